@@ -1,0 +1,1 @@
+"""Reading and writing skyquill inputs: drawings, line-segment plans and safe corridors."""

@@ -1,0 +1,1 @@
+"""Reproduction harness: peer implementations that skyquill compares itself with."""

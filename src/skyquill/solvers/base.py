@@ -1,0 +1,92 @@
+"""The one small interface every QP backend adapter implements.
+
+A :class:`QuadraticProgram` is ``min 1/2 x'Px + q'x  s.t.  A_eq x = b_eq,
+G x <= h``; a backend returns a typed :class:`QPSolution` whose ``status``
+is one of ``"optimal"``, ``"infeasible"`` or ``"failed"`` (qpsolvers'
+``Solution`` and rotorpy's ``ExitStatus`` do the same).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Literal, Protocol
+
+import numpy as np
+import scipy.sparse as sp
+
+from skyquill.validation import FloatArray
+
+QPStatus = Literal["optimal", "infeasible", "failed"]
+
+
+@dataclass(frozen=True)
+class QuadraticProgram:
+    """``min 1/2 x'Px + q'x  s.t.  A_eq x = b_eq,  G x <= h``.
+
+    Attributes
+    ----------
+    P
+        Symmetric positive semi-definite, shape (n, n), CSC.
+    q
+        Shape (n,).
+    A_eq, b_eq
+        Shapes (m_eq, n), (m_eq,).
+    G, h
+        Shapes (m_in, n), (m_in,).
+    """
+
+    P: sp.csc_array
+    q: FloatArray
+    A_eq: sp.csc_array
+    b_eq: FloatArray
+    G: sp.csc_array
+    h: FloatArray
+
+    @property
+    def n(self) -> int:
+        """Number of variables."""
+        return int(self.q.size)
+
+    def objective(self, x: FloatArray) -> float:
+        """``1/2 x'Px + q'x``."""
+        return float(0.5 * x @ (self.P @ x) + self.q @ x)
+
+
+@dataclass(frozen=True)
+class QPSolution:
+    """What a backend returns.
+
+    Attributes
+    ----------
+    status
+        ``"optimal"``, ``"infeasible"`` (certified primal infeasible) or
+        ``"failed"`` (anything else; see ``message``).
+    x
+        Solution, shape (n,), or ``None`` unless optimal.
+    solver
+        Backend name.
+    solve_time_s
+        Wall time of the backend's setup and solve.
+    message
+        The backend's own status text.
+    """
+
+    status: QPStatus
+    x: FloatArray | None
+    solver: str
+    solve_time_s: float
+    message: str = ""
+
+
+class QPBackend(Protocol):
+    """A function that solves a :class:`QuadraticProgram` to high accuracy."""
+
+    def __call__(self, qp: QuadraticProgram, tol: float) -> QPSolution: ...
+
+
+def stacked_constraints(qp: QuadraticProgram) -> tuple[sp.csc_array, FloatArray, FloatArray]:
+    """``l <= [A_eq; G] x <= u`` form used by several backends."""
+    A = sp.csc_array(sp.vstack([qp.A_eq, qp.G]))
+    lower = np.concatenate([qp.b_eq, np.full(qp.h.size, -np.inf)])
+    upper = np.concatenate([qp.b_eq, qp.h])
+    return A, lower, upper

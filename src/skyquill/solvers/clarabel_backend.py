@@ -1,0 +1,38 @@
+"""Clarabel (interior point, Rust) adapter."""
+
+from __future__ import annotations
+
+import time
+
+import clarabel
+import numpy as np
+import scipy.sparse as sp
+
+from skyquill.solvers.base import QPSolution, QuadraticProgram
+
+
+def solve_clarabel(qp: QuadraticProgram, tol: float) -> QPSolution:
+    """Solve with Clarabel; ``tol`` sets its gap and feasibility tolerances."""
+    start = time.perf_counter()
+    settings = clarabel.DefaultSettings()
+    settings.verbose = False
+    settings.tol_gap_abs = settings.tol_gap_rel = tol
+    settings.tol_feas = tol
+    settings.tol_ktratio = 1e-8
+    settings.max_iter = 200
+    A = sp.csc_matrix(sp.vstack([qp.A_eq, qp.G]))
+    b = np.concatenate([qp.b_eq, qp.h])
+    cones = []
+    if qp.b_eq.size:
+        cones.append(clarabel.ZeroConeT(qp.b_eq.size))
+    if qp.h.size:
+        cones.append(clarabel.NonnegativeConeT(qp.h.size))
+    P = sp.csc_matrix(sp.triu(qp.P, format="csc"))
+    result = clarabel.DefaultSolver(P, qp.q, A, b, cones, settings).solve()
+    elapsed = time.perf_counter() - start
+    name = str(result.status).split(".")[-1]
+    if name in ("Solved", "AlmostSolved"):
+        return QPSolution("optimal", np.asarray(result.x), "clarabel", elapsed, name)
+    if "PrimalInfeasible" in name:
+        return QPSolution("infeasible", None, "clarabel", elapsed, name)
+    return QPSolution("failed", None, "clarabel", elapsed, name)

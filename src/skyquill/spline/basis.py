@@ -1,0 +1,278 @@
+"""Clamped uniform B-spline basis in the path parameter ``s`` (paper 003 §2).
+
+Everything here works in the *normalised* parameter ``s`` in ``[0, L]`` where
+``L = M - k`` is the number of knot spans; the linear time scale
+``s = alpha * t`` (paper 003 eq. 5) is applied by the caller, which multiplies
+an ``n``-th derivative map by ``alpha**n`` and a Gram matrix of order ``n`` by
+``alpha**(2n - 1)``.
+
+Every map returned is a sparse matrix acting on the control points of one
+axis, shape ``(rows, M)``; the axis-coupled problem uses their Kronecker
+product with ``I_d`` (paper 003 eq. 9). Evaluation of basis functions is
+delegated to :meth:`scipy.interpolate.BSpline.design_matrix`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cached_property, lru_cache
+from typing import Literal
+
+import numpy as np
+import scipy.sparse as sp
+from numpy.typing import NDArray
+from scipy.interpolate import BSpline
+
+from skyquill.errors import InputError
+
+FloatArray = NDArray[np.float64]
+HullKind = Literal["bspline", "bezier"]
+
+MAX_DEGREE = 7
+
+
+def clamped_uniform_knots(degree: int, n_ctrl: int) -> FloatArray:
+    """Knot vector of paper 003 eq. (4).
+
+    ``[0]*(k+1), 1, 2, ..., L-1, [L]*(k+1)`` with ``L = M - k`` spans.
+
+    Parameters
+    ----------
+    degree
+        Spline degree ``k`` (the paper's "order").
+    n_ctrl
+        Number of control points ``M``; at least ``k + 1``.
+
+    Returns
+    -------
+    numpy.ndarray, shape (M + k + 1,)
+    """
+    n_spans = n_ctrl - degree
+    return np.concatenate(
+        [np.zeros(degree), np.arange(n_spans + 1, dtype=float), np.full(degree, float(n_spans))]
+    )
+
+
+def _bernstein_matrix(degree: int, u: FloatArray) -> FloatArray:
+    """Bernstein basis of ``degree`` at local parameters ``u`` in [0, 1]; shape (len(u), degree+1)."""
+    from math import comb
+
+    i = np.arange(degree + 1)
+    binom = np.array([comb(degree, j) for j in i], dtype=float)
+    return binom * u[:, None] ** i * (1.0 - u[:, None]) ** (degree - i)
+
+
+@dataclass(frozen=True)
+class ClampedUniformBasis:
+    """Clamped uniform B-spline basis of degree ``k`` with ``M`` control points.
+
+    Parameters
+    ----------
+    degree
+        Degree ``k``, 1 to 7.
+    n_ctrl
+        Number of control points ``M >= k + 1``.
+    """
+
+    degree: int
+    n_ctrl: int
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.degree, int | np.integer) or not 1 <= self.degree <= MAX_DEGREE:
+            raise InputError(
+                f"degree: got {self.degree!r}, expected an integer from 1 to {MAX_DEGREE}"
+            )
+        if not isinstance(self.n_ctrl, int | np.integer) or self.n_ctrl < self.degree + 1:
+            raise InputError(
+                f"n_ctrl: got {self.n_ctrl!r}, expected an integer >= degree + 1 = "
+                f"{self.degree + 1}"
+            )
+
+    @property
+    def n_spans(self) -> int:
+        """Number of knot spans ``L = M - k``; the parameter runs over ``[0, L]``."""
+        return self.n_ctrl - self.degree
+
+    @cached_property
+    def knots(self) -> FloatArray:
+        """Knot vector, shape (M + k + 1,)."""
+        return clamped_uniform_knots(self.degree, self.n_ctrl)
+
+    def reduced(self, order: int) -> ClampedUniformBasis | None:
+        """Basis of the ``order``-th derivative spline (degree ``k - order``, ``M - order`` points).
+
+        Returns ``None`` for ``order == k`` (degree 0 is handled by the callers
+        directly, since this class requires degree >= 1).
+        """
+        if order == self.degree:
+            return None
+        return ClampedUniformBasis(self.degree - order, self.n_ctrl - order)
+
+    def _check_order(self, order: int) -> None:
+        if not isinstance(order, int | np.integer) or not 0 <= order <= self.degree:
+            raise InputError(
+                f"order: got {order!r}, expected an integer from 0 to the degree {self.degree}"
+            )
+
+    def design_matrix(self, s: FloatArray, order: int = 0) -> sp.csr_array:
+        """Rows of basis-function derivatives at parameters ``s``.
+
+        Parameters
+        ----------
+        s
+            Parameters, shape (N,), each in ``[0, L]``.
+        order
+            Derivative order with respect to ``s``, 0 to ``k``.
+
+        Returns
+        -------
+        scipy.sparse.csr_array, shape (N, M)
+            ``row @ C`` is the ``order``-th ``s``-derivative of the spline at ``s``.
+        """
+        self._check_order(order)
+        s = np.asarray(s, dtype=float)
+        if s.ndim != 1 or not np.all(np.isfinite(s)):
+            raise InputError(f"s: got shape {s.shape} with non-finite values or wrong rank, "
+                             "expected a finite 1-D array")
+        if s.size and (s.min() < 0.0 or s.max() > self.n_spans):
+            raise InputError(
+                f"s: got values in [{s.min():g}, {s.max():g}], expected within [0, {self.n_spans}]"
+            )
+        p = self.degree - order
+        knots = self.knots[order : len(self.knots) - order]
+        if p == 0:
+            # Piecewise-constant basis: column = span index (right end -> last span).
+            cols = np.minimum(np.floor(s).astype(int), self.n_spans - 1)
+            basis = sp.csr_array(
+                (np.ones(s.size), (np.arange(s.size), cols)), shape=(s.size, self.n_ctrl - order)
+            )
+        else:
+            basis = sp.csr_array(BSpline.design_matrix(s, knots, p))
+        if order == 0:
+            return basis
+        return sp.csr_array(basis @ self.derivative_map(order))
+
+    def derivative_map(self, order: int) -> sp.csr_array:
+        """Map Γ_n from control points to those of the ``order``-th ``s``-derivative.
+
+        Paper 003 eqs. (34)-(37) with ``alpha = 1``: applying eq. (34)
+        ``order`` times. The derivative spline has degree ``k - order`` and the
+        knot vector of eq. (35).
+
+        Returns
+        -------
+        scipy.sparse.csr_array, shape (M - order, M)
+        """
+        self._check_order(order)
+        return self._derivative_maps[order]
+
+    @cached_property
+    def _derivative_maps(self) -> tuple[sp.csr_array, ...]:
+        maps = [sp.csr_array(sp.eye_array(self.n_ctrl, format="csr"))]
+        knots = self.knots
+        for j in range(1, self.degree + 1):
+            p = self.degree - j + 1  # degree before this differentiation
+            m = self.n_ctrl - j + 1  # control points before it
+            t = knots[j - 1 : len(knots) - j + 1]
+            scale = p / (t[p + 1 : p + m] - t[1:m])  # eq. (34): k / (s_{i+k+1} - s_{i+1})
+            step = sp.diags_array([-scale, scale], offsets=[0, 1], shape=(m - 1, m), format="csr")
+            maps.append(sp.csr_array(step @ maps[-1]))
+        return tuple(maps)
+
+    def gram(self, order: int) -> sp.csr_array:
+        """Exact Gram matrix of the ``order``-th derivative (paper 003 eq. 10, ``alpha = 1``).
+
+        ``V[i, j] = ∫_0^L N_i^(n)(s) N_j^(n)(s) ds``. The integrand is a
+        polynomial of degree ``2(k - n)`` on each span, so Gauss-Legendre with
+        ``k - n + 1`` nodes per span integrates it exactly (up to round-off).
+
+        Returns
+        -------
+        scipy.sparse.csr_array, shape (M, M), symmetric positive semi-definite.
+        """
+        self._check_order(order)
+        return self._grams[order]
+
+    @cached_property
+    def _grams(self) -> tuple[sp.csr_array, ...]:
+        grams = []
+        for order in range(self.degree + 1):
+            n_nodes = self.degree - order + 1
+            nodes, weights = np.polynomial.legendre.leggauss(n_nodes)
+            u = 0.5 * (nodes + 1.0)  # on [0, 1]
+            spans = np.arange(self.n_spans)
+            s = (spans[:, None] + u[None, :]).ravel()
+            w = np.tile(0.5 * weights, self.n_spans)
+            B = self.design_matrix(s, order)
+            grams.append(sp.csr_array(B.T @ sp.diags_array(w) @ B))
+        return tuple(grams)
+
+    def hull_map(
+        self, order: int, first_span: int = 0, last_span: int | None = None,
+        kind: HullKind = "bspline",
+    ) -> sp.csr_array:
+        """Points whose convex hull contains the ``order``-th derivative on spans.
+
+        The curve ``d^n S / ds^n`` restricted to ``s`` in
+        ``[first_span, last_span + 1]`` lies in the convex hull of the rows of
+        ``hull_map(...) @ C``; this is what makes a linear inequality on these
+        points hold on the whole interval (paper 003 eqs. 29-31, 39).
+
+        Parameters
+        ----------
+        order
+            Derivative order ``n``, 0 to ``k``.
+        first_span, last_span
+            Inclusive span range; defaults to all spans.
+        kind
+            ``"bspline"``: the control points of the derivative spline that
+            are active on those spans (the papers' hull, eq. 39).
+            ``"bezier"``: the Bézier control points of each span's polynomial
+            piece. Each is a convex combination of the B-spline points active
+            on its span, so the Bézier hull is contained in the B-spline hull
+            and the constraint is never looser; it is exact at the span ends.
+
+        Returns
+        -------
+        scipy.sparse.csr_array, shape (P, M)
+        """
+        self._check_order(order)
+        last = self.n_spans - 1 if last_span is None else last_span
+        if not 0 <= first_span <= last <= self.n_spans - 1:
+            raise InputError(
+                f"span range: got [{first_span}, {last}], expected 0 <= first <= last <= "
+                f"{self.n_spans - 1}"
+            )
+        p = self.degree - order
+        if kind == "bspline":
+            # Derivative control points active on spans first..last (eq. 35 knots).
+            rows = np.arange(first_span, min(last + p, self.n_ctrl - order - 1) + 1)
+            return sp.csr_array(self.derivative_map(order)[rows, :])
+        if kind != "bezier":
+            raise InputError(f"kind: got {kind!r}, expected 'bspline' or 'bezier'")
+        # Sample each span's polynomial at p+1 interior points, then invert the
+        # Bernstein matrix: exact Bézier points of a degree-p polynomial.
+        u = (np.arange(p + 1) + 0.5) / (p + 1)
+        to_bezier = np.linalg.inv(_bernstein_matrix(p, u))
+        n_sel = last - first_span + 1
+        s = (np.arange(first_span, last + 1)[:, None] + u[None, :]).ravel()
+        values = self.design_matrix(s, order)
+        blocks = sp.block_diag([to_bezier] * n_sel, format="csr")
+        return sp.csr_array(blocks @ values)
+
+    def spans_in_window(self, s_start: float, s_end: float) -> tuple[int, int]:
+        """Inclusive range of spans that intersect ``[s_start, s_end)`` (paper 003 §3.4).
+
+        The paper's ``eta(tau) = floor(alpha tau) + k`` indexes the knot; here
+        the span index is ``floor(s)``. A window ending exactly on a knot does
+        not reach into the next span.
+        """
+        first = min(int(np.floor(s_start)), self.n_spans - 1)
+        last = max(first, min(int(np.ceil(s_end)) - 1, self.n_spans - 1))
+        return first, last
+
+
+@lru_cache(maxsize=64)
+def basis_for(degree: int, n_ctrl: int) -> ClampedUniformBasis:
+    """Shared, cached basis: its derivative maps and Gram matrices are built once."""
+    return ClampedUniformBasis(degree, n_ctrl)

@@ -1,0 +1,202 @@
+"""Trajectories: the object every pipeline stage speaks.
+
+:class:`Trajectory` is the protocol (duration, evaluate, sample);
+:class:`SplineTrajectory` is the clamped uniform B-spline the engine returns.
+Positions are in the z-up world frame, metres; time in seconds from 0.
+"""
+
+from __future__ import annotations
+
+import math
+
+from dataclasses import dataclass
+from functools import cached_property
+from typing import Protocol, runtime_checkable
+
+import numpy as np
+from scipy.interpolate import BSpline
+
+from skyquill.errors import InputError
+from skyquill.spline import ClampedUniformBasis, basis_for
+from skyquill.validation import FloatArray, as_array, as_float, as_int
+
+#: DESIGN.md: at least 20 samples per knot span and never fewer than 10,000.
+DENSE_PER_SPAN = 20
+DENSE_MIN_TOTAL = 10_000
+
+
+@dataclass(frozen=True)
+class Samples:
+    """A trajectory sampled at fixed times.
+
+    Attributes
+    ----------
+    t
+        Times, shape (N,), s.
+    p, v, a, j
+        Position (m), velocity (m/s), acceleration (m/s^2), jerk (m/s^3),
+        each shape (N, d).
+    """
+
+    t: FloatArray
+    p: FloatArray
+    v: FloatArray
+    a: FloatArray
+    j: FloatArray
+
+
+@runtime_checkable
+class Trajectory(Protocol):
+    """What every stage needs of a trajectory."""
+
+    @property
+    def duration(self) -> float:
+        """Length in seconds; the trajectory is defined on ``[0, duration]``."""
+        ...
+
+    @property
+    def dim(self) -> int:
+        """Number of axes ``d``."""
+        ...
+
+    def evaluate(self, t: FloatArray, order: int = 0) -> FloatArray:
+        """The ``order``-th time derivative at times ``t`` (N,); returns (N, d)."""
+        ...
+
+    def sample(self, rate: float) -> Samples:
+        """Samples at ``rate`` Hz from 0 to ``duration`` inclusive."""
+        ...
+
+
+def sample_times(duration: float, rate: float) -> FloatArray:
+    """``0, 1/rate, ...`` up to and including ``duration``; shape (N,)."""
+    rate = as_float("rate", rate, positive=True)
+    n = int(np.floor(duration * rate + 1e-9)) + 1
+    t = np.arange(n) / rate
+    if duration - t[-1] > 1e-9:
+        t = np.append(t, duration)
+    return np.minimum(t, duration)
+
+
+def sample(traj: Trajectory, rate: float) -> Samples:
+    """Sample any :class:`Trajectory` (position to jerk) at ``rate`` Hz."""
+    t = sample_times(traj.duration, rate)
+    p, v, a, j = (traj.evaluate(t, n) for n in range(4))
+    return Samples(t, p, v, a, j)
+
+
+@dataclass(frozen=True)
+class SplineTrajectory:
+    """Clamped uniform B-spline ``p(t) = sum_i c_i N_i^k(alpha t)``.
+
+    Parameters
+    ----------
+    control_points
+        Shape (M, d), metres.
+    degree
+        Degree ``k``, 1 to 7.
+    duration
+        Seconds; ``alpha = (M - k) / duration`` (paper 003 eq. 5).
+    """
+
+    control_points: FloatArray
+    degree: int
+    duration: float
+
+    def __post_init__(self) -> None:
+        ctrl = as_array("control_points", self.control_points, ndim=2)
+        as_int("degree", self.degree, low=1, high=7)
+        as_float("duration", self.duration, positive=True)
+        ClampedUniformBasis(self.degree, ctrl.shape[0])  # validates M >= k + 1
+        ctrl.setflags(write=False)
+        object.__setattr__(self, "control_points", ctrl)
+
+    @property
+    def dim(self) -> int:
+        """Number of axes ``d``."""
+        return int(self.control_points.shape[1])
+
+    @cached_property
+    def basis(self) -> ClampedUniformBasis:
+        """The basis in the normalised parameter ``s`` (shared cache)."""
+        return basis_for(self.degree, int(self.control_points.shape[0]))
+
+    @property
+    def alpha(self) -> float:
+        """Time scale ``s / t`` in spans per second."""
+        return self.basis.n_spans / self.duration
+
+    @property
+    def knot_times(self) -> FloatArray:
+        """Distinct knot times (breakpoints), shape (L + 1,), s."""
+        return np.arange(self.basis.n_spans + 1) / self.alpha
+
+    @cached_property
+    def _splines(self) -> tuple[BSpline, ...]:
+        base = BSpline(self.basis.knots / self.alpha, self.control_points, self.degree)
+        return (base, *(base.derivative(n) for n in range(1, self.degree + 1)))
+
+    def evaluate(self, t: FloatArray, order: int = 0) -> FloatArray:
+        """The ``order``-th time derivative at times ``t``.
+
+        Parameters
+        ----------
+        t
+            Times, shape (N,), each in ``[0, duration]`` s.
+        order
+            0 (position) and up; orders above the degree are identically 0.
+
+        Returns
+        -------
+        numpy.ndarray, shape (N, d)
+        """
+        times = as_array("t", t, ndim=1)
+        as_int("order", order, low=0)
+        tol = 1e-9 * max(1.0, self.duration)
+        if times.size and (times.min() < -tol or times.max() > self.duration + tol):
+            raise InputError(
+                f"t: got times in [{times.min():g}, {times.max():g}] s, expected within "
+                f"[0, {self.duration:g}] s"
+            )
+        times = np.clip(times, 0.0, self.duration)  # only round-off reaches here
+        if order > self.degree:
+            return np.zeros((times.size, self.dim))
+        return np.asarray(self._splines[order](times), dtype=float).reshape(times.size, self.dim)
+
+    def sample(self, rate: float) -> Samples:
+        """Samples at ``rate`` Hz (position to jerk), including both ends."""
+        return sample(self, rate)
+
+    def dense_times(self) -> FloatArray:
+        """Times for the dense check: >= 20 per knot span and >= 10,000 in all."""
+        n = max(DENSE_MIN_TOTAL, DENSE_PER_SPAN * self.basis.n_spans + 1)
+        return np.linspace(0.0, self.duration, n)
+
+    def derivative_control_points(self, order: int) -> FloatArray:
+        """Control points of the ``order``-th time derivative, shape (M - order, d).
+
+        Paper 003 eq. (37): ``alpha^n Gamma_n C``.
+        """
+        return np.asarray(
+            self.alpha**order * (self.basis.derivative_map(order) @ self.control_points)
+        )
+
+    def to_piecewise_polynomial(self) -> tuple[FloatArray, FloatArray]:
+        """Exact conversion to one polynomial per knot span.
+
+        Returns
+        -------
+        breaks : numpy.ndarray, shape (L + 1,)
+            Span boundaries, s.
+        coeffs : numpy.ndarray, shape (L, k + 1, d)
+            Power-basis coefficients in local time ``tau = t - breaks[i]``,
+            lowest order first: ``p(t) = sum_j coeffs[i, j] tau^j``.
+        """
+        # Taylor coefficients at each span's left end: BSpline evaluates a
+        # breakpoint with the span to its right, so these are right limits.
+        breaks = self.knot_times
+        left = breaks[:-1]
+        coeffs = np.stack(
+            [self._splines[j](left) / math.factorial(j) for j in range(self.degree + 1)], axis=1
+        )
+        return breaks, np.asarray(coeffs, dtype=float)

@@ -1,0 +1,95 @@
+"""Argument checks shared by every entry point.
+
+Each helper either returns a clean ``float64`` array / number or raises
+:class:`~skyquill.errors.InputError` whose message names the argument, says
+what was received and what was expected. Nothing is clipped or repaired.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from skyquill.errors import InputError
+
+FloatArray = NDArray[np.float64]
+
+
+def _describe(value: Any) -> str:
+    arr = np.asarray(value) if not isinstance(value, str) else None
+    if arr is not None and arr.dtype.kind in "fiub" and arr.ndim > 0:
+        return f"an array of shape {arr.shape}"
+    text = repr(value)
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def as_array(
+    name: str, value: Any, *, ndim: int | None = None, shape: tuple[int | None, ...] | None = None
+) -> FloatArray:
+    """Convert ``value`` to a finite float64 array and check its rank and shape.
+
+    ``shape`` entries of ``None`` match any length.
+    """
+    try:
+        arr = np.asarray(value, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise InputError(
+            f"{name}: got {_describe(value)}, expected numbers convertible to a float array"
+        ) from exc
+    want_ndim = len(shape) if shape is not None else ndim
+    if want_ndim is not None and arr.ndim != want_ndim:
+        raise InputError(
+            f"{name}: got an array of shape {arr.shape}, expected {want_ndim} dimension(s)"
+            + (f" with shape {_shape_text(shape)}" if shape is not None else "")
+        )
+    if shape is not None and any(w is not None and w != a for w, a in zip(shape, arr.shape,
+                                                                            strict=True)):
+        raise InputError(
+            f"{name}: got an array of shape {arr.shape}, expected shape {_shape_text(shape)}"
+        )
+    if not np.all(np.isfinite(arr)):
+        bad = int(np.count_nonzero(~np.isfinite(arr)))
+        raise InputError(f"{name}: got {bad} NaN or infinite value(s), expected finite numbers")
+    return arr
+
+
+def _shape_text(shape: tuple[int | None, ...]) -> str:
+    return "(" + ", ".join("any" if s is None else str(s) for s in shape) + ")"
+
+
+def as_float(name: str, value: Any, *, positive: bool = False, nonneg: bool = False) -> float:
+    """A finite float, optionally required ``> 0`` or ``>= 0``."""
+    if isinstance(value, bool) or not isinstance(value, int | float | np.integer | np.floating):
+        raise InputError(f"{name}: got {_describe(value)}, expected a number")
+    x = float(value)
+    if not np.isfinite(x):
+        raise InputError(f"{name}: got {x}, expected a finite number")
+    if positive and x <= 0.0:
+        raise InputError(f"{name}: got {x:g}, expected a number > 0")
+    if nonneg and x < 0.0:
+        raise InputError(f"{name}: got {x:g}, expected a number >= 0")
+    return x
+
+
+def as_int(name: str, value: Any, *, low: int, high: int | None = None) -> int:
+    """An integer in ``[low, high]``."""
+    if isinstance(value, bool) or not isinstance(value, int | np.integer):
+        raise InputError(f"{name}: got {_describe(value)}, expected an integer")
+    i = int(value)
+    if i < low or (high is not None and i > high):
+        rng = f"from {low} to {high}" if high is not None else f">= {low}"
+        raise InputError(f"{name}: got {i}, expected an integer {rng}")
+    return i
+
+
+def strictly_increasing(name: str, times: FloatArray) -> None:
+    """Raise unless the 1-D array ``times`` is strictly increasing."""
+    steps = np.diff(times)
+    if np.any(steps <= 0.0):
+        i = int(np.argmax(steps <= 0.0))
+        raise InputError(
+            f"{name}: got {name}[{i}] = {times[i]:g} followed by {times[i + 1]:g}, "
+            "expected strictly increasing values"
+        )
