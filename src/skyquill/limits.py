@@ -39,7 +39,7 @@ def order_name(order: int) -> str:
 
 def _relative(excess: float, bound: float) -> float:
     """Excess relative to the bound's magnitude (absolute when the bound is 0)."""
-    return max(0.0, excess) / max(abs(bound), 1e-12)
+    return max(0.0, excess) / abs(bound) if bound != 0.0 else max(0.0, excess)
 
 
 @dataclass(frozen=True)

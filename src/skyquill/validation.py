@@ -26,11 +26,18 @@ def _describe(value: Any) -> str:
 
 
 def as_array(
-    name: str, value: Any, *, ndim: int | None = None, shape: tuple[int | None, ...] | None = None
+    name: str,
+    value: Any,
+    *,
+    ndim: int | None = None,
+    shape: tuple[int | None, ...] | None = None,
+    max_abs: float | None = None,
 ) -> FloatArray:
     """Convert ``value`` to a finite float64 array and check its rank and shape.
 
-    ``shape`` entries of ``None`` match any length.
+    ``shape`` entries of ``None`` match any length; ``max_abs`` bounds every
+    entry's magnitude (coordinates beyond it are almost surely in the wrong unit,
+    and would overflow squared distances).
     """
     try:
         arr = np.asarray(value, dtype=float)
@@ -52,6 +59,11 @@ def as_array(
     if not np.all(np.isfinite(arr)):
         bad = int(np.count_nonzero(~np.isfinite(arr)))
         raise InputError(f"{name}: got {bad} NaN or infinite value(s), expected finite numbers")
+    if max_abs is not None and arr.size and np.abs(arr).max() > max_abs:
+        raise InputError(
+            f"{name}: got a value of magnitude {np.abs(arr).max():.3g}, expected at most "
+            f"{max_abs:g}"
+        )
     return arr
 
 

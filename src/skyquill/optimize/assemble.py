@@ -104,7 +104,7 @@ def assemble(problem: SmoothingProblem, margin: float = 0.0) -> Assembled:
     coupled: list[tuple[sp.csr_array, FloatArray, float]] = []
     for term in problem.deviations:
         if isinstance(term, PointDeviation):
-            H = basis.design_matrix(alpha * term.times)
+            H = basis.design_matrix(_params(problem, term.times))
             G_points = G_points + term.weight * (H.T @ H)
             F -= 2.0 * term.weight * (H.T @ term.points)
             const += term.weight * float(np.sum(term.points**2))
@@ -126,9 +126,21 @@ def assemble(problem: SmoothingProblem, margin: float = 0.0) -> Assembled:
     )
 
 
+def _params(problem: SmoothingProblem, times: FloatArray) -> FloatArray:
+    """Path parameters ``s = alpha * t`` of validated times, clipped to ``[0, L]``.
+
+    Fix: ``SmoothingProblem`` accepts times up to 1e-9 * duration outside
+    ``[0, duration]``, and even ``t = duration`` exactly can round to
+    ``alpha * t > L`` (e.g. L = 3, duration = 1.3437...); the basis rejects
+    such ``s`` (and a window start below 0 gave span -1), so clip here.
+    """
+    s = problem.alpha * np.asarray(times, dtype=float)
+    return np.clip(s, 0.0, float(problem.basis.n_spans))
+
+
 def _window_controls(problem: SmoothingProblem, t_start: float, t_end: float) -> FloatArray:
     """Indicator (M,) of the control points active on ``[t_start, t_end)`` (§3.4)."""
-    first, last = problem.basis.spans_in_window(problem.alpha * t_start, problem.alpha * t_end)
+    first, last = problem.basis.spans_in_window(*_params(problem, np.array([t_start, t_end])))
     active = np.zeros(problem.n_ctrl)
     active[first : last + problem.degree + 1] = 1.0
     return active
@@ -161,7 +173,7 @@ def _equalities(problem: SmoothingProblem) -> tuple[sp.csr_array, FloatArray]:
             rhs.append(bc.end[None, :])
     for term in problem.interpolation:
         if isinstance(term, Interpolation):
-            rows.append(basis.design_matrix(alpha * term.times))
+            rows.append(basis.design_matrix(_params(problem, term.times)))
             rhs.append(term.points)
     if not rows:
         return sp.csr_array((0, M)), np.zeros((0, problem.dim))
@@ -191,7 +203,7 @@ def _inequalities(
         add(f"limit: {lim.label}", basis.hull_map(lim.order, kind=problem.hull) * alpha**lim.order,
             A, b)
     for i, cor in enumerate(problem.corridors):
-        first, last = basis.spans_in_window(alpha * cor.t_start, alpha * cor.t_end)
+        first, last = basis.spans_in_window(*_params(problem, np.array([cor.t_start, cor.t_end])))
         add(_corridor_label(i, cor), basis.hull_map(0, first, last, problem.hull), cor.A, cor.b)
     if not blocks:
         return sp.csr_array((0, problem.n_ctrl * d)), np.zeros(0), ()

@@ -19,9 +19,12 @@ from skyquill.errors import InfeasibleError, InputError
 from skyquill.limits import DerivativeLimit, vehicle_limits
 from skyquill.optimize.problem import Boundary, PointDeviation, SmoothingProblem
 from skyquill.optimize.solve import FitResult, solve
-from skyquill.optimize.timing import allocate_path_times
+from skyquill.optimize.timing import MAX_COORDINATE_M, allocate_path_times
 from skyquill.spline import HullKind
 from skyquill.validation import FloatArray, as_array, as_float, as_int, strictly_increasing
+
+
+MAX_SPANS = 100_000
 
 
 @dataclass(frozen=True)
@@ -126,13 +129,13 @@ def fit_points(
         :class:`FitOptions`; defaults if ``None``.
     """
     opts = options or FitOptions()
-    pts = as_array("points", points, ndim=2)
+    pts = as_array("points", points, ndim=2, max_abs=MAX_COORDINATE_M)
     if pts.shape[1] not in (2, 3) or pts.shape[0] < 2:
         raise InputError(f"points: got shape {pts.shape}, expected (N >= 2, 2 or 3)")
     if times is None:
         t = allocate_path_times(pts, opts.vmax, opts.allocation_accel_fraction * opts.amax)
     else:
-        t = as_array("times", times, shape=(pts.shape[0],))
+        t = as_array("times", times, shape=(pts.shape[0],), max_abs=1e7)
         strictly_increasing("times", t)
         t = t - t[0]
     limits = vehicle_limits(pts.shape[1], opts.vmax, opts.amax, opts.jmax, opts.coupled)
@@ -155,6 +158,11 @@ def _problem(
 ) -> SmoothingProblem:
     duration = float(t[-1])
     n_spans = max(1, math.ceil(duration / opts.knot_interval))
+    if n_spans > MAX_SPANS:
+        raise InputError(
+            f"knot_interval: got {opts.knot_interval:g} s for a {duration:.6g} s plan, i.e. "
+            f"{n_spans} knot spans, expected at most {MAX_SPANS} (are the points in metres?)"
+        )
     return SmoothingProblem(
         dim=pts.shape[1],
         degree=opts.degree,

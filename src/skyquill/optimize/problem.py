@@ -12,22 +12,55 @@ checks that dimensions agree and that every time lies within the duration.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
+from typing import Any, TypeVar
 
 import numpy as np
 import scipy.optimize
 
+from skyquill import validation
 from skyquill.errors import InputError
-from skyquill.limits import DerivativeLimit
+from skyquill.limits import BoxLimit, CylinderLimit, DerivativeLimit
 from skyquill.spline import ClampedUniformBasis, HullKind, basis_for
-from skyquill.validation import (
-    FloatArray,
-    as_array,
-    as_float,
-    as_int,
-    strictly_increasing,
-)
+from skyquill.validation import FloatArray, strictly_increasing
+
+_T = TypeVar("_T")
+
+
+def _guarded(check: Callable[..., _T], name: str, value: Any, **kwargs: Any) -> _T:
+    """Run a :mod:`skyquill.validation` check; let only :class:`InputError` out.
+
+    Fix: the validation helpers let two kinds of garbage escape as other
+    exception types -- a ragged nested list (their message helper calls
+    ``np.asarray`` on it again: ValueError) and an int beyond the float range
+    (OverflowError). The root fix belongs in ``validation.py``; until then
+    every constructor here still raises only ``InputError``.
+    """
+    try:
+        return check(name, value, **kwargs)
+    except InputError:
+        raise
+    except (ValueError, OverflowError, TypeError) as exc:
+        raise InputError(
+            f"{name}: got a {type(value).__name__} that is not a rectangular array of "
+            "float-range numbers, expected numbers convertible to float"
+        ) from exc
+
+
+def as_array(name: str, value: Any, **kwargs: Any) -> FloatArray:
+    """:func:`skyquill.validation.as_array` through :func:`_guarded`."""
+    return _guarded(validation.as_array, name, value, **kwargs)
+
+
+def as_float(name: str, value: Any, **kwargs: Any) -> float:
+    """:func:`skyquill.validation.as_float` through :func:`_guarded`."""
+    return _guarded(validation.as_float, name, value, **kwargs)
+
+
+def as_int(name: str, value: Any, **kwargs: Any) -> int:
+    """:func:`skyquill.validation.as_int` through :func:`_guarded`."""
+    return _guarded(validation.as_int, name, value, **kwargs)
 
 
 def _points_at_times(name: str, times: object, points: object) -> tuple[FloatArray, FloatArray]:
@@ -184,6 +217,7 @@ class Boundary:
         """Position at both ends and derivatives ``1..orders-1`` zero: rest to rest."""
         s = as_array("start", start, ndim=1)
         e = as_array("end", end, shape=(s.size,))
+        as_int("orders", orders, low=1, high=7)  # fix: garbage gave TypeError from range()
         zero = np.zeros(s.size)
         return (cls(0, s, e), *(cls(n, zero, zero) for n in range(1, orders)))
 
@@ -210,6 +244,8 @@ class Corridor:
         b = as_array("corridor.b", self.b, shape=(A.shape[0],))
         if A.shape[0] == 0:
             raise InputError("corridor.A: got no half-spaces, expected at least one row")
+        if A.shape[1] == 0:  # fix: linprog raised ValueError on zero columns
+            raise InputError(f"corridor.A: got shape {A.shape}, expected at least one column")
         _window("corridor", self.t_start, self.t_end)
         object.__setattr__(self, "A", A)
         object.__setattr__(self, "b", b)
@@ -268,8 +304,21 @@ class SmoothingProblem:
         as_int("dim", self.dim, low=1, high=16)
         ClampedUniformBasis(self.degree, self.n_ctrl)
         as_float("duration", self.duration, positive=True)
-        if self.hull not in ("bspline", "bezier"):
+        # Fix: a non-str hull (an array: ambiguous truth value) and non-mapping
+        # smoothness or non-term entries in the term tuples (AttributeError,
+        # TypeError) escaped as other exception types.
+        if not isinstance(self.hull, str) or self.hull not in ("bspline", "bezier"):
             raise InputError(f"hull: got {self.hull!r}, expected 'bspline' or 'bezier'")
+        if not isinstance(self.smoothness, Mapping):
+            raise InputError(
+                f"smoothness: got {type(self.smoothness).__name__}, expected a mapping "
+                "{order: weight}"
+            )
+        self._check_terms("deviations", (PointDeviation, LineDeviation, PlaneDeviation))
+        self._check_terms("interpolation", (Interpolation,))
+        self._check_terms("boundary", (Boundary,))
+        self._check_terms("limits", (BoxLimit, CylinderLimit))
+        self._check_terms("corridors", (Corridor,))
         for order, sigma in self.smoothness.items():
             as_int("smoothness order", order, low=1, high=self.degree)
             as_float(f"smoothness[{order}]", sigma, nonneg=True)
@@ -283,6 +332,21 @@ class SmoothingProblem:
                     self._check_dim(f"boundary (order {bc.order})", value.size)
         for term in (*self.deviations, *self.interpolation, *self.corridors):
             self._check_term(term)
+
+    def _check_terms(self, name: str, kinds: tuple[type, ...]) -> None:
+        terms = getattr(self, name)
+        if not isinstance(terms, tuple | list):
+            raise InputError(
+                f"{name}: got {type(terms).__name__}, expected a tuple of "
+                f"{' / '.join(k.__name__ for k in kinds)}"
+            )
+        for i, term in enumerate(terms):
+            if not isinstance(term, kinds):
+                raise InputError(
+                    f"{name}[{i}]: got {type(term).__name__}, expected "
+                    f"{' / '.join(k.__name__ for k in kinds)}"
+                )
+        object.__setattr__(self, name, tuple(terms))
 
     def _check_order(self, what: str, order: int, highest: int) -> None:
         if order > highest:

@@ -21,10 +21,11 @@ from __future__ import annotations
 
 import logging
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Literal
 
 import numpy as np
+import scipy.linalg
 import scipy.optimize
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
@@ -96,9 +97,10 @@ def solve(problem: SmoothingProblem, solver: str = DEFAULT_BACKEND) -> FitResult
     Raises
     ------
     InfeasibleError
-        The constraints cannot all be met; ``families`` names which.
+        The constraints cannot all be met; ``families`` names which
+        (``("equalities",)`` for contradictory equalities, on either route).
     SolverError
-        Every backend failed, or the equalities are contradictory/redundant.
+        Every backend failed, or the cost does not determine the closed form.
     """
     if solver not in BACKENDS:
         from skyquill.errors import InputError
@@ -124,7 +126,50 @@ def solve(problem: SmoothingProblem, solver: str = DEFAULT_BACKEND) -> FitResult
 
 
 def _closed_form(asm: Assembled) -> FloatArray:
-    """Minimise the quadratic subject to the equalities by one sparse LU."""
+    """Minimise the quadratic subject to the equalities by one sparse LU.
+
+    Fix: consistent but redundant equalities (an interpolated point at ``t = 0``
+    that a boundary condition also fixes) made the KKT matrix singular, so the
+    closed form raised where the QP route solves the same problem. On a
+    singular factorisation the redundant rows are dropped and the system is
+    solved again; contradictory rows raise :class:`InfeasibleError`, as on the
+    QP route.
+    """
+    try:
+        return _closed_form_kkt(asm)
+    except SolverError:
+        reduced = _independent_equalities(asm)
+        if reduced is None:
+            raise
+        return _closed_form_kkt(reduced)
+
+
+def _independent_equalities(asm: Assembled) -> Assembled | None:
+    """``asm`` with linearly dependent equality rows dropped; ``None`` if there are none.
+
+    Dense pivoted QR of ``E'``: only reached after a singular factorisation.
+    """
+    E = asm.E.toarray()
+    if E.shape[0] == 0:
+        return None
+    _, R, piv = scipy.linalg.qr(E.T, mode="economic", pivoting=True)
+    diag = np.abs(np.diag(R))
+    rank = int(np.count_nonzero(diag > diag[0] * max(E.shape) * np.finfo(float).eps))
+    if rank == E.shape[0]:
+        return None
+    keep = np.sort(piv[:rank])
+    C0 = np.linalg.lstsq(E[keep], asm.e[keep], rcond=None)[0]
+    # Residual relative to each row's magnitude (rows scale with alpha^order).
+    scale = np.abs(E).sum(axis=1)[:, None] * max(float(np.abs(C0).max()), 1e-300) + np.abs(asm.e)
+    if float((np.abs(E @ C0 - asm.e) / scale).max()) > 1e-9:
+        raise InfeasibleError(
+            "infeasible: the boundary conditions and interpolated points contradict each other",
+            ("equalities",),
+        )
+    return replace(asm, E=sp.csr_array(asm.E[keep]), e=asm.e[keep])
+
+
+def _closed_form_kkt(asm: Assembled) -> FloatArray:
     M, d = asm.F.shape
     m = asm.E.shape[0]
     if asm.separable:

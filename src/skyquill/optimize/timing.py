@@ -44,14 +44,18 @@ def rest_to_rest_distance(t: FloatArray, distance: float, vmax: float, amax: flo
     t_acc = v_peak / amax
     t = np.clip(np.asarray(t, dtype=float), 0.0, total)
     s_acc = 0.5 * amax * np.minimum(t, t_acc) ** 2
-    s_cruise = v_peak * np.clip(t - t_acc, 0.0, total - 2 * t_acc)
+    s_cruise = v_peak * np.clip(t - t_acc, 0.0, max(total - 2 * t_acc, 0.0))
     t_dec = np.clip(t - (total - t_acc), 0.0, t_acc)
     s_dec = v_peak * t_dec - 0.5 * amax * t_dec**2
     return np.asarray(s_acc + s_cruise + s_dec)
 
 
+#: Coordinates beyond this (m) are refused: a drawing is not 1000 km wide.
+MAX_COORDINATE_M = 1e6
+
+
 def _waypoints(name: str, points: object) -> FloatArray:
-    pts = as_array(name, points, ndim=2)
+    pts = as_array(name, points, ndim=2, max_abs=MAX_COORDINATE_M)
     if pts.shape[0] < 2:
         raise InputError(f"{name}: got {pts.shape[0]} point(s), expected at least 2")
     return pts

@@ -24,7 +24,9 @@ def solve_osqp(qp: QuadraticProgram, tol: float) -> QPSolution:
         sp.csc_matrix(sp.triu(qp.P, format="csc")), qp.q, sp.csc_matrix(A), lower, upper,
         verbose=False, eps_abs=tol, eps_rel=tol, max_iter=200_000, polishing=True,
     )
-    result = problem.solve()
+    # Fix: explicit raise_error=False -- osqp warns that its default will become True,
+    # which would turn 'infeasible' / 'failed' statuses into exceptions here.
+    result = problem.solve(raise_error=False)
     elapsed = time.perf_counter() - start
     name = str(result.info.status)
     if name.startswith("solved") and "inaccurate" not in name:

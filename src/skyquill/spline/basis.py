@@ -29,6 +29,8 @@ FloatArray = NDArray[np.float64]
 HullKind = Literal["bspline", "bezier"]
 
 MAX_DEGREE = 7
+#: Far beyond any drawing (1e5 samples fit with 1e4 spans); guards memory.
+MAX_CTRL = 2_000_000
 
 
 def clamped_uniform_knots(degree: int, n_ctrl: int) -> FloatArray:
@@ -82,10 +84,12 @@ class ClampedUniformBasis:
             raise InputError(
                 f"degree: got {self.degree!r}, expected an integer from 1 to {MAX_DEGREE}"
             )
-        if not isinstance(self.n_ctrl, int | np.integer) or self.n_ctrl < self.degree + 1:
+        if not isinstance(self.n_ctrl, int | np.integer) or not (
+            self.degree + 1 <= self.n_ctrl <= MAX_CTRL
+        ):
             raise InputError(
-                f"n_ctrl: got {self.n_ctrl!r}, expected an integer >= degree + 1 = "
-                f"{self.degree + 1}"
+                f"n_ctrl: got {self.n_ctrl!r}, expected an integer from degree + 1 = "
+                f"{self.degree + 1} to {MAX_CTRL}"
             )
 
     @property
@@ -140,6 +144,8 @@ class ClampedUniformBasis:
             )
         p = self.degree - order
         knots = self.knots[order : len(self.knots) - order]
+        if s.size == 0:
+            return sp.csr_array((0, self.n_ctrl))
         if p == 0:
             # Piecewise-constant basis: column = span index (right end -> last span).
             cols = np.minimum(np.floor(s).astype(int), self.n_spans - 1)
@@ -267,6 +273,13 @@ class ClampedUniformBasis:
         the span index is ``floor(s)``. A window ending exactly on a knot does
         not reach into the next span.
         """
+        if not (np.isfinite(s_start) and np.isfinite(s_end)) or not (
+            0.0 <= s_start <= s_end <= self.n_spans
+        ):
+            raise InputError(
+                f"window: got s_start={s_start:g}, s_end={s_end:g}, expected "
+                f"0 <= s_start <= s_end <= {self.n_spans}"
+            )
         first = min(int(np.floor(s_start)), self.n_spans - 1)
         last = max(first, min(int(np.ceil(s_end)) - 1, self.n_spans - 1))
         return first, last

@@ -1,0 +1,164 @@
+"""Tests for skyquill.verify: the dense check on trajectories with known derivatives."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pytest
+from numpy.typing import NDArray
+from scipy.interpolate import make_lsq_spline
+
+from skyquill.limits import BoxLimit, CylinderLimit
+from skyquill.trajectory import SplineTrajectory
+from skyquill.verify import Verification, verify
+
+FloatArray = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class Region:
+    """A minimal corridor region for verify()."""
+
+    A: FloatArray
+    b: FloatArray
+    t_start: float
+    t_end: float
+
+
+def _time_knots(k: int, M: int, duration: float) -> FloatArray:
+    L = M - k
+    s = np.concatenate([np.zeros(k + 1), np.arange(1, L, dtype=float), np.full(k + 1, L)])
+    return s * duration / L
+
+
+def _polynomial_trajectory(coeffs: FloatArray, k: int, M: int, duration: float) -> SplineTrajectory:
+    """Spline reproducing p(t) = sum_j coeffs[j] t^j exactly (degree <= k), by least squares."""
+    t = np.linspace(0.0, duration, 4 * M)
+    p = sum(c[None, :] * t[:, None] ** j for j, c in enumerate(coeffs))
+    spline = make_lsq_spline(t, p, _time_knots(k, M, duration), k)
+    return SplineTrajectory(np.asarray(spline.c), k, duration)
+
+
+def _line(v: FloatArray, p0: FloatArray, k: int, M: int, duration: float) -> SplineTrajectory:
+    """Constant velocity by Greville abscissae (linear precision of B-splines)."""
+    knots = _time_knots(k, M, duration)
+    greville = np.array([knots[i + 1 : i + k + 1].mean() for i in range(M)])
+    return SplineTrajectory(p0[None, :] + greville[:, None] * v[None, :], k, duration)
+
+
+# ------------------------------------------------------------------ known maxima
+def test_constant_velocity_line() -> None:
+    v = np.array([3.0, -4.0, 0.0])
+    traj = _line(v, np.array([1.0, 2.0, 3.0]), k=3, M=12, duration=2.0)
+    # The spline really is the line p0 + v t.
+    t = np.linspace(0.0, 2.0, 7)
+    np.testing.assert_allclose(traj.evaluate(t), [1.0, 2.0, 3.0] + t[:, None] * v, atol=1e-12)
+    res = verify(traj)
+    assert isinstance(res, Verification)
+    assert res.n_samples >= 10_000
+    assert res.max_speed == pytest.approx(5.0, rel=1e-12)
+    np.testing.assert_allclose(res.max_velocity, [3.0, 4.0, 0.0], atol=1e-11)
+    np.testing.assert_allclose(res.max_acc, 0.0, atol=1e-9)
+    np.testing.assert_allclose(res.max_jerk, 0.0, atol=1e-8)
+    assert res.max_horizontal_acc == pytest.approx(0.0, abs=1e-9)
+    assert res.checks == ()
+    assert res.max_excess == 0.0
+    assert res.corridor_excess_m == 0.0
+
+
+def test_speed_limits_exceeded_by_the_line() -> None:
+    traj = _line(np.array([3.0, -4.0, 0.0]), np.zeros(3), k=4, M=10, duration=1.0)
+    box = BoxLimit.symmetric(1, 3.5, 3)  # |v_y| = 4 exceeds by 0.5 / 3.5
+    cyl = CylinderLimit(1, 4.0, z_lower=-1.0, z_upper=1.0)  # |v_xy| = 5 exceeds by 1 / 4
+    roomy = BoxLimit.symmetric(1, 6.0, 3)
+    res = verify(traj, [box, cyl, roomy], guaranteed=False)
+    assert [c.label for c in res.checks] == ["speed box", "speed cylinder (8-gon)", "speed box"]
+    assert [c.order for c in res.checks] == [1, 1, 1]
+    assert res.checks[0].max_value == pytest.approx(4.0, rel=1e-12)
+    assert res.checks[0].relative_excess == pytest.approx(0.5 / 3.5, rel=1e-9)
+    assert res.checks[1].max_value == pytest.approx(5.0, rel=1e-12)
+    assert res.checks[1].relative_excess == pytest.approx(0.25, rel=1e-9)
+    assert res.checks[2].relative_excess == 0.0
+    assert not any(c.guaranteed for c in res.checks)
+    assert res.max_excess == pytest.approx(0.25, rel=1e-9)
+
+
+def test_constant_acceleration() -> None:
+    """p = a t^2 / 2: speed grows to |a| T, acceleration is a, jerk is 0."""
+    a = np.array([1.0, 2.0, -2.0])  # |a| = 3
+    T = 2.0
+    traj = _polynomial_trajectory(
+        np.array([np.zeros(3), np.zeros(3), a / 2]), k=5, M=11, duration=T
+    )
+    np.testing.assert_allclose(traj.evaluate(np.array([0.3, 1.7]), 2), [a, a], atol=1e-9)
+    acc_box = BoxLimit.symmetric(2, 1.5, 3)  # |a_y| = |a_z| = 2 exceed by 1/3
+    acc_cyl = CylinderLimit(2, 2.0, z_lower=-3.0, z_upper=3.0)  # sqrt(5) exceeds 2
+    res = verify(traj, [acc_box, acc_cyl])
+    assert res.max_speed == pytest.approx(3.0 * T, rel=1e-9)
+    np.testing.assert_allclose(res.max_velocity, np.abs(a) * T, rtol=1e-9)
+    np.testing.assert_allclose(res.max_acc, np.abs(a), rtol=1e-9)
+    np.testing.assert_allclose(res.max_jerk, 0.0, atol=1e-7)
+    assert res.max_horizontal_acc == pytest.approx(np.sqrt(5.0), rel=1e-9)
+    assert res.max_horizontal_jerk == pytest.approx(0.0, abs=1e-7)
+    assert res.checks[0].relative_excess == pytest.approx(1.0 / 3.0, rel=1e-8)
+    assert res.checks[1].relative_excess == pytest.approx((np.sqrt(5.0) - 2.0) / 2.0, rel=1e-8)
+    assert all(c.guaranteed for c in res.checks)
+    assert res.max_excess == pytest.approx(1.0 / 3.0, rel=1e-8)
+
+
+def test_higher_order_limit_matches_own_dense_maximum() -> None:
+    rng = np.random.default_rng(3)
+    traj = SplineTrajectory(rng.uniform(-1, 1, size=(14, 2)), 5, 3.0)
+    snap_bound = 1.0
+    res = verify(traj, [BoxLimit.symmetric(4, snap_bound, 2)])
+    snap = traj.evaluate(traj.dense_times(), 4)
+    peak = float(np.abs(snap).max())
+    assert res.checks[0].order == 4
+    assert res.checks[0].label == "snap box"
+    assert res.checks[0].max_value == pytest.approx(peak, rel=1e-12)
+    assert res.checks[0].relative_excess == pytest.approx(max(0.0, peak - snap_bound) / snap_bound)
+    assert len(res.max_jerk) == 2
+    # Dense sampling never beats the hull bound of the jerk (convex hull property).
+    hull = float(np.abs(traj.derivative_control_points(3)).max())
+    assert max(res.max_jerk) <= hull * (1 + 1e-12)
+
+
+# ------------------------------------------------------------------ corridors
+def test_corridor_excess_sign() -> None:
+    # x = t on [0, 4].
+    traj = _line(np.array([1.0, 0.0, 0.0]), np.zeros(3), k=3, M=10, duration=4.0)
+    dt = 4.0 / (traj.dense_times().size - 1)
+    x_le = np.array([[1.0, 0.0, 0.0]])
+    inside = Region(x_le, np.array([10.0]), 0.0, 4.0)
+    res = verify(traj, corridors=[inside])
+    assert res.corridor_excess_m == pytest.approx(4.0 - 10.0, abs=1e-9)  # negative: inside
+
+    # x <= 2.5 only on [0, 2]: inside by 0.5 (up to one sample step).
+    early = Region(x_le, np.array([2.5]), 0.0, 2.0)
+    assert verify(traj, corridors=[early]).corridor_excess_m == pytest.approx(-0.5, abs=dt)
+
+    # x <= 2.5 on [0, 3]: out by 0.5.
+    late = Region(x_le, np.array([2.5]), 0.0, 3.0)
+    res = verify(traj, corridors=[late])
+    assert res.corridor_excess_m == pytest.approx(0.5, abs=dt)
+    assert res.corridor_excess_m > 0
+
+    # Several corridors: the largest excursion; -x <= -1 on [1.5, 4] (x >= 1) is inside.
+    floor = Region(-x_le, np.array([-1.0]), 1.5, 4.0)
+    res = verify(traj, corridors=[early, floor])
+    assert res.corridor_excess_m == pytest.approx(-0.5, abs=dt)
+    assert verify(traj, corridors=[floor]).corridor_excess_m == pytest.approx(-0.5, abs=dt)
+    assert verify(traj, corridors=[early, late, floor]).corridor_excess_m == pytest.approx(
+        0.5, abs=dt
+    )
+    # Corridors do not contribute to the limit excess.
+    assert res.max_excess == 0.0
+
+
+def test_as_dict_is_plain() -> None:
+    traj = _line(np.array([1.0, 1.0]), np.zeros(2), k=2, M=6, duration=1.0)
+    d = verify(traj, [BoxLimit.symmetric(1, 2.0, 2)]).as_dict()
+    assert d["max_speed"] == pytest.approx(np.sqrt(2.0))
+    assert d["checks"][0]["label"] == "speed box"
+    assert set(d) >= {"n_samples", "max_speed", "checks", "corridor_excess_m", "max_excess"}
