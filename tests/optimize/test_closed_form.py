@@ -43,7 +43,10 @@ Array = NDArray[np.float64]
 def boundary_only(dim: int = 2, degree: int = 5, n_ctrl: int = 14) -> SmoothingProblem:
     """Rest to rest, pure minimum jerk."""
     return SmoothingProblem(
-        dim=dim, degree=degree, n_ctrl=n_ctrl, duration=3.0,
+        dim=dim,
+        degree=degree,
+        n_ctrl=n_ctrl,
+        duration=3.0,
         boundary=Boundary.rest(np.zeros(dim), np.arange(1.0, dim + 1.0), 3),
     )
 
@@ -58,7 +61,10 @@ def boundary_interpolation(dim: int = 2) -> SmoothingProblem:
     start, end = np.zeros(dim), np.ones(dim)
     points = np.vstack([start, rng.uniform(-1, 2, (3, dim)), end])
     return SmoothingProblem(
-        dim=dim, degree=5, n_ctrl=16, duration=4.0,
+        dim=dim,
+        degree=5,
+        n_ctrl=16,
+        duration=4.0,
         boundary=Boundary.rest(start, end, 3),
         interpolation=(Interpolation([0.0, 1.0, 2.0, 3.0, 4.0], points),),
     )
@@ -68,7 +74,10 @@ def boundary_interior_interpolation(dim: int = 2) -> SmoothingProblem:
     """Rest to rest through interior waypoints only (independent equalities)."""
     rng = np.random.default_rng(8)
     return SmoothingProblem(
-        dim=dim, degree=5, n_ctrl=16, duration=4.0,
+        dim=dim,
+        degree=5,
+        n_ctrl=16,
+        duration=4.0,
         boundary=Boundary.rest(np.zeros(dim), np.ones(dim), 3),
         interpolation=(Interpolation([0.7, 2.1, 3.3], rng.uniform(-1, 2, (3, dim))),),
     )
@@ -79,7 +88,10 @@ def boundary_points(dim: int = 3, degree: int = 4, seed: int = 3) -> SmoothingPr
     rng = np.random.default_rng(seed)
     times = np.sort(rng.uniform(0.0, 5.0, 12))
     return SmoothingProblem(
-        dim=dim, degree=degree, n_ctrl=20, duration=5.0,
+        dim=dim,
+        degree=degree,
+        n_ctrl=20,
+        duration=5.0,
         smoothness={3: 1.0, 2: 0.1},
         boundary=Boundary.rest(np.zeros(dim), np.ones(dim), min(3, degree)),
         deviations=(PointDeviation(times, rng.normal(size=(12, dim)), weight=30.0),),
@@ -220,7 +232,10 @@ def dense_reference(problem: SmoothingProblem) -> Array:
 @pytest.mark.parametrize("distance", [1.0, -3.0])
 def test_single_span_min_jerk_is_the_classic_quintic(duration: float, distance: float) -> None:
     problem = SmoothingProblem(
-        dim=1, degree=5, n_ctrl=6, duration=duration,
+        dim=1,
+        degree=5,
+        n_ctrl=6,
+        duration=duration,
         boundary=Boundary.rest([0.0], [distance], 3),
     )
     result = solve(problem)
@@ -259,8 +274,11 @@ def test_single_span_min_jerk_against_bernstein_kkt() -> None:
 
 
 # ------------------------------------------------------------------ dense reference
-@pytest.mark.parametrize("make", [*CLOSED_FORM_CASES.values(), *COUPLED_CASES.values()],
-                         ids=[*CLOSED_FORM_CASES, *COUPLED_CASES])
+@pytest.mark.parametrize(
+    "make",
+    [*CLOSED_FORM_CASES.values(), *COUPLED_CASES.values()],
+    ids=[*CLOSED_FORM_CASES, *COUPLED_CASES],
+)
 def test_closed_form_matches_dense_kkt(make: object) -> None:
     problem = make()  # type: ignore[operator]
     result = solve(problem)
@@ -271,8 +289,11 @@ def test_closed_form_matches_dense_kkt(make: object) -> None:
 
 
 # ------------------------------------------------------------------ closed form == QP
-@pytest.mark.parametrize("make", [*CLOSED_FORM_CASES.values(), *COUPLED_CASES.values()],
-                         ids=[*CLOSED_FORM_CASES, *COUPLED_CASES])
+@pytest.mark.parametrize(
+    "make",
+    [*CLOSED_FORM_CASES.values(), *COUPLED_CASES.values()],
+    ids=[*CLOSED_FORM_CASES, *COUPLED_CASES],
+)
 @pytest.mark.parametrize("backend", ["clarabel", "piqp"])
 def test_closed_form_equals_qp_route(make: object, backend: str) -> None:
     problem = make()  # type: ignore[operator]
@@ -285,8 +306,11 @@ def test_closed_form_equals_qp_route(make: object, backend: str) -> None:
     assert qp.cost == pytest.approx(closed.cost, rel=1e-8)
 
 
-@pytest.mark.parametrize("make", [*CLOSED_FORM_CASES.values(), *COUPLED_CASES.values()],
-                         ids=[*CLOSED_FORM_CASES, *COUPLED_CASES])
+@pytest.mark.parametrize(
+    "make",
+    [*CLOSED_FORM_CASES.values(), *COUPLED_CASES.values()],
+    ids=[*CLOSED_FORM_CASES, *COUPLED_CASES],
+)
 @pytest.mark.parametrize("backend", ["clarabel", "piqp", "osqp"])
 def test_closed_form_equals_solve_qp_on_assembled(make: object, backend: str) -> None:
     """The assembled equality-only QP, straight to each backend."""
@@ -422,7 +446,10 @@ def test_window_controls_match_independent_support() -> None:
 def test_point_at_the_final_time(duration: float) -> None:
     """``alpha * duration`` rounds above the last knot for these durations."""
     problem = SmoothingProblem(
-        dim=1, degree=3, n_ctrl=6, duration=duration,
+        dim=1,
+        degree=3,
+        n_ctrl=6,
+        duration=duration,
         boundary=(Boundary(0, [0.0]),),
         deviations=(PointDeviation([duration], [[1.0]], weight=10.0),),
         interpolation=(Interpolation([0.5 * duration, duration], [[0.5], [1.0]]),),

@@ -36,7 +36,9 @@ from skyquill.spline import basis_for
 Array = NDArray[np.float64]
 
 SETTINGS = settings(
-    max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow],
+    max_examples=25,
+    deadline=None,
+    suppress_health_check=[HealthCheck.too_slow],
     derandomize=True,
 )
 
@@ -71,7 +73,10 @@ def base_problem(spec: Spec) -> SmoothingProblem:
     points = rng.uniform(-1.0, 1.0, (n_pts, d))
     start, end = rng.uniform(-0.5, 0.5, d), rng.uniform(-0.5, 0.5, d)
     return SmoothingProblem(
-        dim=d, degree=spec.degree, n_ctrl=spec.n_ctrl, duration=duration,
+        dim=d,
+        degree=spec.degree,
+        n_ctrl=spec.n_ctrl,
+        duration=duration,
         boundary=Boundary.rest(start, end, min(3, spec.degree)),
         deviations=(PointDeviation(times, points, weight=float(rng.uniform(1.0, 100.0))),),
     )
@@ -100,9 +105,9 @@ def dense_hmax(result: FitResult, order: int) -> float:
     return float(np.hypot(v[:, 0], v[:, 1]).max())
 
 
-def box_limits(problem: SmoothingProblem, free: FitResult, W: Array, fracs: Array) -> tuple[
-    DerivativeLimit, ...
-]:
+def box_limits(
+    problem: SmoothingProblem, free: FitResult, W: Array, fracs: Array
+) -> tuple[DerivativeLimit, ...]:
     """Per-axis symmetric boxes on speed, acceleration and jerk."""
     out: list[DerivativeLimit] = []
     for order, frac in zip((1, 2, 3), fracs, strict=True):
@@ -229,7 +234,10 @@ def test_limits_are_active_and_tightening_changes_the_answer() -> None:
 # ------------------------------------------------------------------ infeasibility
 def rest_problem(**kwargs: object) -> SmoothingProblem:
     args: dict[str, object] = {
-        "dim": 2, "degree": 5, "n_ctrl": 12, "duration": 1.0,
+        "dim": 2,
+        "degree": 5,
+        "n_ctrl": 12,
+        "duration": 1.0,
         "boundary": Boundary.rest(np.zeros(2), np.ones(2), 3),
     }
     args.update(kwargs)
@@ -265,7 +273,8 @@ def test_corridor_excluding_the_start_is_infeasible(backend: str) -> None:
 def test_contradictory_equalities_are_infeasible(backend: str, with_limit: bool) -> None:
     limits = (BoxLimit.symmetric(1, 100.0, 2),) if with_limit else ()
     problem = rest_problem(
-        duration=3.0, limits=limits,
+        duration=3.0,
+        limits=limits,
         interpolation=(Interpolation([0.0, 1.5], [[0.3, 0.0], [0.5, 0.5]]),),
     )
     with pytest.raises(InfeasibleError, match="contradict") as info:
@@ -276,9 +285,9 @@ def test_contradictory_equalities_are_infeasible(backend: str, with_limit: bool)
 def test_redundant_consistent_equalities_solve_on_both_routes() -> None:
     interp = Interpolation([0.0, 1.5, 3.0], [[0.0, 0.0], [0.8, -0.2], [1.0, 1.0]])
     closed = solve(rest_problem(duration=3.0, interpolation=(interp,)))
-    qp = solve(rest_problem(
-        duration=3.0, interpolation=(interp,), limits=(BoxLimit.symmetric(1, 1e6, 2),)
-    ))
+    qp = solve(
+        rest_problem(duration=3.0, interpolation=(interp,), limits=(BoxLimit.symmetric(1, 1e6, 2),))
+    )
     assert closed.method == "closed_form"
     assert qp.method == "qp"
     assert qp.cost == pytest.approx(closed.cost, rel=1e-8)

@@ -22,12 +22,17 @@ TOL = {"clarabel": 1e-8, "piqp": 1e-8, "osqp": 1e-6}
 
 
 def make_qp(
-    P: Array, q: Array, A: Array | None = None, b: Array | None = None,
-    G: Array | None = None, h: Array | None = None,
+    P: Array,
+    q: Array,
+    A: Array | None = None,
+    b: Array | None = None,
+    G: Array | None = None,
+    h: Array | None = None,
 ) -> QuadraticProgram:
     n = q.size
     return QuadraticProgram(
-        P=sp.csc_array(P), q=np.asarray(q, dtype=float),
+        P=sp.csc_array(P),
+        q=np.asarray(q, dtype=float),
         A_eq=sp.csc_array(A if A is not None else np.zeros((0, n))),
         b_eq=np.asarray(b if b is not None else np.zeros(0), dtype=float),
         G=sp.csc_array(G if G is not None else np.zeros((0, n))),
@@ -87,10 +92,19 @@ def test_simplex_projection(backend: str) -> None:
 @settings(max_examples=20, deadline=None)
 @given(z=hnp.arrays(np.float64, st.integers(1, 6), elements=st.floats(-5, 5)))
 def test_random_simplex_projections(backend: str, z: Array) -> None:
-    sol = solve_qp(simplex_projection(z), backend)
+    """Random projections, including degenerate ones (``z = (0, 1)``: a bound active with
+    a zero multiplier), where an interior-point iterate is only accurate to about the
+    square root of the gap tolerance; the objective is accurate to the tolerance.
+    """
+    qp = simplex_projection(z)
+    sol = solve_qp(qp, backend)
     assert sol.status == "optimal"
     assert sol.x is not None
-    assert np.abs(sol.x - simplex_projection_reference(z)).max() <= 10 * TOL[backend]
+    ref = simplex_projection_reference(z)
+    assert np.abs(sol.x - ref).max() <= 1e-4
+    assert abs(sol.x.sum() - 1.0) <= 1e-8
+    assert sol.x.min() >= -1e-8
+    assert qp.objective(sol.x) - qp.objective(ref) <= 1e-8
 
 
 @pytest.mark.parametrize("backend", ALL)
@@ -138,8 +152,12 @@ def test_infeasible_equalities_and_inequalities(backend: str) -> None:
     """``x0 + x1 = 3`` with ``0 <= x <= 1``."""
     eye = np.eye(2)
     qp = make_qp(
-        eye, np.zeros(2), A=np.ones((1, 2)), b=np.array([3.0]),
-        G=np.vstack([eye, -eye]), h=np.array([1.0, 1.0, 0.0, 0.0]),
+        eye,
+        np.zeros(2),
+        A=np.ones((1, 2)),
+        b=np.array([3.0]),
+        G=np.vstack([eye, -eye]),
+        h=np.array([1.0, 1.0, 0.0, 0.0]),
     )
     sol = solve_qp(qp, backend)
     assert sol.status == "infeasible"

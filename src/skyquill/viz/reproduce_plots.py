@@ -154,6 +154,10 @@ def plot_fig7(
     trajectories: Mapping[str, FloatArray],
     path: str | Path,
     title: str = "",
+    *,
+    times: FloatArray | None = None,
+    deviations: Mapping[str, FloatArray] | None = None,
+    snap_norms: Mapping[str, FloatArray] | None = None,
 ) -> None:
     """Top view (x-y) and side view (x-z) of line-segment fits (paper 003 Fig. 7).
 
@@ -169,14 +173,23 @@ def plot_fig7(
         PNG file to write.
     title
         Figure title.
+    times
+        Sample times, shape (N,), s; needed for the two optional panels.
+    deviations
+        Per method, distance to the polyline at ``times``, shape (N,), m:
+        drawn against time on a log axis.
+    snap_norms
+        Per method, ``||d^4 p / dt^4||`` at ``times``, shape (N,), m/s^4.
     """
     wp = np.asarray(polyline)
     views = ((0, 1, "top view", "y [m]"), (0, 2, "side view", "z [m]"))
     n_views = 2 if wp.shape[1] >= 3 else 1
-    fig, axes = plt.subplots(n_views, 1, figsize=(11, 4.2 * n_views), layout="constrained",
-                             squeeze=False)
+    extra_row = times is not None and (deviations is not None or snap_norms is not None)
+    fig = plt.figure(figsize=(12, 4.0 * n_views + (3.6 if extra_row else 0.0)),
+                     layout="constrained")
+    grid = fig.add_gridspec(n_views + int(extra_row), 2)
     for row in range(n_views):
-        ax = axes[row, 0]
+        ax = fig.add_subplot(grid[row, :])
         i, j, name, ylabel = views[row]
         ax.plot(wp[:, i], wp[:, j], "k-", lw=2.4, alpha=0.25, label="line segments")
         ax.plot(wp[:, i], wp[:, j], "ks", ms=5, label="waypoints")
@@ -191,6 +204,24 @@ def plot_fig7(
             ax.set_aspect("equal", adjustable="datalim")
         ax.grid(True, alpha=0.3)
         ax.legend(loc="best", fontsize=8)
+    if extra_row and times is not None:
+        panels = (
+            (deviations, "distance to the polyline [m]", "deviation", True),
+            (snap_norms, "|snap| [m/s⁴]", "snap", False),
+        )
+        for col, (data, ylabel, name, log) in enumerate(panels):
+            if data is None:
+                continue
+            ax = fig.add_subplot(grid[n_views, col])
+            for k, (label, y) in enumerate(data.items()):
+                ax.plot(times, np.maximum(y, 1e-6) if log else y, _STYLES[k % len(_STYLES)],
+                        color=_color(k), lw=1.0, label=label.split(":")[0])
+            if log:
+                ax.set_yscale("log")
+                ax.set_ylim(1e-5, None)
+            ax.set(xlabel="t [s]", ylabel=ylabel, title=name)
+            ax.grid(True, which="both", alpha=0.3)
+            ax.legend(loc="best", fontsize=8)
     if title:
         fig.suptitle(title)
     fig.savefig(path, dpi=120)

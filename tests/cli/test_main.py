@@ -1,0 +1,62 @@
+"""The command line: fit and demo write what they promise; user errors exit 2 cleanly."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from skyquill.cli.main import app
+
+EXAMPLES = Path(__file__).parents[2] / "examples"
+SUMMARY_KEYS = {
+    "duration_s", "solve_time_s", "cost", "max_speed", "max_acc", "max_jerk", "max_excess",
+    "rms_deviation_m", "max_deviation_m",
+}
+runner = CliRunner()
+
+
+def test_fit_writes_trajectory_plot_and_summary(tmp_path: Path) -> None:
+    out = tmp_path / "fit"
+    result = runner.invoke(
+        app, ["fit", str(EXAMPLES / "segments.csv"), "--out", str(out), "--coupled", "8",
+              "--vmax", "1.5", "--amax", "1.0", "--jmax", "4", "--rate", "50"],
+    )
+    assert result.exit_code == 0, result.output
+    summary = json.loads((out / "summary.json").read_text())
+    assert SUMMARY_KEYS <= summary.keys()
+    assert summary["max_excess"] <= 1e-9
+    assert len(summary["max_acc"]) == 3
+    data = np.loadtxt(out / "trajectory.csv", delimiter=",", skiprows=1)
+    assert data.shape[1] == 13
+    assert np.diff(data[:, 0]).max() == pytest.approx(0.02)
+    assert (out / "plot.png").stat().st_size > 10_000
+
+
+def test_demo(tmp_path: Path) -> None:
+    result = runner.invoke(app, ["demo", "--out", str(tmp_path / "demo")])
+    assert result.exit_code == 0, result.output
+    summary = json.loads((tmp_path / "demo" / "summary.json").read_text())
+    assert summary["max_excess"] <= 1e-9
+    assert summary["rms_deviation_m"] < 0.005
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["fit", "missing.csv"], "expected an existing CSV file"),
+        (["fit", str(EXAMPLES / "segments.csv"), "--vmax", "-1"], "vmax: got -1"),
+        (["fit", str(EXAMPLES / "segments.csv"), "--degree", "9"], "degree: got 9"),
+        (["fit", str(EXAMPLES / "segments.csv"), "--rate", "0"], "--rate: got 0"),
+        (["fit", str(EXAMPLES / "segments.csv"), "--hull", "round"], "--hull: got 'round'"),
+        (["fit", str(EXAMPLES / "segments.csv"), "--solver", "cplex"], "solver: got 'cplex'"),
+    ],
+)
+def test_user_errors_exit_2_with_one_line(tmp_path: Path, args: list[str], message: str) -> None:
+    result = runner.invoke(app, [*args, "--out", str(tmp_path / "o")])
+    assert result.exit_code == 2
+    assert message in " ".join(result.output.split())
+    assert "Traceback" not in result.output
