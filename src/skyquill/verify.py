@@ -23,10 +23,17 @@ from skyquill.validation import FloatArray
 class Region(Protocol):
     """A convex polytope ``{p : A p <= b}`` to be respected on ``[t_start, t_end]``."""
 
-    A: FloatArray
-    b: FloatArray
-    t_start: float
-    t_end: float
+    @property
+    def A(self) -> FloatArray: ...
+
+    @property
+    def b(self) -> FloatArray: ...
+
+    @property
+    def t_start(self) -> float: ...
+
+    @property
+    def t_end(self) -> float: ...
 
 
 class DenseTrajectory(Protocol):

@@ -12,6 +12,7 @@ that is still above the witness, so they are active.
 from __future__ import annotations
 
 import dataclasses
+import itertools
 from dataclasses import dataclass
 
 import numpy as np
@@ -145,7 +146,7 @@ def box_corridors(problem: SmoothingProblem, W: Array, n_windows: int) -> tuple[
     basis = basis_for(problem.degree, problem.n_ctrl)
     eye = np.eye(problem.dim)
     out = []
-    for t0, t1 in zip(edges[:-1], edges[1:], strict=True):
+    for t0, t1 in itertools.pairwise(edges):
         first, last = basis.spans_in_window(problem.alpha * t0, problem.alpha * t1)
         pts = W[first : last + problem.degree + 1]
         hi, lo = pts.max(axis=0) + 0.05, pts.min(axis=0) - 0.05

@@ -24,6 +24,7 @@ TOL = {"clarabel": 1e-8, "piqp": 1e-8, "osqp": 1e-6}
 def make_qp(
     P: Array,
     q: Array,
+    *,
     A: Array | None = None,
     b: Array | None = None,
     G: Array | None = None,

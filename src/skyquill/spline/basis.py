@@ -181,7 +181,9 @@ class ClampedUniformBasis:
             m = self.n_ctrl - j + 1  # control points before it
             t = knots[j - 1 : len(knots) - j + 1]
             scale = p / (t[p + 1 : p + m] - t[1:m])  # eq. (34): k / (s_{i+k+1} - s_{i+1})
-            step = sp.diags_array([-scale, scale], offsets=[0, 1], shape=(m - 1, m), format="csr")
+            step = sp.diags_array(
+                [-scale, scale], offsets=[0, 1], shape=(m - 1, m), format="csr"
+            )  # type: ignore[call-overload]  # scipy-stubs reject a list of float arrays
             maps.append(sp.csr_array(step @ maps[-1]))
         return tuple(maps)
 

@@ -8,6 +8,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
+from matplotlib.axes import Axes
 import numpy as np
 
 from skyquill.limits import BoxLimit, CylinderLimit
@@ -55,7 +56,7 @@ def plot_fit(fit: PointFit, path: str | Path, title: str = "") -> None:
     plt.close(fig)
 
 
-def _draw_limit(panel: plt.Axes, t: np.ndarray, values: np.ndarray,
+def _draw_limit(panel: Axes, t: np.ndarray, values: np.ndarray,
                 lim: BoxLimit | CylinderLimit) -> None:
     if isinstance(lim, BoxLimit):
         for bound in (lim.upper.max(), lim.lower.min()):
