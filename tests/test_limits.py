@@ -46,7 +46,7 @@ def test_box_shape_mismatch() -> None:
     with pytest.raises(
         InputError,
         match=r"jerk lower: got an array of shape \(3,\), "
-        r"expected shape \(2\)",
+        r"expected shape \(2,\)",
     ):
         BoxLimit(3, np.zeros(3) - 1, np.ones(2))
 

@@ -18,9 +18,8 @@ FloatArray = NDArray[np.float64]
 
 
 def _describe(value: Any) -> str:
-    arr = np.asarray(value) if not isinstance(value, str) else None
-    if arr is not None and arr.dtype.kind in "fiub" and arr.ndim > 0:
-        return f"an array of shape {arr.shape}"
+    if isinstance(value, np.ndarray) and value.ndim > 0:
+        return f"an array of shape {value.shape} and dtype {value.dtype}"
     text = repr(value)
     return text if len(text) <= 60 else text[:57] + "..."
 
@@ -40,11 +39,15 @@ def as_array(
     and would overflow squared distances).
     """
     try:
-        arr = np.asarray(value, dtype=float)
-    except (TypeError, ValueError) as exc:
+        raw = np.asarray(value)
+    except (TypeError, ValueError, OverflowError, UnicodeError) as exc:
         raise InputError(
-            f"{name}: got {_describe(value)}, expected numbers convertible to a float array"
+            f"{name}: got {_describe(value)}, expected a rectangular array of real numbers"
         ) from exc
+    if raw.dtype.kind not in "iuf":
+        what = "complex numbers" if raw.dtype.kind == "c" else f"values of type {raw.dtype}"
+        raise InputError(f"{name}: got {what}, expected real numbers")
+    arr = raw.astype(float)
     want_ndim = len(shape) if shape is not None else ndim
     if want_ndim is not None and arr.ndim != want_ndim:
         raise InputError(
@@ -68,14 +71,18 @@ def as_array(
 
 
 def _shape_text(shape: tuple[int | None, ...]) -> str:
-    return "(" + ", ".join("any" if s is None else str(s) for s in shape) + ")"
+    parts = ["any" if s is None else str(s) for s in shape]
+    return "(" + ", ".join(parts) + ("," if len(parts) == 1 else "") + ")"
 
 
 def as_float(name: str, value: Any, *, positive: bool = False, nonneg: bool = False) -> float:
     """A finite float, optionally required ``> 0`` or ``>= 0``."""
     if isinstance(value, bool) or not isinstance(value, int | float | np.integer | np.floating):
         raise InputError(f"{name}: got {_describe(value)}, expected a number")
-    x = float(value)
+    try:
+        x = float(value)
+    except OverflowError:
+        raise InputError(f"{name}: got an integer too large for a float, expected a number")
     if not np.isfinite(x):
         raise InputError(f"{name}: got {x}, expected a finite number")
     if positive and x <= 0.0:

@@ -540,11 +540,6 @@ def test_garbage_problem(**kwargs: Any) -> None:
     _construct_or_input_error(lambda: SmoothingProblem(**kwargs))
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="skyquill.validation.as_array casts complex arrays to float with only a "
-    "ComplexWarning, silently dropping the imaginary part (not in this file's scope)",
-)
 def test_complex_array_is_rejected() -> None:
     with pytest.raises(InputError, match=r"points\.points"):
         PointDeviation([1.0], np.array([[1.0 + 2.0j, 0.0]]))

@@ -12,55 +12,16 @@ checks that dimensions agree and that every time lies within the duration.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import Any, TypeVar
 
 import numpy as np
 import scipy.optimize
 
-from skyquill import validation
 from skyquill.errors import InputError
 from skyquill.limits import BoxLimit, CylinderLimit, DerivativeLimit
 from skyquill.spline import ClampedUniformBasis, HullKind, basis_for
-from skyquill.validation import FloatArray, strictly_increasing
-
-_T = TypeVar("_T")
-
-
-def _guarded(check: Callable[..., _T], name: str, value: Any, **kwargs: Any) -> _T:
-    """Run a :mod:`skyquill.validation` check; let only :class:`InputError` out.
-
-    Fix: the validation helpers let two kinds of garbage escape as other
-    exception types -- a ragged nested list (their message helper calls
-    ``np.asarray`` on it again: ValueError) and an int beyond the float range
-    (OverflowError). The root fix belongs in ``validation.py``; until then
-    every constructor here still raises only ``InputError``.
-    """
-    try:
-        return check(name, value, **kwargs)
-    except InputError:
-        raise
-    except (ValueError, OverflowError, TypeError) as exc:
-        raise InputError(
-            f"{name}: got a {type(value).__name__} that is not a rectangular array of "
-            "float-range numbers, expected numbers convertible to float"
-        ) from exc
-
-
-def as_array(name: str, value: Any, **kwargs: Any) -> FloatArray:
-    """:func:`skyquill.validation.as_array` through :func:`_guarded`."""
-    return _guarded(validation.as_array, name, value, **kwargs)
-
-
-def as_float(name: str, value: Any, **kwargs: Any) -> float:
-    """:func:`skyquill.validation.as_float` through :func:`_guarded`."""
-    return _guarded(validation.as_float, name, value, **kwargs)
-
-
-def as_int(name: str, value: Any, **kwargs: Any) -> int:
-    """:func:`skyquill.validation.as_int` through :func:`_guarded`."""
-    return _guarded(validation.as_int, name, value, **kwargs)
+from skyquill.validation import FloatArray, as_array, as_float, as_int, strictly_increasing
 
 
 def _points_at_times(name: str, times: object, points: object) -> tuple[FloatArray, FloatArray]:

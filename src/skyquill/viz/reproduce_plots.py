@@ -38,6 +38,7 @@ def plot_fig10(
     time_s: Mapping[str, Sequence[float | None]],
     path: str | Path,
     title: str = "",
+    reference: Sequence[float | None] | None = None,
 ) -> None:
     """Cost (a) and computing time (b) against the number of control points.
 
@@ -55,6 +56,10 @@ def plot_fig10(
         PNG file to write.
     title
         Figure title.
+    reference
+        K costs of the same problems without derivative limits (a lower bound
+        of every variant), drawn thin and grey in panel (a); ``None`` entries
+        are skipped.
 
     Notes
     -----
@@ -91,6 +96,10 @@ def plot_fig10(
             if np.any(bad):
                 ax.plot(m[bad], np.full(int(bad.sum()), strip[i]), "x", ms=7, mew=1.6,
                         color=_color(i), linestyle="none")
+        if data is cost and reference is not None:
+            ref = np.array([np.nan if v is None else v for v in reference])
+            ax.plot(m, ref, ":", color="0.5", lw=1.2, marker=".",
+                    label="no derivative limits (lower bound)")
         ax.set(xlabel="number of control points M", ylabel=ylabel, title=name)
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(loc="upper right", fontsize=8, title="x below: infeasible",
@@ -107,6 +116,9 @@ def plot_corridor_top_view(
     trajectories: Mapping[str, FloatArray | None],
     path: str | Path,
     title: str = "",
+    *,
+    speeds: Mapping[str, tuple[FloatArray, FloatArray]] | None = None,
+    speed_limits: Mapping[str, float] | None = None,
 ) -> None:
     """Top view of a box corridor and the trajectories flown through it.
 
@@ -124,13 +136,21 @@ def plot_corridor_top_view(
         PNG file to write.
     title
         Figure title.
+    speeds
+        Optional panel below the map: per curve ``(t, speed)``, shapes (N,)
+        and (N,), s and m/s (e.g. each variant's horizontal speed and the
+        nominal plan's). A name without a trajectory is drawn in black.
+    speed_limits
+        Horizontal lines in the speed panel, ``{label: m/s}``.
     """
-    fig, ax = plt.subplots(figsize=(8, 8), layout="constrained")
+    fig = plt.figure(figsize=(8.5, 11.5 if speeds else 8.5), layout="constrained")
+    grid = fig.add_gridspec(2 if speeds else 1, 1, height_ratios=[3, 1] if speeds else [1])
+    ax = fig.add_subplot(grid[0, 0])
     for i, corners in enumerate(footprints):
         ax.add_patch(Polygon(corners, closed=True, facecolor="0.85", edgecolor="0.45",
                              alpha=0.55, lw=1.0, label="corridor boxes" if i == 0 else None))
         centre = np.asarray(corners).mean(axis=0)
-        ax.annotate(str(i), centre, color="0.35", fontsize=9, ha="center", va="center")
+        ax.annotate(f"box {i}", centre, color="0.35", fontsize=8, ha="center", va="center")
     wp = np.asarray(waypoints)
     ax.plot(wp[:, 0], wp[:, 1], "k--", lw=0.9, marker="s", ms=4, label="nominal waypoints")
     for i, (name, p) in enumerate(trajectories.items()):
@@ -143,7 +163,23 @@ def plot_corridor_top_view(
     ax.set(xlabel="x [m]", ylabel="y [m]", aspect="equal", title=title or "safe corridor")
     ax.autoscale_view()
     ax.grid(True, alpha=0.3)
-    ax.legend(loc="best", fontsize=8)
+    ax.legend(loc="lower left", fontsize=8)
+    if speeds:
+        sp = fig.add_subplot(grid[1, 0])
+        names = list(trajectories)
+        for name, (t, v) in speeds.items():
+            i = names.index(name) if name in names else -1
+            style = _STYLES[i % len(_STYLES)] if i >= 0 else "-"
+            sp.plot(t, v, style, color=_color(i) if i >= 0 else "0.2",
+                    lw=1.2 if i >= 0 else 0.8, label=name)
+        for k, (label, value) in enumerate((speed_limits or {}).items()):
+            sp.axhline(value, color="0.4", ls=(":", "--", "-.")[k % 3], lw=0.9, label=label)
+        top = max([float(np.max(v)) for _, v in speeds.values()]
+                  + list((speed_limits or {}).values()))
+        sp.set_ylim(0.0, 1.45 * top)  # room for the legend above the curves
+        sp.set(xlabel="t [s]", ylabel="horizontal speed [m/s]", title="horizontal speed")
+        sp.grid(True, alpha=0.3)
+        sp.legend(loc="upper left", fontsize=7, ncol=2)
     fig.savefig(path, dpi=120)
     plt.close(fig)
 
