@@ -97,8 +97,10 @@ class BoxLimit:
         over = values - self.upper
         under = self.lower - values
         rel = max(
-            max(_relative(float(over[:, i].max(initial=-np.inf)), self.upper[i]),
-                _relative(float(under[:, i].max(initial=-np.inf)), self.lower[i]))
+            max(
+                _relative(float(over[:, i].max(initial=-np.inf)), self.upper[i]),
+                _relative(float(under[:, i].max(initial=-np.inf)), self.lower[i]),
+            )
             for i in range(self.dim)
         )
         return float(np.abs(values).max(initial=0.0)), rel
@@ -175,8 +177,11 @@ class CylinderLimit:
         rel = _relative(float(norm.max(initial=0.0)) - self.radius, self.radius)
         if self.dim == 3:
             assert self.z_lower is not None and self.z_upper is not None
-            rel = max(rel, _relative(float(values[:, 2].max()) - self.z_upper, self.z_upper),
-                      _relative(self.z_lower - float(values[:, 2].min()), self.z_lower))
+            rel = max(
+                rel,
+                _relative(float(values[:, 2].max()) - self.z_upper, self.z_upper),
+                _relative(self.z_lower - float(values[:, 2].min()), self.z_lower),
+            )
         return float(norm.max(initial=0.0)), rel
 
 

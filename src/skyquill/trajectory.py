@@ -8,7 +8,6 @@ Positions are in the z-up world frame, metres; time in seconds from 0.
 from __future__ import annotations
 
 import math
-
 from dataclasses import dataclass
 from functools import cached_property
 from typing import Protocol, runtime_checkable

@@ -54,8 +54,9 @@ def as_array(
             f"{name}: got an array of shape {arr.shape}, expected {want_ndim} dimension(s)"
             + (f" with shape {_shape_text(shape)}" if shape is not None else "")
         )
-    if shape is not None and any(w is not None and w != a for w, a in zip(shape, arr.shape,
-                                                                            strict=True)):
+    if shape is not None and any(
+        w is not None and w != a for w, a in zip(shape, arr.shape, strict=True)
+    ):
         raise InputError(
             f"{name}: got an array of shape {arr.shape}, expected shape {_shape_text(shape)}"
         )
@@ -82,7 +83,9 @@ def as_float(name: str, value: Any, *, positive: bool = False, nonneg: bool = Fa
     try:
         x = float(value)
     except OverflowError:
-        raise InputError(f"{name}: got an integer too large for a float, expected a number")
+        raise InputError(
+            f"{name}: got an integer too large for a float, expected a number"
+        ) from None
     if not np.isfinite(x):
         raise InputError(f"{name}: got {x}, expected a finite number")
     if positive and x <= 0.0:

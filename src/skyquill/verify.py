@@ -24,7 +24,7 @@ class Region(Protocol):
     """A convex polytope ``{p : A p <= b}`` to be respected on ``[t_start, t_end]``."""
 
     @property
-    def A(self) -> FloatArray: ...
+    def A(self) -> FloatArray: ...  # noqa: N802 -- the papers' name
 
     @property
     def b(self) -> FloatArray: ...

@@ -52,7 +52,7 @@ def test_bad_csv_is_named(tmp_path: Path, text: str, message: str) -> None:
 
 
 def test_missing_file(tmp_path: Path) -> None:
-    with pytest.raises(InputError, match="points file: got .*nope.csv', expected an existing"):
+    with pytest.raises(InputError, match=r"points file: got .*nope\.csv', expected an existing"):
         read_points_csv(tmp_path / "nope.csv")
 
 

@@ -20,8 +20,9 @@ pytest.importorskip("minsnap_trajectories")  # the study imports the segments mo
 def study(tmp_path_factory: pytest.TempPathFactory) -> tuple[dict[str, object], Path]:
     out = tmp_path_factory.mktemp("corridor")
     # Reduced M grid: coupled-8 alone (44), both coupled (52), all three (60, 80).
-    summary = run_corridor_study(EXAMPLES / "s_corridor.json", out,
-                                 n_ctrl_values=(44, 52, 60, 80), repeats=1)
+    summary = run_corridor_study(
+        EXAMPLES / "s_corridor.json", out, n_ctrl_values=(44, 52, 60, 80), repeats=1
+    )
     return summary, out
 
 

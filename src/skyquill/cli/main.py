@@ -21,7 +21,8 @@ from skyquill.io.points import read_points_csv, write_json, write_trajectory_csv
 from skyquill.optimize.fit import FitOptions, PointFit, fit_points
 
 app = typer.Typer(
-    add_completion=False, no_args_is_help=True,
+    add_completion=False,
+    no_args_is_help=True,
     help="Plan smooth, limit-respecting quadrotor trajectories for aerial drawing.",
 )
 console = Console(stderr=True)
@@ -68,15 +69,22 @@ def fit_summary(fit: PointFit, rows: int, rate: float) -> dict[str, Any]:
         "n_points": int(fit.points.shape[0]),
         "rate_hz": rate,
         "trajectory_rows": rows,
-        "limits": [{"label": c.label, "max_value": c.max_value,
-                    "relative_excess": c.relative_excess, "guaranteed": c.guaranteed}
-                   for c in check.checks],
+        "limits": [
+            {
+                "label": c.label,
+                "max_value": c.max_value,
+                "relative_excess": c.relative_excess,
+                "guaranteed": c.guaranteed,
+            }
+            for c in check.checks
+        ],
         "dense_samples": check.n_samples,
     }
 
 
-def run_fit(points_csv: Path, options: FitOptions, out: Path, rate: float,
-            title: str) -> dict[str, Any]:
+def run_fit(
+    points_csv: Path, options: FitOptions, out: Path, rate: float, title: str
+) -> dict[str, Any]:
     """Read, fit, write ``trajectory.csv``, ``plot.png`` and ``summary.json``."""
     from skyquill.viz.fit_plot import plot_fit
 
@@ -92,7 +100,8 @@ def run_fit(points_csv: Path, options: FitOptions, out: Path, rate: float,
     console.print(
         f"[green]done[/] {out}: duration {summary['duration_s']:.2f} s, solve "
         f"{1e3 * summary['solve_time_s']:.1f} ms, max excess {summary['max_excess']:.1e}, "
-        f"rms deviation {1e3 * summary['rms_deviation_m']:.2f} mm", highlight=False,
+        f"rms deviation {1e3 * summary['rms_deviation_m']:.2f} mm",
+        highlight=False,
     )
     return summary
 
@@ -107,27 +116,37 @@ def _rate(rate: float) -> float:
 def fit(
     points_csv: Annotated[Path, typer.Argument(help="CSV with columns x,y[,z][,t] in m and s.")],
     out: OutDir,
-    vmax: Annotated[float, typer.Option(help="Speed limit per axis (or norm if coupled), m/s.")]
-    = 1.0,
+    vmax: Annotated[
+        float, typer.Option(help="Speed limit per axis (or norm if coupled), m/s.")
+    ] = 1.0,
     amax: Annotated[float, typer.Option(help="Acceleration limit, m/s^2.")] = 2.0,
     jmax: Annotated[float, typer.Option(help="Jerk limit, m/s^3.")] = 10.0,
-    coupled: Annotated[int | None, typer.Option(
-        help="Couple the horizontal axes: sides of the polygon inscribed in the norm limit.")]
-    = None,
+    coupled: Annotated[
+        int | None,
+        typer.Option(
+            help="Couple the horizontal axes: sides of the polygon inscribed in the norm limit."
+        ),
+    ] = None,
     degree: Annotated[int, typer.Option(help="Spline degree (3 to 7).")] = 5,
     weight: Annotated[float, typer.Option(help="Weight of the point deviation.")] = 1e4,
     rate: Annotated[float, typer.Option(help="Sample rate of trajectory.csv, Hz.")] = 100.0,
     knot_interval: Annotated[float, typer.Option(help="Seconds per knot span.")] = 0.1,
-    hull: Annotated[str, typer.Option(help="Limit hull: bspline (papers') or bezier.")]
-    = "bspline",
-    solver: Annotated[str, typer.Option(help="QP backend: clarabel, piqp or osqp.")]
-    = "clarabel",
+    hull: Annotated[str, typer.Option(help="Limit hull: bspline (papers') or bezier.")] = "bspline",
+    solver: Annotated[str, typer.Option(help="QP backend: clarabel, piqp or osqp.")] = "clarabel",
 ) -> None:
     """Fit a smooth trajectory to POINTS_CSV that starts and ends at rest."""
     with user_errors():
-        options = FitOptions(vmax=vmax, amax=amax, jmax=jmax, coupled=coupled, degree=degree,
-                             weight=weight, knot_interval=knot_interval,
-                             hull=_hull(hull), solver=solver)
+        options = FitOptions(
+            vmax=vmax,
+            amax=amax,
+            jmax=jmax,
+            coupled=coupled,
+            degree=degree,
+            weight=weight,
+            knot_interval=knot_interval,
+            hull=_hull(hull),
+            solver=solver,
+        )
         run_fit(points_csv, options, out, _rate(rate), points_csv.stem)
 
 

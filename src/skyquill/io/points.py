@@ -84,8 +84,9 @@ def trajectory_table(traj: Trajectory, rate: float) -> FloatArray:
 def write_trajectory_csv(path: str | Path, traj: Trajectory, rate: float) -> int:
     """Write ``trajectory.csv`` sampled at ``rate`` Hz; returns the number of rows."""
     table = trajectory_table(traj, rate)
-    np.savetxt(path, table, delimiter=",", header=",".join(TRAJECTORY_COLUMNS), comments="",
-               fmt="%.9g")
+    np.savetxt(
+        path, table, delimiter=",", header=",".join(TRAJECTORY_COLUMNS), comments="", fmt="%.9g"
+    )
     return int(table.shape[0])
 
 

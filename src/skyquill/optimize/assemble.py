@@ -121,8 +121,17 @@ def assemble(problem: SmoothingProblem, margin: float = 0.0) -> Assembled:
     G_ineq, h_ineq, families = _inequalities(problem)
     h_ineq = h_ineq - margin * np.maximum(np.abs(h_ineq), 1e-3)
     return Assembled(
-        sp.csr_array(G_smooth), sp.csr_array(G_points), F, G_coupled, f_coupled, const,
-        E, e, G_ineq, h_ineq, families,
+        sp.csr_array(G_smooth),
+        sp.csr_array(G_points),
+        F,
+        G_coupled,
+        f_coupled,
+        const,
+        E,
+        e,
+        G_ineq,
+        h_ineq,
+        families,
     )
 
 
@@ -200,8 +209,12 @@ def _inequalities(
 
     for lim in problem.limits:
         A, b = lim.halfspaces()
-        add(f"limit: {lim.label}", basis.hull_map(lim.order, kind=problem.hull) * alpha**lim.order,
-            A, b)
+        add(
+            f"limit: {lim.label}",
+            basis.hull_map(lim.order, kind=problem.hull) * alpha**lim.order,
+            A,
+            b,
+        )
     for i, cor in enumerate(problem.corridors):
         first, last = basis.spans_in_window(*_params(problem, np.array([cor.t_start, cor.t_end])))
         add(_corridor_label(i, cor), basis.hull_map(0, first, last, problem.hull), cor.A, cor.b)

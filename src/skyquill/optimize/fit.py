@@ -23,7 +23,6 @@ from skyquill.optimize.timing import MAX_COORDINATE_M, allocate_path_times
 from skyquill.spline import HullKind
 from skyquill.validation import FloatArray, as_array, as_float, as_int, strictly_increasing
 
-
 MAX_SPANS = 100_000
 
 
@@ -79,8 +78,9 @@ class FitOptions:
         if as_float("stretch_factor", self.stretch_factor) <= 1.0:
             raise InputError(f"stretch_factor: got {self.stretch_factor:g}, expected > 1")
         as_int("max_stretches", self.max_stretches, low=0)
-        fraction = as_float("allocation_accel_fraction", self.allocation_accel_fraction,
-                            positive=True)
+        fraction = as_float(
+            "allocation_accel_fraction", self.allocation_accel_fraction, positive=True
+        )
         if fraction > 1.0:
             raise InputError(f"allocation_accel_fraction: got {fraction:g}, expected <= 1")
 
@@ -149,8 +149,9 @@ def fit_points(
                 raise
             scale *= opts.stretch_factor
     err = np.linalg.norm(result.trajectory.evaluate(t * scale) - pts, axis=1)
-    return PointFit(result, pts, t * scale, scale, limits, float(np.sqrt(np.mean(err**2))),
-                    float(err.max()))
+    return PointFit(
+        result, pts, t * scale, scale, limits, float(np.sqrt(np.mean(err**2))), float(err.max())
+    )
 
 
 def _problem(

@@ -28,9 +28,7 @@ def _points_at_times(name: str, times: object, points: object) -> tuple[FloatArr
     t = as_array(f"{name}.times", times, ndim=1)
     p = as_array(f"{name}.points", points, ndim=2)
     if p.shape[0] != t.size:
-        raise InputError(
-            f"{name}.points: got {p.shape[0]} rows, expected one per time ({t.size})"
-        )
+        raise InputError(f"{name}.points: got {p.shape[0]} rows, expected one per time ({t.size})")
     if t.size == 0:
         raise InputError(f"{name}.times: got an empty array, expected at least one time")
     return t, p
@@ -219,8 +217,11 @@ class Corridor:
     def is_nonempty(self) -> bool:
         """Whether some point satisfies ``A p <= b`` (an LP through HiGHS)."""
         res = scipy.optimize.linprog(
-            np.zeros(self.A.shape[1]), A_ub=self.A, b_ub=self.b,
-            bounds=[(None, None)] * self.A.shape[1], method="highs",
+            np.zeros(self.A.shape[1]),
+            A_ub=self.A,
+            b_ub=self.b,
+            bounds=[(None, None)] * self.A.shape[1],
+            method="highs",
         )
         return bool(res.status == 0)
 
@@ -333,8 +334,11 @@ class SmoothingProblem:
             self._check_dim(f"{name}.points", term.points.shape[1])
             self._check_times(f"{name}.times", float(term.times.min()), float(term.times.max()))
         else:
-            size = term.A.shape[1] if isinstance(term, Corridor) else (
-                term.a.size if isinstance(term, LineDeviation) else term.normal.size)
+            size = (
+                term.A.shape[1]
+                if isinstance(term, Corridor)
+                else (term.a.size if isinstance(term, LineDeviation) else term.normal.size)
+            )
             self._check_dim(name, size)
             self._check_times(f"{name} window", term.t_start, term.t_end)
 

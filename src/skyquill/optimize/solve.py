@@ -119,8 +119,16 @@ def solve(problem: SmoothingProblem, solver: str = DEFAULT_BACKEND) -> FitResult
     terms = asm.cost_terms(C)
     check = verify(traj, problem.limits, problem.corridors)
     return FitResult(
-        traj, method, used, terms["total"], terms, elapsed, margin, check,
-        n_variables=C.size, n_equalities=asm.E.shape[0] * problem.dim,
+        traj,
+        method,
+        used,
+        terms["total"],
+        terms,
+        elapsed,
+        margin,
+        check,
+        n_variables=C.size,
+        n_equalities=asm.E.shape[0] * problem.dim,
         n_inequalities=asm.G_ineq.shape[0],
     )
 
@@ -209,9 +217,7 @@ def _to_qp(asm: Assembled) -> QuadraticProgram:
     )
 
 
-def _solve_qp(
-    problem: SmoothingProblem, solver: str
-) -> tuple[FloatArray, str, float, Assembled]:
+def _solve_qp(problem: SmoothingProblem, solver: str) -> tuple[FloatArray, str, float, Assembled]:
     exact = assemble(problem)
     scale = np.maximum(np.abs(exact.h_ineq), 1e-3)
     backends = [solver, *(b for b in ("clarabel", "piqp") if b != solver)]
@@ -252,22 +258,29 @@ def _raise_infeasible(problem: SmoothingProblem, asm: Assembled, certain: bool =
         G = sp.vstack([asm.G_ineq[r, :] for r in rows]) if rows else None
         h = np.concatenate([asm.h_ineq[r] for r in rows]) if rows else None
         res = scipy.optimize.linprog(
-            np.zeros(asm.G_ineq.shape[1]), A_ub=G, b_ub=h,
-            A_eq=A_eq if b_eq.size else None, b_eq=b_eq if b_eq.size else None,
-            bounds=(None, None), method="highs",
+            np.zeros(asm.G_ineq.shape[1]),
+            A_ub=G,
+            b_ub=h,
+            A_eq=A_eq if b_eq.size else None,
+            b_eq=b_eq if b_eq.size else None,
+            bounds=(None, None),
+            method="highs",
         )
         return bool(res.status == 0)
 
     prefix = "infeasible" if certain else "the QP solvers failed; most likely infeasible"
     if b_eq.size and not feasible([]):
-        raise InfeasibleError(f"{prefix}: the boundary conditions and interpolated points "
-                              "contradict each other", ("equalities",))
+        raise InfeasibleError(
+            f"{prefix}: the boundary conditions and interpolated points contradict each other",
+            ("equalities",),
+        )
     alone = [f.label for f in asm.families if not feasible([f.rows])]
     if alone:
         raise InfeasibleError(
             f"{prefix}: cannot be met together with the boundary conditions and interpolated "
             f"points: {'; '.join(alone)} (try a longer duration, more control points or "
-            "looser limits)", tuple(alone),
+            "looser limits)",
+            tuple(alone),
         )
     raise InfeasibleError(
         f"{prefix}: each constraint family is satisfiable alone but not all together: "

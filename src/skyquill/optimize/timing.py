@@ -116,7 +116,9 @@ def allocate_path_times(
     if ds.sum() == 0.0:
         raise InputError("points: got all points equal, expected a path of non-zero length")
     v_cap = np.full(pts.shape[0], vmax)
-    v_cap[1:-1] = np.minimum(vmax, np.sqrt(amax / np.maximum(_curvature(pts, ds, resolution), 1e-12)))
+    v_cap[1:-1] = np.minimum(
+        vmax, np.sqrt(amax / np.maximum(_curvature(pts, ds, resolution), 1e-12))
+    )
     v_cap[0] = v_cap[-1] = 0.0
     v = v_cap.copy()
     for i in range(1, v.size):  # forward: v_i^2 <= v_{i-1}^2 + 2 a ds
@@ -165,6 +167,7 @@ def segment_chain_terms(
     times: FloatArray,
     vmax: float,
     amax: float,
+    *,
     kappa: float = 0.25,
     point_weight: float = 1.0,
     line_weight: float = 1.0,
@@ -203,8 +206,9 @@ def segment_chain_terms(
         seg = pts[i + 1] - pts[i]
         length = float(np.linalg.norm(seg))
         t_plus, t_minus = t[i] + k * dt, t[i] + (1 - k) * dt
-        s_plus, s_minus = rest_to_rest_distance(np.array([k * dt, (1 - k) * dt]), length, vmax,
-                                                amax)
+        s_plus, s_minus = rest_to_rest_distance(
+            np.array([k * dt, (1 - k) * dt]), length, vmax, amax
+        )
         point_t += [t_plus, t_minus, t[i + 1]]
         point_p += [pts[i] + seg * s_plus / length, pts[i] + seg * s_minus / length, pts[i + 1]]
         lines.append(LineDeviation(pts[i], pts[i + 1], t_plus, t_minus, line_weight))

@@ -101,6 +101,7 @@ from skyquill.reproduce.segments import DEVIATION_WEIGHT, KAPPA, polyline_distan
 from skyquill.solvers import DEFAULT_BACKEND
 from skyquill.spline import HullKind
 from skyquill.validation import FloatArray, as_int
+from skyquill.verify import verify
 
 __all__ = [
     "DEGREE",
@@ -144,8 +145,11 @@ def eq55_limits(sides: int | None) -> tuple[DerivativeLimit, ...]:
     """
     if sides is None:
         return tuple(
-            BoxLimit(order, np.array([-r / _SQRT2, -r / _SQRT2, lo]),
-                     np.array([r / _SQRT2, r / _SQRT2, hi]))
+            BoxLimit(
+                order,
+                np.array([-r / _SQRT2, -r / _SQRT2, lo]),
+                np.array([r / _SQRT2, r / _SQRT2, hi]),
+            )
             for order, r, lo, hi in EQ55
         )
     return tuple(CylinderLimit(order, r, lo, hi, sides) for order, r, lo, hi in EQ55)
@@ -165,6 +169,7 @@ def corridor_problem(
     corridor: BoxCorridor,
     n_ctrl: int,
     limits: tuple[DerivativeLimit, ...],
+    *,
     hull: HullKind = "bspline",
     weight: float = DEVIATION_WEIGHT,
     kappa: float = KAPPA,
@@ -191,17 +196,24 @@ def corridor_problem(
         )
     times = _timing(corridor)
     vmax, amax = EQ55[0][1] / _SQRT2, EQ55[1][1] / _SQRT2
-    terms = segment_chain_terms(wp, times, vmax, amax, kappa=kappa, point_weight=weight,
-                                line_weight=weight)
+    terms = segment_chain_terms(
+        wp, times, vmax, amax, kappa=kappa, point_weight=weight, line_weight=weight
+    )
     boxes = tuple(
         Corridor(*box.halfspaces(), float(times[i]), float(times[i + 1]))
         for i, box in enumerate(corridor.boxes)
     )
     return SmoothingProblem(
-        dim=3, degree=DEGREE, n_ctrl=n_ctrl, duration=float(times[-1]),
-        smoothness={4: 1.0}, deviations=terms,
+        dim=3,
+        degree=DEGREE,
+        n_ctrl=n_ctrl,
+        duration=float(times[-1]),
+        smoothness={4: 1.0},
+        deviations=terms,
         boundary=Boundary.rest(corridor.start, corridor.goal, 4),
-        limits=limits, corridors=boxes, hull=hull,
+        limits=limits,
+        corridors=boxes,
+        hull=hull,
     )
 
 
@@ -217,9 +229,15 @@ def _solve_variant(
         results = [solve(problem, solver) for _ in range(repeats)]
     except InfeasibleError as exc:
         return {
-            "feasible": False, "cost": None, "cost_terms": None, "solve_time_s": None,
-            "solve_times_s": [], "max_excess": None, "corridor_excess_m": None,
-            "infeasible_families": list(exc.families), "message": str(exc),
+            "feasible": False,
+            "cost": None,
+            "cost_terms": None,
+            "solve_time_s": None,
+            "solve_times_s": [],
+            "max_excess": None,
+            "corridor_excess_m": None,
+            "infeasible_families": list(exc.families),
+            "message": str(exc),
         }, None
     res = results[-1]
     check = res.verification
@@ -254,8 +272,7 @@ def _solve_variant(
 
 
 def _true_excess(res: FitResult) -> float:
-    from skyquill.verify import verify
-
+    """Largest relative excess over the cylinders of eq. (55) themselves."""
     return verify(res.trajectory, _cylinders()).max_excess
 
 
@@ -265,8 +282,11 @@ def _footprint(corners_of: BoxCorridor) -> list[FloatArray]:
         u, v = box.axes[0, :2], box.axes[1, :2]
         c = box.center[:2]
         hl, hw = box.size[0] / 2.0, box.size[1] / 2.0
-        out.append(np.array([c + hl * u + hw * v, c - hl * u + hw * v,
-                             c - hl * u - hw * v, c + hl * u - hw * v]))
+        out.append(
+            np.array(
+                [c + hl * u + hw * v, c - hl * u + hw * v, c - hl * u - hw * v, c + hl * u - hw * v]
+            )
+        )
     return out
 
 
@@ -331,37 +351,60 @@ def run_corridor_study(
     solved: dict[tuple[int, str], FitResult] = {}
     for m in ms:
         try:
-            ref = solve(corridor_problem(corridor, m, (), hull), solver)
+            ref = solve(corridor_problem(corridor, m, (), hull=hull), solver)
             reference[m] = ref.cost
         except InfeasibleError:
             reference[m] = None
         for v, name in zip(variants, names, strict=True):
-            problem = corridor_problem(corridor, m, eq55_limits(v), hull)
+            problem = corridor_problem(corridor, m, eq55_limits(v), hull=hull)
             rec, res = _solve_variant(problem, reps, solver, corridor.waypoints)
             ref_cost = reference[m]
             rec["limits_bind"] = (
-                None if rec["cost"] is None or ref_cost is None
+                None
+                if rec["cost"] is None or ref_cost is None
                 else bool(rec["cost"] > ref_cost * (1.0 + COST_RTOL))
             )
             records.append({"n_ctrl": m, "variant": name, **rec})
             if res is not None:
                 solved[(m, name)] = res
-            log.info("M=%d %s: %s", m, name,
-                     f"cost {rec['cost']:.6g}" if rec["feasible"] else "infeasible")
+            log.info(
+                "M=%d %s: %s",
+                m,
+                name,
+                f"cost {rec['cost']:.6g}" if rec["feasible"] else "infeasible",
+            )
 
     summary = _summarise(records, ms, names)
     summary["settings"] = {
-        "corridor": str(corridor_path), "degree": DEGREE, "smoothness": "snap, sigma_4 = 1",
-        "rest": "velocity, acceleration, jerk zero at both ends", "hull": hull,
-        "kappa": KAPPA, "weight": DEVIATION_WEIGHT, "repeats": reps, "solver": solver,
-        "allocation_vmax_mps": EQ55[0][1] / _SQRT2, "allocation_amax_mps2": EQ55[1][1] / _SQRT2,
+        "corridor": str(corridor_path),
+        "degree": DEGREE,
+        "smoothness": "snap, sigma_4 = 1",
+        "rest": "velocity, acceleration, jerk zero at both ends",
+        "hull": hull,
+        "kappa": KAPPA,
+        "weight": DEVIATION_WEIGHT,
+        "repeats": reps,
+        "solver": solver,
+        "allocation_vmax_mps": EQ55[0][1] / _SQRT2,
+        "allocation_amax_mps2": EQ55[1][1] / _SQRT2,
         "duration_s": float(_timing(corridor)[-1]),
         "eq55": [{"order": o, "radius": r, "z_lower": lo, "z_upper": hi} for o, r, lo, hi in EQ55],
-        "n_ctrl_values": ms, "sides": sides_list,
+        "n_ctrl_values": ms,
+        "sides": sides_list,
     }
 
     plot_m = plot_n_ctrl if plot_n_ctrl is not None else _default_plot_m(records, ms, names)
-    _plots(out, corridor, records, reference, solved, ms, names, plot_m, hull)
+    _plots(
+        out,
+        corridor,
+        records=records,
+        reference=reference,
+        solved=solved,
+        ms=ms,
+        names=names,
+        plot_m=plot_m,
+        hull=hull,
+    )
     summary["corridor_png_n_ctrl"] = plot_m
     results = {
         "summary": summary,
@@ -405,9 +448,11 @@ def _summarise(records: list[dict[str, Any]], ms: list[int], names: list[str]) -
     feas = [r for r in records if r["feasible"]]
     max_excess = max((r["max_excess"] for r in feas), default=None)
     max_corr = max((r["corridor_excess_m"] for r in feas), default=None)
-    coupled_smallest = [smallest[n] for n in names[1:] if smallest[n] is not None]
+    coupled_smallest = [m for n in names[1:] if (m := smallest[n]) is not None]
     dec_smallest = smallest["decoupled"]
-    fewer = bool(coupled_smallest) and (dec_smallest is None or min(coupled_smallest) < dec_smallest)
+    fewer = bool(coupled_smallest) and (
+        dec_smallest is None or min(coupled_smallest) < dec_smallest
+    )
     any_both = any(ratios[n] is not None for n in names[1:])
     lower_all = all(lower.values())
     time_vals = [t for t in time_ratios.values() if t is not None]
@@ -430,8 +475,9 @@ def _summarise(records: list[dict[str, Any]], ms: list[int], names: list[str]) -
         "claims": {
             "lower_cost": {
                 "paper": "coupled constraints give trajectories with lower cost",
-                "reproduced": bool(any_both and lower_all
-                                   and any(v > 0 for v in strictly.values())),
+                "reproduced": bool(
+                    any_both and lower_all and any(v > 0 for v in strictly.values())
+                ),
                 "mean_cost_ratio": ratios,
             },
             "slightly_longer_time": {
@@ -449,9 +495,16 @@ def _summarise(records: list[dict[str, Any]], ms: list[int], names: list[str]) -
 
 
 def _plots(
-    out: Path, corridor: BoxCorridor, records: list[dict[str, Any]],
-    reference: dict[int, float | None], solved: dict[tuple[int, str], FitResult],
-    ms: list[int], names: list[str], plot_m: int, hull: str,
+    out: Path,
+    corridor: BoxCorridor,
+    *,
+    records: list[dict[str, Any]],
+    reference: dict[int, float | None],
+    solved: dict[tuple[int, str], FitResult],
+    ms: list[int],
+    names: list[str],
+    plot_m: int,
+    hull: str,
 ) -> None:
     from skyquill.viz.reproduce_plots import plot_corridor_top_view, plot_fig10
 
@@ -462,7 +515,7 @@ def _plots(
         {n: [by[(m, n)]["solve_time_s"] for m in ms] for n in names},
         out / "fig10.png",
         title=f"Paper 003 Fig. 10 reproduction: S corridor, eq. (55) limits, degree {DEGREE}, "
-              f"{hull} hull",
+        f"{hull} hull",
         reference=[reference[m] for m in ms],
     )
     trajectories: dict[str, FloatArray | None] = {}
@@ -480,11 +533,16 @@ def _plots(
     speeds["nominal plan (rest to rest per segment)"] = _nominal_speed(corridor)
     r_v = EQ55[0][1]
     plot_corridor_top_view(
-        _footprint(corridor), corridor.waypoints, trajectories, out / "corridor.png",
+        _footprint(corridor),
+        corridor.waypoints,
+        trajectories,
+        out / "corridor.png",
         title=f"S corridor, top view: trajectories with M = {plot_m} control points",
         speeds=speeds,
-        speed_limits={f"eq. (55) cylinder {r_v:g} m/s": r_v,
-                      f"decoupled box, per axis {r_v / _SQRT2:.3g} m/s": r_v / _SQRT2},
+        speed_limits={
+            f"eq. (55) cylinder {r_v:g} m/s": r_v,
+            f"decoupled box, per axis {r_v / _SQRT2:.3g} m/s": r_v / _SQRT2,
+        },
     )
 
 

@@ -167,6 +167,7 @@ def fit_segment_chain(
     times: FloatArray,
     vmax: float,
     amax: float,
+    *,
     kappa: float = KAPPA,
     weight: float = DEVIATION_WEIGHT,
     degree: int = 7,
@@ -204,14 +205,19 @@ def fit_segment_chain(
     deg = as_int("degree", degree, low=5, high=7)
     step = as_float("knot_interval", knot_interval, positive=True)
     t = as_array("times", times, ndim=1)
-    terms = segment_chain_terms(waypoints, t, vmax, amax, kappa=kappa, point_weight=weight,
-                                line_weight=weight)
+    terms = segment_chain_terms(
+        waypoints, t, vmax, amax, kappa=kappa, point_weight=weight, line_weight=weight
+    )
     duration = float(t[-1] - t[0])
     n_ctrl = math.ceil(duration / step - 1e-9) + deg
     start, goal = np.asarray(waypoints, dtype=float)[[0, -1]]
     problem = SmoothingProblem(
-        dim=start.size, degree=deg, n_ctrl=n_ctrl, duration=duration,
-        smoothness={4: 1.0}, deviations=terms,
+        dim=start.size,
+        degree=deg,
+        n_ctrl=n_ctrl,
+        duration=duration,
+        smoothness={4: 1.0},
+        deviations=terms,
         boundary=Boundary.rest(start, goal, 4),  # velocity, acceleration, jerk zero
     )
     result = solve(problem)
@@ -219,7 +225,9 @@ def fit_segment_chain(
 
 
 def _metrics(
-    traj: PolynomialTrajectory | SplineTrajectory, waypoints: FloatArray, duration: float,
+    traj: PolynomialTrajectory | SplineTrajectory,
+    waypoints: FloatArray,
+    duration: float,
     n_samples: int,
 ) -> dict[str, Any]:
     t = np.linspace(0.0, duration, n_samples)
@@ -245,25 +253,33 @@ def _intermediate(terms: tuple[Deviation, ...]) -> PointDeviation:
 
 
 def _sensitivity(
-    waypoints: FloatArray, times: FloatArray, vmax: float, amax: float, kappa: float,
-    weight: float, n_samples: int,
+    waypoints: FloatArray,
+    times: FloatArray,
+    vmax: float,
+    amax: float,
+    *,
+    kappa: float,
+    weight: float,
+    n_samples: int,
 ) -> dict[str, Any]:
     """Method 3 over ``omega`` at the chosen ``kappa``; Methods 2 and 3 over ``kappa``."""
     duration = float(times[-1])
     by_weight = []
     for w in _WEIGHT_SWEEP:
-        traj, _, _ = fit_segment_chain(waypoints, times, vmax, amax, kappa, w)
+        traj, _, _ = fit_segment_chain(waypoints, times, vmax, amax, kappa=kappa, weight=w)
         by_weight.append({"weight": w, **_metrics(traj, waypoints, duration, n_samples)})
     by_kappa = []
     for k in _KAPPA_SWEEP:
-        traj, _, terms = fit_segment_chain(waypoints, times, vmax, amax, k, weight)
+        traj, _, terms = fit_segment_chain(waypoints, times, vmax, amax, kappa=k, weight=weight)
         point = _intermediate(terms)
         peer = minsnap_interpolate(point.points, point.times)
-        by_kappa.append({
-            "kappa": k,
-            "method_2": _metrics(peer, waypoints, duration, n_samples),
-            "method_3": _metrics(traj, waypoints, duration, n_samples),
-        })
+        by_kappa.append(
+            {
+                "kappa": k,
+                "method_2": _metrics(peer, waypoints, duration, n_samples),
+                "method_3": _metrics(traj, waypoints, duration, n_samples),
+            }
+        )
     return {"method_3_by_weight": by_weight, "by_kappa": by_kappa}
 
 
@@ -313,7 +329,9 @@ def run_segment_study(
     duration = float(times[-1])
 
     m1 = minsnap_interpolate(waypoints, times)
-    traj3, terms3, terms = fit_segment_chain(waypoints, times, vmax, amax, kappa, weight)
+    traj3, terms3, terms = fit_segment_chain(
+        waypoints, times, vmax, amax, kappa=kappa, weight=weight
+    )
     point = _intermediate(terms)
     m2 = minsnap_interpolate(point.points, point.times)
     is_waypoint = np.isin(point.times, times)
@@ -322,16 +340,18 @@ def run_segment_study(
     methods: dict[str, dict[str, Any]] = {
         "method_1": {
             "description": "min-snap interpolation of the waypoints (peer, degree 7)",
-            **_metrics(m1, waypoints, duration, n), "solve_time_s": m1.solve_time_s,
+            **_metrics(m1, waypoints, duration, n),
+            "solve_time_s": m1.solve_time_s,
         },
         "method_2": {
             "description": "min-snap interpolation with the intermediate points of §3.5 "
-                           "(peer, degree 7)",
-            **_metrics(m2, waypoints, duration, n), "solve_time_s": m2.solve_time_s,
+            "(peer, degree 7)",
+            **_metrics(m2, waypoints, duration, n),
+            "solve_time_s": m2.solve_time_s,
         },
         "method_3": {
             "description": "skyquill line-segment fit (§3.5): B-spline degree 7, snap cost, "
-                           "point + line deviation, rest to rest, closed form",
+            "point + line deviation, rest to rest, closed form",
             **_metrics(traj3, waypoints, duration, n),
             "solve_time_s": terms3["solve_time_s"],
             "n_ctrl": int(traj3.control_points.shape[0]),
@@ -343,7 +363,7 @@ def run_segment_study(
     methods["method_3"]["snap_cost_check_rel_diff"] = abs(snap3 - smooth3) / max(snap3, 1e-300)
 
     t_dense = np.linspace(0.0, duration, 4001)
-    labels = {
+    labels: dict[str, PolynomialTrajectory | SplineTrajectory] = {
         "Method 1: min-snap through waypoints": m1,
         "Method 2: min-snap with intermediate points": m2,
         "Method 3: line-segment fit (ours)": traj3,
@@ -352,13 +372,17 @@ def run_segment_study(
     from skyquill.viz.reproduce_plots import plot_fig7
 
     plot_fig7(
-        waypoints, extra, positions, out / "fig7.png",
+        waypoints,
+        extra,
+        positions,
+        out / "fig7.png",
         title=f"Paper 003 Fig. 7 reproduction: vmax {vmax:g} m/s, amax {amax:g} m/s², "
-              f"kappa {kappa:g}, omega {weight:g}",
+        f"kappa {kappa:g}, omega {weight:g}",
         times=t_dense,
         deviations={name: polyline_distance(p, waypoints) for name, p in positions.items()},
-        snap_norms={name: np.linalg.norm(tr.evaluate(t_dense, 4), axis=1)
-                    for name, tr in labels.items()},
+        snap_norms={
+            name: np.linalg.norm(tr.evaluate(t_dense, 4), axis=1) for name, tr in labels.items()
+        },
     )
 
     d2, d3 = methods["method_2"], methods["method_3"]
@@ -366,9 +390,14 @@ def run_segment_study(
         "study": "paper 003 §5.2 (Fig. 7): line-segment nominal plan flown three ways",
         "input": str(segments_csv),
         "settings": {
-            "vmax_mps": vmax, "amax_mps2": amax, "kappa": kappa, "weight": weight,
-            "method_3_degree": 7, "method_3_knot_interval_s": 0.1,
-            "waypoint_times_s": times.tolist(), "duration_s": duration,
+            "vmax_mps": vmax,
+            "amax_mps2": amax,
+            "kappa": kappa,
+            "weight": weight,
+            "method_3_degree": 7,
+            "method_3_knot_interval_s": 0.1,
+            "waypoint_times_s": times.tolist(),
+            "duration_s": duration,
         },
         "methods": {
             name: {k: m[k] for k in ("avg_deviation_m", "max_deviation_m", "snap_cost")}
@@ -408,7 +437,9 @@ def run_segment_study(
         "n_samples": n,
     }
     if sensitivity:
-        results["sensitivity"] = _sensitivity(waypoints, times, vmax, amax, kappa, weight, n)
+        results["sensitivity"] = _sensitivity(
+            waypoints, times, vmax, amax, kappa=kappa, weight=weight, n_samples=n
+        )
     write_json(out / "results.json", results)
     write_json(out / "summary.json", summary)
     return summary

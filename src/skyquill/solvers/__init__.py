@@ -21,7 +21,9 @@ BACKENDS: dict[str, QPBackend] = {
 DEFAULT_BACKEND = "clarabel"
 
 
-def solve_qp(qp: QuadraticProgram, backend: str = DEFAULT_BACKEND, tol: float = 1e-10) -> QPSolution:
+def solve_qp(
+    qp: QuadraticProgram, backend: str = DEFAULT_BACKEND, tol: float = 1e-10
+) -> QPSolution:
     """Solve ``qp`` with the named backend."""
     if backend not in BACKENDS:
         raise InputError(f"solver: got {backend!r}, expected one of {sorted(BACKENDS)}")

@@ -21,8 +21,16 @@ def solve_osqp(qp: QuadraticProgram, tol: float) -> QPSolution:
     A, lower, upper = stacked_constraints(qp)
     problem = osqp.OSQP()
     problem.setup(
-        sp.csc_matrix(sp.triu(qp.P, format="csc")), qp.q, sp.csc_matrix(A), lower, upper,
-        verbose=False, eps_abs=tol, eps_rel=tol, max_iter=200_000, polishing=True,
+        sp.csc_matrix(sp.triu(qp.P, format="csc")),
+        qp.q,
+        sp.csc_matrix(A),
+        lower,
+        upper,
+        verbose=False,
+        eps_abs=tol,
+        eps_rel=tol,
+        max_iter=200_000,
+        polishing=True,
     )
     # Fix: explicit raise_error=False -- osqp warns that its default will become True,
     # which would turn 'infeasible' / 'failed' statuses into exceptions here.

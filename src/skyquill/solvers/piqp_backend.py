@@ -20,9 +20,13 @@ def solve_piqp(qp: QuadraticProgram, tol: float) -> QPSolution:
     solver.settings.eps_rel = tol
     solver.settings.max_iter = 250
     solver.setup(
-        sp.csc_matrix(qp.P), qp.q,
-        sp.csc_matrix(qp.A_eq) if qp.b_eq.size else None, qp.b_eq if qp.b_eq.size else None,
-        sp.csc_matrix(qp.G) if qp.h.size else None, None, qp.h if qp.h.size else None,
+        sp.csc_matrix(qp.P),
+        qp.q,
+        sp.csc_matrix(qp.A_eq) if qp.b_eq.size else None,
+        qp.b_eq if qp.b_eq.size else None,
+        sp.csc_matrix(qp.G) if qp.h.size else None,
+        None,
+        qp.h if qp.h.size else None,
     )
     status = solver.solve()
     elapsed = time.perf_counter() - start

@@ -56,7 +56,7 @@ def clamped_uniform_knots(degree: int, n_ctrl: int) -> FloatArray:
 
 
 def _bernstein_matrix(degree: int, u: FloatArray) -> FloatArray:
-    """Bernstein basis of ``degree`` at local parameters ``u`` in [0, 1]; shape (len(u), degree+1)."""
+    """Bernstein basis of ``degree`` at parameters ``u`` in [0, 1]; shape (len(u), degree + 1)."""
     from math import comb
 
     i = np.arange(degree + 1)
@@ -136,8 +136,10 @@ class ClampedUniformBasis:
         self._check_order(order)
         s = np.asarray(s, dtype=float)
         if s.ndim != 1 or not np.all(np.isfinite(s)):
-            raise InputError(f"s: got shape {s.shape} with non-finite values or wrong rank, "
-                             "expected a finite 1-D array")
+            raise InputError(
+                f"s: got shape {s.shape} with non-finite values or wrong rank, "
+                "expected a finite 1-D array"
+            )
         if s.size and (s.min() < 0.0 or s.max() > self.n_spans):
             raise InputError(
                 f"s: got values in [{s.min():g}, {s.max():g}], expected within [0, {self.n_spans}]"
@@ -181,9 +183,7 @@ class ClampedUniformBasis:
             m = self.n_ctrl - j + 1  # control points before it
             t = knots[j - 1 : len(knots) - j + 1]
             scale = p / (t[p + 1 : p + m] - t[1:m])  # eq. (34): k / (s_{i+k+1} - s_{i+1})
-            step = sp.diags_array(
-                [-scale, scale], offsets=[0, 1], shape=(m - 1, m), format="csr"
-            )  # type: ignore[call-overload]  # scipy-stubs reject a list of float arrays
+            step = sp.diags_array([-scale, scale], offsets=[0, 1], shape=(m - 1, m), format="csr")  # type: ignore[call-overload]  # scipy-stubs reject a list of float arrays
             maps.append(sp.csr_array(step @ maps[-1]))
         return tuple(maps)
 
@@ -216,7 +216,10 @@ class ClampedUniformBasis:
         return tuple(grams)
 
     def hull_map(
-        self, order: int, first_span: int = 0, last_span: int | None = None,
+        self,
+        order: int,
+        first_span: int = 0,
+        last_span: int | None = None,
         kind: HullKind = "bspline",
     ) -> sp.csr_array:
         """Points whose convex hull contains the ``order``-th derivative on spans.

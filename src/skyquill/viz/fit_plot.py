@@ -8,8 +8,8 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
-from matplotlib.axes import Axes
 import numpy as np
+from matplotlib.axes import Axes
 
 from skyquill.limits import BoxLimit, CylinderLimit
 from skyquill.optimize.fit import PointFit
@@ -56,8 +56,9 @@ def plot_fit(fit: PointFit, path: str | Path, title: str = "") -> None:
     plt.close(fig)
 
 
-def _draw_limit(panel: Axes, t: np.ndarray, values: np.ndarray,
-                lim: BoxLimit | CylinderLimit) -> None:
+def _draw_limit(
+    panel: Axes, t: np.ndarray, values: np.ndarray, lim: BoxLimit | CylinderLimit
+) -> None:
     if isinstance(lim, BoxLimit):
         for bound in (lim.upper.max(), lim.lower.min()):
             panel.axhline(bound, color="k", ls="--", lw=0.8)

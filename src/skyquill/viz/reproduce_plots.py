@@ -38,6 +38,7 @@ def plot_fig10(
     time_s: Mapping[str, Sequence[float | None]],
     path: str | Path,
     title: str = "",
+    *,
     reference: Sequence[float | None] | None = None,
 ) -> None:
     """Cost (a) and computing time (b) against the number of control points.
@@ -90,20 +91,40 @@ def plot_fig10(
         for i, name_v in enumerate(variants):
             values = data[name_v]
             y = np.array([np.nan if v is None else v * scale for v in values])
-            ax.plot(m, y, _STYLES[i % len(_STYLES)], marker="o", ms=4, color=_color(i),
-                    label=f"{name_v} (feasible {int(np.sum(np.isfinite(y)))}/{y.size})")
+            ax.plot(
+                m,
+                y,
+                _STYLES[i % len(_STYLES)],
+                marker="o",
+                ms=4,
+                color=_color(i),
+                label=f"{name_v} (feasible {int(np.sum(np.isfinite(y)))}/{y.size})",
+            )
             bad = ~np.isfinite(y)
             if np.any(bad):
-                ax.plot(m[bad], np.full(int(bad.sum()), strip[i]), "x", ms=7, mew=1.6,
-                        color=_color(i), linestyle="none")
+                ax.plot(
+                    m[bad],
+                    np.full(int(bad.sum()), strip[i]),
+                    "x",
+                    ms=7,
+                    mew=1.6,
+                    color=_color(i),
+                    linestyle="none",
+                )
         if data is cost and reference is not None:
             ref = np.array([np.nan if v is None else v for v in reference])
-            ax.plot(m, ref, ":", color="0.5", lw=1.2, marker=".",
-                    label="no derivative limits (lower bound)")
+            ax.plot(
+                m,
+                ref,
+                ":",
+                color="0.5",
+                lw=1.2,
+                marker=".",
+                label="no derivative limits (lower bound)",
+            )
         ax.set(xlabel="number of control points M", ylabel=ylabel, title=name)
         ax.grid(True, which="both", alpha=0.3)
-        ax.legend(loc="upper right", fontsize=8, title="x below: infeasible",
-                  title_fontsize=8)
+        ax.legend(loc="upper right", fontsize=8, title="x below: infeasible", title_fontsize=8)
     if title:
         fig.suptitle(title)
     fig.savefig(path, dpi=120)
@@ -147,19 +168,26 @@ def plot_corridor_top_view(
     grid = fig.add_gridspec(2 if speeds else 1, 1, height_ratios=[3, 1] if speeds else [1])
     ax = fig.add_subplot(grid[0, 0])
     for i, corners in enumerate(footprints):
-        ax.add_patch(Polygon(corners, closed=True, facecolor="0.85", edgecolor="0.45",
-                             alpha=0.55, lw=1.0, label="corridor boxes" if i == 0 else None))
+        ax.add_patch(
+            Polygon(
+                corners,
+                closed=True,
+                facecolor="0.85",
+                edgecolor="0.45",
+                alpha=0.55,
+                lw=1.0,
+                label="corridor boxes" if i == 0 else None,
+            )
+        )
         centre = np.asarray(corners).mean(axis=0)
         ax.annotate(f"box {i}", centre, color="0.35", fontsize=8, ha="center", va="center")
     wp = np.asarray(waypoints)
     ax.plot(wp[:, 0], wp[:, 1], "k--", lw=0.9, marker="s", ms=4, label="nominal waypoints")
     for i, (name, p) in enumerate(trajectories.items()):
         if p is None:
-            ax.plot([], [], _STYLES[i % len(_STYLES)], color=_color(i),
-                    label=f"{name}: infeasible")
+            ax.plot([], [], _STYLES[i % len(_STYLES)], color=_color(i), label=f"{name}: infeasible")
             continue
-        ax.plot(p[:, 0], p[:, 1], _STYLES[i % len(_STYLES)], color=_color(i), lw=1.4,
-                label=name)
+        ax.plot(p[:, 0], p[:, 1], _STYLES[i % len(_STYLES)], color=_color(i), lw=1.4, label=name)
     ax.set(xlabel="x [m]", ylabel="y [m]", aspect="equal", title=title or "safe corridor")
     ax.autoscale_view()
     ax.grid(True, alpha=0.3)
@@ -170,12 +198,19 @@ def plot_corridor_top_view(
         for name, (t, v) in speeds.items():
             i = names.index(name) if name in names else -1
             style = _STYLES[i % len(_STYLES)] if i >= 0 else "-"
-            sp.plot(t, v, style, color=_color(i) if i >= 0 else "0.2",
-                    lw=1.2 if i >= 0 else 0.8, label=name)
+            sp.plot(
+                t,
+                v,
+                style,
+                color=_color(i) if i >= 0 else "0.2",
+                lw=1.2 if i >= 0 else 0.8,
+                label=name,
+            )
         for k, (label, value) in enumerate((speed_limits or {}).items()):
             sp.axhline(value, color="0.4", ls=(":", "--", "-.")[k % 3], lw=0.9, label=label)
-        top = max([float(np.max(v)) for _, v in speeds.values()]
-                  + list((speed_limits or {}).values()))
+        top = max(
+            [float(np.max(v)) for _, v in speeds.values()] + list((speed_limits or {}).values())
+        )
         sp.set_ylim(0.0, 1.45 * top)  # room for the legend above the curves
         sp.set(xlabel="t [s]", ylabel="horizontal speed [m/s]", title="horizontal speed")
         sp.grid(True, alpha=0.3)
@@ -221,8 +256,9 @@ def plot_fig7(
     views = ((0, 1, "top view", "y [m]"), (0, 2, "side view", "z [m]"))
     n_views = 2 if wp.shape[1] >= 3 else 1
     extra_row = times is not None and (deviations is not None or snap_norms is not None)
-    fig = plt.figure(figsize=(12, 4.0 * n_views + (3.6 if extra_row else 0.0)),
-                     layout="constrained")
+    fig = plt.figure(
+        figsize=(12, 4.0 * n_views + (3.6 if extra_row else 0.0)), layout="constrained"
+    )
     grid = fig.add_gridspec(n_views + int(extra_row), 2)
     for row in range(n_views):
         ax = fig.add_subplot(grid[row, :])
@@ -230,11 +266,19 @@ def plot_fig7(
         ax.plot(wp[:, i], wp[:, j], "k-", lw=2.4, alpha=0.25, label="line segments")
         ax.plot(wp[:, i], wp[:, j], "ks", ms=5, label="waypoints")
         if extra_points.size:
-            ax.plot(extra_points[:, i], extra_points[:, j], "o", ms=4, mfc="none",
-                    color="0.3", label="intermediate points (Method 2)")
+            ax.plot(
+                extra_points[:, i],
+                extra_points[:, j],
+                "o",
+                ms=4,
+                mfc="none",
+                color="0.3",
+                label="intermediate points (Method 2)",
+            )
         for k, (label, p) in enumerate(trajectories.items()):
-            ax.plot(p[:, i], p[:, j], _STYLES[k % len(_STYLES)], color=_color(k), lw=1.3,
-                    label=label)
+            ax.plot(
+                p[:, i], p[:, j], _STYLES[k % len(_STYLES)], color=_color(k), lw=1.3, label=label
+            )
         ax.set(xlabel="x [m]", ylabel=ylabel, title=name)
         if row == 0:
             ax.set_aspect("equal", adjustable="datalim")
@@ -250,8 +294,14 @@ def plot_fig7(
                 continue
             ax = fig.add_subplot(grid[n_views, col])
             for k, (label, y) in enumerate(data.items()):
-                ax.plot(times, np.maximum(y, 1e-6) if log else y, _STYLES[k % len(_STYLES)],
-                        color=_color(k), lw=1.0, label=label.split(":")[0])
+                ax.plot(
+                    times,
+                    np.maximum(y, 1e-6) if log else y,
+                    _STYLES[k % len(_STYLES)],
+                    color=_color(k),
+                    lw=1.0,
+                    label=label.split(":")[0],
+                )
             if log:
                 ax.set_yscale("log")
                 ax.set_ylim(1e-5, None)
