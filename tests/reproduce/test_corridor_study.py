@@ -13,7 +13,6 @@ from skyquill.limits import BoxLimit, CylinderLimit
 from skyquill.reproduce.corridor import EQ55, eq55_limits, run_corridor_study
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
-pytest.importorskip("minsnap_trajectories")  # the study imports the segments module's peer
 
 
 @pytest.fixture(scope="module")

@@ -4,9 +4,16 @@ The variable is the control-point matrix ``C`` of shape (M, d), vectorised
 control-point-major, ``x = C.ravel()`` (the paper's ``C-hat``): the Hessian of
 an axis-separable term is then ``V ⊗ I_d`` (eq. 9) and stays banded.
 
-Cost ``J(C) = sum_j C_j' G C_j + <F, C> + x' G_c x + f_c' x + const`` where the
-first two terms are axis-separable (smoothness, points) and the coupled part
-holds lines and planes, whose quadratic forms mix axes.
+The objective ``sum_j C_j' G C_j + <F, C> + x' G_c x + f_c' x`` (plus a
+constant) has an axis-separable part (smoothness, points) and a coupled part
+(lines and planes, whose quadratic forms mix axes). ``cost_scale`` makes its
+largest diagonal entry 1 in the closed form's KKT system: with jerk or snap
+costs at fine knot spacing the raw entries grow like ``alpha^5`` or ``alpha^7``
+and would be mixed with O(1) equality rows. (The QP backends equilibrate on
+their own and keep the raw scale, on which their absolute tolerances were
+set.) Equality rows are written in the path parameter ``s`` (derivative rows
+divided by ``alpha^n``). Neither changes the minimiser; the reported cost is
+evaluated term by term by :func:`problem_cost`, never from these matrices.
 """
 
 from __future__ import annotations
@@ -37,14 +44,13 @@ class InequalityFamily:
 
 @dataclass(frozen=True)
 class Assembled:
-    """The problem as matrices. See the module docstring for the cost form."""
+    """The problem as matrices (module docstring)."""
 
-    G_smooth: sp.csr_array  # (M, M)
-    G_points: sp.csr_array  # (M, M)
+    cost_scale: float  # 1 / largest diagonal entry of the Hessian
+    G_axis: sp.csr_array  # (M, M): smoothness + points, per axis
     F: FloatArray  # (M, d)
     G_coupled: sp.csr_array | None  # (Md, Md)
     f_coupled: FloatArray | None  # (Md,)
-    const: float
     E: sp.csr_array  # (m_eq, M), same rows for every axis
     e: FloatArray  # (m_eq, d)
     G_ineq: sp.csr_array  # (m_in, Md)
@@ -59,22 +65,13 @@ class Assembled:
     def hessian(self) -> sp.csr_array:
         """Full ``G`` of ``x' G x`` with ``x = C.ravel()``, shape (Md, Md)."""
         d = self.F.shape[1]
-        G = sp.kron(self.G_smooth + self.G_points, sp.eye_array(d), format="csr")
+        G = sp.kron(self.G_axis, sp.eye_array(d), format="csr")
         return sp.csr_array(G + self.G_coupled) if self.G_coupled is not None else G
 
     def linear(self) -> FloatArray:
         """Full ``f`` of ``f' x``, shape (Md,)."""
         f = self.F.ravel()
         return f + self.f_coupled if self.f_coupled is not None else f
-
-    def cost_terms(self, C: FloatArray) -> dict[str, float]:
-        """``{"smoothness", "deviation", "total"}`` at control points ``C`` (M, d)."""
-        smooth = float(np.sum(C * (self.G_smooth @ C)))
-        dev = float(np.sum(C * (self.G_points @ C)) + np.sum(self.F * C) + self.const)
-        if self.G_coupled is not None and self.f_coupled is not None:
-            x = C.ravel()
-            dev += float(x @ (self.G_coupled @ x) + self.f_coupled @ x)
-        return {"smoothness": smooth, "deviation": dev, "total": smooth + dev}
 
 
 def assemble(problem: SmoothingProblem, margin: float = 0.0) -> Assembled:
@@ -93,46 +90,68 @@ def assemble(problem: SmoothingProblem, margin: float = 0.0) -> Assembled:
     alpha = problem.alpha
     M, d = problem.n_ctrl, problem.dim
 
-    G_smooth = sp.csr_array((M, M))
+    G_axis = sp.csr_array((M, M))
     for order, sigma in problem.smoothness.items():
         if sigma:
-            G_smooth = G_smooth + sigma * alpha ** (2 * order - 1) * basis.gram(order)
-
-    G_points = sp.csr_array((M, M))
+            G_axis = G_axis + sigma * alpha ** (2 * order - 1) * basis.gram(order)
     F = np.zeros((M, d))
-    const = 0.0
-    coupled: list[tuple[sp.csr_array, FloatArray, float]] = []
+    coupled: list[tuple[sp.csr_array, FloatArray]] = []
     for term in problem.deviations:
         if isinstance(term, PointDeviation):
             H = basis.design_matrix(_params(problem, term.times))
-            G_points = G_points + term.weight * (H.T @ H)
+            G_axis = G_axis + term.weight * (H.T @ H)
             F -= 2.0 * term.weight * (H.T @ term.points)
-            const += term.weight * float(np.sum(term.points**2))
         else:
             coupled.append(_flat_term(problem, term))
-
     G_coupled = f_coupled = None
     if coupled:
-        G_coupled = sp.csr_array(sum((g for g, _, _ in coupled), sp.csr_array((M * d, M * d))))
-        f_coupled = np.sum([f for _, f, _ in coupled], axis=0)
-        const += sum(c for _, _, c in coupled)
+        G_coupled = sp.csr_array(sum((g for g, _ in coupled), sp.csr_array((M * d, M * d))))
+        f_coupled = np.sum([f for _, f in coupled], axis=0)
 
+    diagonal = G_axis.diagonal().max(initial=0.0)
+    if G_coupled is not None:
+        diagonal = max(diagonal, G_coupled.diagonal().max(initial=0.0))
     E, e = _equalities(problem)
     G_ineq, h_ineq, families = _inequalities(problem)
     h_ineq = h_ineq - margin * np.maximum(np.abs(h_ineq), 1e-3)
     return Assembled(
-        sp.csr_array(G_smooth),
-        sp.csr_array(G_points),
+        1.0 / diagonal if diagonal > 0 else 1.0,
+        sp.csr_array(G_axis),
         F,
         G_coupled,
         f_coupled,
-        const,
         E,
         e,
         G_ineq,
         h_ineq,
         families,
     )
+
+
+def problem_cost(problem: SmoothingProblem, C: FloatArray) -> dict[str, float]:
+    """Cost of control points ``C`` (M, d), term by term: ``smoothness``, ``deviation``, ``total``.
+
+    Smoothness is ``sum_n sigma_n alpha^(2n-1) sum_j D_j' W_n D_j`` on the
+    derivative control points ``D = Gamma_n C`` (eq. 8-10), deviations are the
+    residuals themselves (eq. 11, 25, 27): no cancellation of large terms.
+    """
+    basis, alpha = problem.basis, problem.alpha
+    smooth = 0.0
+    for order, sigma in problem.smoothness.items():
+        D = basis.derivative_map(order) @ C
+        energy = float(np.sum(D * (basis.reduced_gram(order) @ D)))
+        smooth += float(sigma * alpha ** (2 * order - 1) * energy)
+    deviation = 0.0
+    for term in problem.deviations:
+        if isinstance(term, PointDeviation):
+            residual = basis.design_matrix(_params(problem, term.times)) @ C - term.points
+            deviation += term.weight * float(np.sum(residual**2))
+        else:
+            Q, w = term.quadratic()
+            active = _window_controls(problem, term.t_start, term.t_end) > 0
+            diff = C[active] - w
+            deviation += term.weight * float(np.sum(diff * (diff @ Q)))
+    return {"smoothness": smooth, "deviation": deviation, "total": smooth + deviation}
 
 
 def _params(problem: SmoothingProblem, times: FloatArray) -> FloatArray:
@@ -157,29 +176,36 @@ def _window_controls(problem: SmoothingProblem, t_start: float, t_end: float) ->
 
 def _flat_term(
     problem: SmoothingProblem, term: LineDeviation | PlaneDeviation
-) -> tuple[sp.csr_array, FloatArray, float]:
-    """Paper 003 eqs. (25), (27): ``sum_i (c_i - w)' Q (c_i - w)`` over the window."""
+) -> tuple[sp.csr_array, FloatArray]:
+    """Paper 003 eqs. (25), (27): ``sum_i (c_i - w)' Q (c_i - w)`` over the window.
+
+    Returns the quadratic and linear parts; the constant ``w'Qw`` per point
+    only enters :func:`problem_cost`.
+    """
     Q, w = term.quadratic()
     active = _window_controls(problem, term.t_start, term.t_end)
     G = term.weight * sp.kron(sp.diags_array(active), Q, format="csr")
     f = -2.0 * term.weight * np.outer(active, Q @ w).ravel()
-    c = term.weight * float(active.sum()) * float(w @ Q @ w)
-    return sp.csr_array(G), f, c
+    return sp.csr_array(G), f
 
 
 def _equalities(problem: SmoothingProblem) -> tuple[sp.csr_array, FloatArray]:
-    """Boundary conditions (eq. 42) and interpolated points (eq. 13), per axis."""
+    """Boundary conditions (eq. 42) and interpolated points (eq. 13), per axis.
+
+    Derivative rows are in ``s``: ``Gamma_n C = value / alpha^n`` (O(1) rows).
+    """
     basis, alpha, M = problem.basis, problem.alpha, problem.n_ctrl
     rows: list[sp.csr_array] = []
     rhs: list[FloatArray] = []
     for bc in problem.boundary:
-        D = basis.derivative_map(bc.order) * alpha**bc.order
+        D = basis.derivative_map(bc.order)
+        to_s = alpha**-bc.order
         if bc.start is not None:
             rows.append(sp.csr_array(D[[0], :]))
-            rhs.append(bc.start[None, :])
+            rhs.append(to_s * bc.start[None, :])
         if bc.end is not None:
             rows.append(sp.csr_array(D[[D.shape[0] - 1], :]))
-            rhs.append(bc.end[None, :])
+            rhs.append(to_s * bc.end[None, :])
     for term in problem.interpolation:
         if isinstance(term, Interpolation):
             rows.append(basis.design_matrix(_params(problem, term.times)))

@@ -31,7 +31,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from skyquill.errors import InfeasibleError, SolverError
-from skyquill.optimize.assemble import Assembled, assemble
+from skyquill.optimize.assemble import Assembled, assemble, problem_cost
 from skyquill.optimize.problem import SmoothingProblem
 from skyquill.solvers import BACKENDS, DEFAULT_BACKEND, QuadraticProgram, solve_qp
 from skyquill.trajectory import SplineTrajectory
@@ -116,7 +116,7 @@ def solve(problem: SmoothingProblem, solver: str = DEFAULT_BACKEND) -> FitResult
         method = "closed_form"
     elapsed = time.perf_counter() - start
     traj = SplineTrajectory(C, problem.degree, problem.duration)
-    terms = asm.cost_terms(C)
+    terms = problem_cost(problem, C)
     check = verify(traj, problem.limits, problem.corridors)
     return FitResult(
         traj,
@@ -179,19 +179,24 @@ def _independent_equalities(asm: Assembled) -> Assembled | None:
 
 def _closed_form_kkt(asm: Assembled) -> FloatArray:
     M, d = asm.F.shape
-    m = asm.E.shape[0]
     if asm.separable:
-        G2 = 2.0 * (asm.G_smooth + asm.G_points)
+        G2 = 2.0 * asm.cost_scale * asm.G_axis
         K = sp.block_array([[G2, asm.E.T], [asm.E, None]], format="csc")
-        rhs = np.vstack([-asm.F, asm.e])
+        rhs = np.vstack([-asm.cost_scale * asm.F, asm.e])
         return _lu_solve(K, rhs)[:M]
     E = sp.kron(asm.E, sp.eye_array(d), format="csr")
-    K = sp.block_array([[2.0 * asm.hessian(), E.T], [E, None]], format="csc")
-    rhs = np.concatenate([-asm.linear(), asm.e.ravel()])
-    return _lu_solve(K, rhs[:, None])[: M * d, 0].reshape(M, d) if m >= 0 else rhs
+    K = sp.block_array([[2.0 * asm.cost_scale * asm.hessian(), E.T], [E, None]], format="csc")
+    rhs = np.concatenate([-asm.cost_scale * asm.linear(), asm.e.ravel()])
+    return _lu_solve(K, rhs[:, None])[: M * d, 0].reshape(M, d)
 
 
 def _lu_solve(K: sp.csc_array, rhs: FloatArray) -> FloatArray:
+    """Solve ``K x = rhs`` by sparse LU (SuperLU, COLAMD ordering).
+
+    With the scaling of :func:`assemble` the relative residual is ~1e-15 even
+    for snap at 100 spans/s (``alpha^7 = 1e14`` against point weights 1e4),
+    so no refinement step is needed.
+    """
     try:
         x = np.asarray(spla.splu(K).solve(rhs))
     except RuntimeError as exc:  # "Factor is exactly singular"

@@ -144,21 +144,24 @@ class ClampedUniformBasis:
             raise InputError(
                 f"s: got values in [{s.min():g}, {s.max():g}], expected within [0, {self.n_spans}]"
             )
-        p = self.degree - order
-        knots = self.knots[order : len(self.knots) - order]
         if s.size == 0:
             return sp.csr_array((0, self.n_ctrl))
-        if p == 0:
-            # Piecewise-constant basis: column = span index (right end -> last span).
-            cols = np.minimum(np.floor(s).astype(int), self.n_spans - 1)
-            basis = sp.csr_array(
-                (np.ones(s.size), (np.arange(s.size), cols)), shape=(s.size, self.n_ctrl - order)
-            )
-        else:
-            basis = sp.csr_array(BSpline.design_matrix(s, knots, p))
+        basis = self._derivative_basis(s, order)
         if order == 0:
             return basis
         return sp.csr_array(basis @ self.derivative_map(order))
+
+    def _derivative_basis(self, s: FloatArray, order: int) -> sp.csr_array:
+        """Basis of the ``order``-th derivative spline (degree k - n, knots eq. 35) at ``s``."""
+        p = self.degree - order
+        if p == 0:
+            # Piecewise-constant basis: column = span index (right end -> last span).
+            cols = np.minimum(np.floor(s).astype(int), self.n_spans - 1)
+            return sp.csr_array(
+                (np.ones(s.size), (np.arange(s.size), cols)), shape=(s.size, self.n_ctrl - order)
+            )
+        knots = self.knots[order : len(self.knots) - order]
+        return sp.csr_array(BSpline.design_matrix(s, knots, p))
 
     def derivative_map(self, order: int) -> sp.csr_array:
         """Map Γ_n from control points to those of the ``order``-th ``s``-derivative.
@@ -203,6 +206,24 @@ class ClampedUniformBasis:
 
     @cached_property
     def _grams(self) -> tuple[sp.csr_array, ...]:
+        return tuple(
+            sp.csr_array(self.derivative_map(n).T @ self.reduced_gram(n) @ self.derivative_map(n))
+            for n in range(self.degree + 1)
+        )
+
+    def reduced_gram(self, order: int) -> sp.csr_array:
+        """Gram matrix ``W_n`` of the derivative spline's own basis, shape (M - n, M - n).
+
+        ``V_n = Gamma_n' W_n Gamma_n``. ``W_n`` is positive definite, so a
+        cost evaluated as ``D' W_n D`` on the derivative control points
+        ``D = Gamma_n C`` does not suffer the cancellation of ``C' V_n C``
+        (large ``C`` nearly in the polynomial null space of ``V_n``).
+        """
+        self._check_order(order)
+        return self._reduced_grams[order]
+
+    @cached_property
+    def _reduced_grams(self) -> tuple[sp.csr_array, ...]:
         grams = []
         for order in range(self.degree + 1):
             n_nodes = self.degree - order + 1
@@ -211,7 +232,7 @@ class ClampedUniformBasis:
             spans = np.arange(self.n_spans)
             s = (spans[:, None] + u[None, :]).ravel()
             w = np.tile(0.5 * weights, self.n_spans)
-            B = self.design_matrix(s, order)
+            B = self._derivative_basis(s, order)
             grams.append(sp.csr_array(B.T @ sp.diags_array(w) @ B))
         return tuple(grams)
 
