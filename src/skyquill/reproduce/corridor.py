@@ -112,7 +112,7 @@ from __future__ import annotations
 import logging
 import math
 import statistics
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -328,6 +328,7 @@ def run_corridor_study(
     solver: str = DEFAULT_BACKEND,
     plot_n_ctrl: int | None = None,
     weight: float = DEVIATION_WEIGHT,
+    on_step: Callable[[int, int], None] | None = None,
 ) -> dict[str, Any]:
     """Reproduce paper 003 §5.4 / Fig. 10 and write its figures and numbers.
 
@@ -358,6 +359,8 @@ def run_corridor_study(
         ``omega`` of the point and line terms; the study's value is
         :data:`~skyquill.reproduce.segments.DEVIATION_WEIGHT` (other values are
         for sensitivity runs only).
+    on_step
+        Called as ``on_step(done, total)`` after each ``M`` (progress display).
 
     Returns
     -------
@@ -406,6 +409,8 @@ def run_corridor_study(
                 name,
                 f"cost {rec['cost']:.6g}" if rec["feasible"] else "infeasible",
             )
+        if on_step is not None:
+            on_step(ms.index(m) + 1, len(ms))
 
     summary = _summarise(records, ms, names)
     summary["settings"] = {
