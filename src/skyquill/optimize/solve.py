@@ -262,7 +262,8 @@ def _raise_infeasible(problem: SmoothingProblem, asm: Assembled, certain: bool =
     def feasible(rows: list[slice]) -> bool:
         G = sp.vstack([asm.G_ineq[r, :] for r in rows]) if rows else None
         h = np.concatenate([asm.h_ineq[r] for r in rows]) if rows else None
-        res = scipy.optimize.linprog(
+        # scipy accepts sparse A_ub / A_eq; its stubs only list dense arrays.
+        res = scipy.optimize.linprog(  # type: ignore[call-overload]
             np.zeros(asm.G_ineq.shape[1]),
             A_ub=G,
             b_ub=h,
