@@ -8,6 +8,7 @@ Positions are in the z-up world frame, metres; time in seconds from 0.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cached_property
 from typing import Protocol, runtime_checkable
@@ -16,7 +17,7 @@ import numpy as np
 from scipy.interpolate import BSpline
 
 from skyquill.errors import InputError
-from skyquill.spline import ClampedUniformBasis, basis_for
+from skyquill.spline import ClampedUniformBasis, basis_for, uniform_design
 from skyquill.validation import FloatArray, as_array, as_float, as_int
 
 #: DESIGN.md: at least 20 samples per knot span and never fewer than 10,000.
@@ -166,10 +167,27 @@ class SplineTrajectory:
         """Samples at ``rate`` Hz (position to jerk), including both ends."""
         return sample(self, rate)
 
+    def _n_dense(self) -> int:
+        return max(DENSE_MIN_TOTAL, DENSE_PER_SPAN * self.basis.n_spans + 1)
+
     def dense_times(self) -> FloatArray:
         """Times for the dense check: >= 20 per knot span and >= 10,000 in all."""
-        n = max(DENSE_MIN_TOTAL, DENSE_PER_SPAN * self.basis.n_spans + 1)
-        return np.linspace(0.0, self.duration, n)
+        return np.linspace(0.0, self.duration, self._n_dense())
+
+    def dense_derivatives(self, orders: Sequence[int]) -> dict[int, FloatArray]:
+        """Derivatives at :meth:`dense_times`, ``{order: (N, d)}``.
+
+        Equal to ``evaluate(dense_times(), order)`` but through a cached sparse
+        design matrix: one sparse product per order.
+        """
+        out = {}
+        for order in orders:
+            if order > self.degree:
+                out[order] = np.zeros((self._n_dense(), self.dim))
+                continue
+            D = uniform_design(self.degree, self.basis.n_ctrl, order, self._n_dense())
+            out[order] = self.alpha**order * np.asarray(D @ self.control_points)
+        return out
 
     def derivative_control_points(self, order: int) -> FloatArray:
         """Control points of the ``order``-th time derivative, shape (M - order, d).

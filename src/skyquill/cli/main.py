@@ -132,7 +132,7 @@ def fit(
     rate: Annotated[float, typer.Option(help="Sample rate of trajectory.csv, Hz.")] = 100.0,
     knot_interval: Annotated[float, typer.Option(help="Seconds per knot span.")] = 0.1,
     hull: Annotated[str, typer.Option(help="Limit hull: bspline (papers') or bezier.")] = "bspline",
-    solver: Annotated[str, typer.Option(help="QP backend: clarabel, piqp or osqp.")] = "clarabel",
+    solver: Annotated[str, typer.Option(help="QP backend: piqp, clarabel or osqp.")] = "piqp",
 ) -> None:
     """Fit a smooth trajectory to POINTS_CSV that starts and ends at rest."""
     with user_errors():

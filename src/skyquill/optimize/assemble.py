@@ -23,6 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
+from skyquill.errors import InfeasibleError
 from skyquill.optimize.problem import (
     Corridor,
     Interpolation,
@@ -74,18 +75,8 @@ class Assembled:
         return f + self.f_coupled if self.f_coupled is not None else f
 
 
-def assemble(problem: SmoothingProblem, margin: float = 0.0) -> Assembled:
-    """Build the matrices of ``problem``.
-
-    Parameters
-    ----------
-    problem
-        The validated problem.
-    margin
-        Relative tightening of every inequality's right-hand side
-        (``h - margin * max(|h|, 1e-3)``), so that a solver's tolerance cannot
-        leave the result outside a limit it was asked to hold.
-    """
+def assemble(problem: SmoothingProblem) -> Assembled:
+    """Build the matrices of ``problem`` (validated)."""
     basis = problem.basis
     alpha = problem.alpha
     M, d = problem.n_ctrl, problem.dim
@@ -113,7 +104,6 @@ def assemble(problem: SmoothingProblem, margin: float = 0.0) -> Assembled:
         diagonal = max(diagonal, G_coupled.diagonal().max(initial=0.0))
     E, e = _equalities(problem)
     G_ineq, h_ineq, families = _inequalities(problem)
-    h_ineq = h_ineq - margin * np.maximum(np.abs(h_ineq), 1e-3)
     return Assembled(
         1.0 / diagonal if diagonal > 0 else 1.0,
         sp.csr_array(G_axis),
@@ -198,13 +188,13 @@ def _equalities(problem: SmoothingProblem) -> tuple[sp.csr_array, FloatArray]:
     rows: list[sp.csr_array] = []
     rhs: list[FloatArray] = []
     for bc in problem.boundary:
-        D = basis.derivative_map(bc.order)
+        start_row, end_row = basis.end_rows(bc.order)
         to_s = alpha**-bc.order
         if bc.start is not None:
-            rows.append(sp.csr_array(D[[0], :]))
+            rows.append(start_row)
             rhs.append(to_s * bc.start[None, :])
         if bc.end is not None:
-            rows.append(sp.csr_array(D[[D.shape[0] - 1], :]))
+            rows.append(end_row)
             rhs.append(to_s * bc.end[None, :])
     for term in problem.interpolation:
         if isinstance(term, Interpolation):
@@ -212,7 +202,35 @@ def _equalities(problem: SmoothingProblem) -> tuple[sp.csr_array, FloatArray]:
             rhs.append(term.points)
     if not rows:
         return sp.csr_array((0, M)), np.zeros((0, problem.dim))
-    return sp.csr_array(sp.vstack(rows)), np.vstack(rhs)
+    return _drop_duplicate_rows(sp.csr_array(sp.vstack(rows)), np.vstack(rhs))
+
+
+def _drop_duplicate_rows(E: sp.csr_array, e: FloatArray) -> tuple[sp.csr_array, FloatArray]:
+    """Remove equality rows that repeat an earlier row exactly.
+
+    The common case: interpolating every waypoint of a rest-to-rest plan
+    repeats the boundary position rows (``e_0`` and ``e_{M-1}``), which would
+    make the KKT matrix singular. A repeat with a different right-hand side
+    is a contradiction and raises :class:`InfeasibleError`.
+    """
+    seen: dict[tuple[bytes, bytes], int] = {}
+    keep = []
+    for i in range(E.shape[0]):
+        lo, hi = E.indptr[i], E.indptr[i + 1]
+        key = (E.indices[lo:hi].tobytes(), E.data[lo:hi].tobytes())
+        if key not in seen:
+            seen[key] = i
+            keep.append(i)
+        elif not np.allclose(e[i], e[seen[key]], rtol=1e-12, atol=1e-12):
+            raise InfeasibleError(
+                "infeasible: two equality constraints fix the same quantity to different values "
+                f"({e[seen[key]].tolist()} and {e[i].tolist()}): check the boundary conditions "
+                "against the interpolated points",
+                ("equalities",),
+            )
+    if len(keep) == E.shape[0]:
+        return E, e
+    return sp.csr_array(E[keep]), e[keep]
 
 
 def _inequalities(

@@ -20,6 +20,7 @@ from skyquill.limits import DerivativeLimit, vehicle_limits
 from skyquill.optimize.problem import Boundary, PointDeviation, SmoothingProblem
 from skyquill.optimize.solve import FitResult, solve
 from skyquill.optimize.timing import MAX_COORDINATE_M, allocate_path_times
+from skyquill.solvers import DEFAULT_BACKEND
 from skyquill.spline import HullKind
 from skyquill.validation import FloatArray, as_array, as_float, as_int, strictly_increasing
 
@@ -64,7 +65,7 @@ class FitOptions:
     weight: float = 1e4
     knot_interval: float = 0.1
     hull: HullKind = "bspline"
-    solver: str = "clarabel"
+    solver: str = DEFAULT_BACKEND
     allocation_accel_fraction: float = 0.5
     stretch_factor: float = 1.25
     max_stretches: int = 10

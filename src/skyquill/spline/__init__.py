@@ -5,6 +5,13 @@ from skyquill.spline.basis import (
     HullKind,
     basis_for,
     clamped_uniform_knots,
+    uniform_design,
 )
 
-__all__ = ["ClampedUniformBasis", "HullKind", "basis_for", "clamped_uniform_knots"]
+__all__ = [
+    "ClampedUniformBasis",
+    "HullKind",
+    "basis_for",
+    "clamped_uniform_knots",
+    "uniform_design",
+]

@@ -190,6 +190,21 @@ class ClampedUniformBasis:
             maps.append(sp.csr_array(step @ maps[-1]))
         return tuple(maps)
 
+    def end_rows(self, order: int) -> tuple[sp.csr_array, sp.csr_array]:
+        """First and last rows of :meth:`derivative_map`, each (1, M): the ``order``-th
+        ``s``-derivative at ``s = 0`` and ``s = L`` (paper 003 eq. 41). Cached.
+        """
+        self._check_order(order)
+        return self._end_rows[order]
+
+    @cached_property
+    def _end_rows(self) -> tuple[tuple[sp.csr_array, sp.csr_array], ...]:
+        rows = []
+        for order in range(self.degree + 1):
+            dense = self.derivative_map(order)[[0, self.n_ctrl - order - 1], :].toarray()
+            rows.append((sp.csr_array(dense[:1]), sp.csr_array(dense[1:])))
+        return tuple(rows)
+
     def gram(self, order: int) -> sp.csr_array:
         """Exact Gram matrix of the ``order``-th derivative (paper 003 eq. 10, ``alpha = 1``).
 
@@ -309,6 +324,18 @@ class ClampedUniformBasis:
         first = min(int(np.floor(s_start)), self.n_spans - 1)
         last = max(first, min(int(np.ceil(s_end)) - 1, self.n_spans - 1))
         return first, last
+
+
+@lru_cache(maxsize=32)
+def uniform_design(degree: int, n_ctrl: int, order: int, n_samples: int) -> sp.csr_array:
+    """Cached :meth:`ClampedUniformBasis.design_matrix` at ``n_samples`` uniform ``s`` in [0, L].
+
+    The dense check samples every trajectory of a given basis at the same
+    parameters; caching the sparse matrix turns each derivative into one
+    sparse product.
+    """
+    basis = basis_for(degree, n_ctrl)
+    return basis.design_matrix(np.linspace(0.0, basis.n_spans, n_samples), order)
 
 
 @lru_cache(maxsize=64)
