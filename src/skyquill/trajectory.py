@@ -17,8 +17,10 @@ import numpy as np
 from scipy.interpolate import BSpline
 
 from skyquill.errors import InputError
+from skyquill.limits import DerivativeLimit
 from skyquill.spline import ClampedUniformBasis, basis_for, uniform_design
 from skyquill.validation import FloatArray, as_array, as_float, as_int
+from skyquill.verify import Region, Verification, verify
 
 #: DESIGN.md: at least 20 samples per knot span and never fewer than 10,000.
 DENSE_PER_SPAN = 20
@@ -188,6 +190,12 @@ class SplineTrajectory:
             D = uniform_design(self.degree, self.basis.n_ctrl, order, self._n_dense())
             out[order] = self.alpha**order * np.asarray(D @ self.control_points)
         return out
+
+    def verify(
+        self, limits: Sequence[DerivativeLimit] = (), corridors: Sequence[Region] = ()
+    ) -> Verification:
+        """The dense check (DESIGN.md) of this trajectory against ``limits`` and ``corridors``."""
+        return verify(self, limits, corridors)
 
     def derivative_control_points(self, order: int) -> FloatArray:
         """Control points of the ``order``-th time derivative, shape (M - order, d).

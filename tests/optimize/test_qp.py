@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import dataclasses
 import itertools
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import pytest
@@ -305,3 +305,28 @@ def test_margin_is_reported() -> None:
     assert qp.n_inequalities > 0
     assert closed.n_inequalities == 0
     assert qp.n_variables == spec.n_ctrl * spec.dim
+
+
+def test_input_limit_of_a_chain_of_integrators_holds() -> None:
+    """Paper 003 §3.8: the input of a 4th-order chain is snap; limit it like any derivative."""
+    from skyquill.limits import BoxLimit
+    from skyquill.optimize import Boundary, PointDeviation, SmoothingProblem, solve
+
+    t = np.linspace(0.0, 4.0, 80)
+    points = np.column_stack([np.sin(t), np.cos(2 * t)])
+    free = SmoothingProblem(
+        2,
+        6,
+        30,
+        4.0,
+        smoothness={4: 1.0},
+        deviations=(PointDeviation(t, points, 1e3),),
+        boundary=Boundary.rest(points[0], points[-1], 4),
+    )
+    snap_free = np.abs(solve(free).trajectory.evaluate(t, 4)).max()
+    limit = BoxLimit.symmetric(4, 0.5 * snap_free, 2)
+    result = solve(replace(free, limits=(limit,)))
+    snap = result.trajectory.evaluate(result.trajectory.dense_times(), 4)
+    assert np.abs(snap).max() <= 0.5 * snap_free * (1 + 1e-9)
+    assert result.verification.max_excess <= 1e-9
+    assert result.trajectory.verify((limit,)).max_excess <= 1e-9

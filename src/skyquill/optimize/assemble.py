@@ -145,15 +145,21 @@ def problem_cost(problem: SmoothingProblem, C: FloatArray) -> dict[str, float]:
 
 
 def _params(problem: SmoothingProblem, times: FloatArray) -> FloatArray:
-    """Path parameters ``s = alpha * t`` of validated times, clipped to ``[0, L]``.
+    """Path parameters ``s = alpha * t`` of validated times, snapped to ``[0, L]``.
 
-    Fix: ``SmoothingProblem`` accepts times up to 1e-9 * duration outside
+    ``SmoothingProblem`` accepts times up to 1e-9 * duration outside
     ``[0, duration]``, and even ``t = duration`` exactly can round to
-    ``alpha * t > L`` (e.g. L = 3, duration = 1.3437...); the basis rejects
-    such ``s`` (and a window start below 0 gave span -1), so clip here.
+    ``alpha * t`` just above or below ``L`` (e.g. L = 3, duration = 1.3437...).
+    Above, the basis would reject it; below, a point meant for the end gets a
+    row that is *almost* the boundary row, and the KKT matrix becomes nearly
+    singular instead of exactly redundant. So parameters within 1e-9 L of an
+    end are put on it.
     """
+    L = float(problem.basis.n_spans)
     s = problem.alpha * np.asarray(times, dtype=float)
-    return np.clip(s, 0.0, float(problem.basis.n_spans))
+    s = np.where(np.abs(s - L) <= 1e-9 * L, L, s)
+    s = np.where(np.abs(s) <= 1e-9 * L, 0.0, s)
+    return np.clip(s, 0.0, L)
 
 
 def _window_controls(problem: SmoothingProblem, t_start: float, t_end: float) -> FloatArray:
@@ -213,6 +219,8 @@ def _drop_duplicate_rows(E: sp.csr_array, e: FloatArray) -> tuple[sp.csr_array, 
     make the KKT matrix singular. A repeat with a different right-hand side
     is a contradiction and raises :class:`InfeasibleError`.
     """
+    E = sp.csr_array(E, copy=True)
+    E.eliminate_zeros()  # scipy's design matrices store the k+1 entries even when 0
     seen: dict[tuple[bytes, bytes], int] = {}
     keep = []
     for i in range(E.shape[0]):
@@ -223,9 +231,9 @@ def _drop_duplicate_rows(E: sp.csr_array, e: FloatArray) -> tuple[sp.csr_array, 
             keep.append(i)
         elif not np.allclose(e[i], e[seen[key]], rtol=1e-12, atol=1e-12):
             raise InfeasibleError(
-                "infeasible: two equality constraints fix the same quantity to different values "
-                f"({e[seen[key]].tolist()} and {e[i].tolist()}): check the boundary conditions "
-                "against the interpolated points",
+                "infeasible: the boundary conditions and interpolated points contradict each "
+                f"other: the same quantity is fixed to {e[seen[key]].tolist()} and "
+                f"{e[i].tolist()}",
                 ("equalities",),
             )
     if len(keep) == E.shape[0]:
