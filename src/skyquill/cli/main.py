@@ -19,6 +19,7 @@ from rich.console import Console
 from skyquill.errors import InputError, SkyquillError
 from skyquill.io.points import read_points_csv, write_json, write_trajectory_csv
 from skyquill.optimize.fit import FitOptions, PointFit, fit_points
+from skyquill.validation import FloatArray
 
 app = typer.Typer(
     add_completion=False,
@@ -83,14 +84,18 @@ def fit_summary(fit: PointFit, rows: int, rate: float) -> dict[str, Any]:
 
 
 def run_fit(
-    points_csv: Path, options: FitOptions, out: Path, rate: float, title: str
+    points: FloatArray,
+    times: FloatArray | None,
+    options: FitOptions,
+    out: Path,
+    rate: float,
+    title: str,
 ) -> dict[str, Any]:
-    """Read, fit, write ``trajectory.csv``, ``plot.png`` and ``summary.json``."""
+    """Fit, then write ``trajectory.csv``, ``plot.png`` and ``summary.json`` into ``out``."""
     from skyquill.viz.fit_plot import plot_fit
 
-    points, times = read_points_csv(points_csv)
     out.mkdir(parents=True, exist_ok=True)
-    with console.status(f"fitting {points.shape[0]} points from {points_csv.name}"):
+    with console.status(f"fitting {points.shape[0]} points ({title})"):
         fit = fit_points(points, times, options)
     rows = write_trajectory_csv(out / "trajectory.csv", fit.result.trajectory, rate)
     with console.status("plotting"):
@@ -147,7 +152,8 @@ def fit(
             hull=_hull(hull),
             solver=solver,
         )
-        run_fit(points_csv, options, out, _rate(rate), points_csv.stem)
+        points, times = read_points_csv(points_csv)
+        run_fit(points, times, options, out, _rate(rate), points_csv.stem)
 
 
 def _hull(name: str) -> Any:
@@ -160,14 +166,10 @@ def _hull(name: str) -> Any:
 def demo(out: OutDir = Path("out/demo")) -> None:
     """Fit the bundled hand-drawn spiral (examples/spiral.csv) and plot it."""
     with user_errors():
-        spiral = EXAMPLES / "spiral.csv"
+        points, _ = read_points_csv(EXAMPLES / "spiral.csv")
         # Time comes from the path allocation, not the tablet's clock: the hand
         # does not start and end at rest, the drone must.
-        points, _ = read_points_csv(spiral)
-        tmp = out / "spiral_points.csv"
-        out.mkdir(parents=True, exist_ok=True)
-        tmp.write_text("x,y\n" + "\n".join(f"{x:.6f},{y:.6f}" for x, y in points) + "\n")
-        run_fit(tmp, FitOptions(), out, 100.0, "hand-drawn spiral")
+        run_fit(points, None, FitOptions(), out, 100.0, "hand-drawn spiral")
 
 
 reproduce_app = typer.Typer(no_args_is_help=True, help="Reproduce the papers' experiments.")
