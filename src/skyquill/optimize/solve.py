@@ -32,7 +32,7 @@ import scipy.optimize
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from skyquill.errors import InfeasibleError, SolverError
+from skyquill.errors import InfeasibleError, InputError, SolverError
 from skyquill.optimize.assemble import Assembled, assemble, problem_cost
 from skyquill.optimize.problem import SmoothingProblem
 from skyquill.solvers import BACKENDS, DEFAULT_BACKEND, QuadraticProgram, solve_qp
@@ -117,8 +117,6 @@ def solve(problem: SmoothingProblem, solver: str = DEFAULT_BACKEND) -> FitResult
         Every backend failed, or the cost does not determine the closed form.
     """
     if solver not in BACKENDS:
-        from skyquill.errors import InputError
-
         raise InputError(f"solver: got {solver!r}, expected one of {sorted(BACKENDS)}")
     start = time.perf_counter()
     if problem.has_inequalities:
