@@ -1,0 +1,1 @@
+"""Closed-loop flight simulation: quadrotor model, outer-loop controllers, disturbances."""
