@@ -1,1 +1,20 @@
 """Closed-loop flight simulation: quadrotor model, outer-loop controllers, disturbances."""
+
+from skyquill.sim.contact import Board
+from skyquill.sim.controllers import CascadePID, OuterLoop, RPTAxisGains, RPTController
+from skyquill.sim.disturbances import Disturbances
+from skyquill.sim.result import Flight
+from skyquill.sim.simulate import simulate
+from skyquill.sim.vehicle import Quadrotor
+
+__all__ = [
+    "Board",
+    "CascadePID",
+    "Disturbances",
+    "Flight",
+    "OuterLoop",
+    "Quadrotor",
+    "RPTAxisGains",
+    "RPTController",
+    "simulate",
+]
