@@ -78,11 +78,17 @@ def simulate(
             f"rng: got {rng!r}, expected a numpy.random.Generator when gusts or noise are set"
         )
     generator = rng if rng is not None else np.random.default_rng(0)  # unused without noise
-    dt = 1.0 / rate
     t = sample_times(trajectory.duration, rate)
     p_ref, v_ref, a_ref, j_ref = _reference(trajectory, t)
     return _fly(
-        t, (p_ref, v_ref, a_ref, j_ref), vehicle, controller, dist, generator, board, conversion
+        t,
+        (p_ref, v_ref, a_ref, j_ref),
+        vehicle,
+        controller,
+        dist,
+        rng=generator,
+        board=board,
+        conversion=conversion,
     )
 
 
@@ -92,6 +98,7 @@ def _fly(
     vehicle: Quadrotor,
     controller: OuterLoop,
     dist: Disturbances,
+    *,
     rng: np.random.Generator,
     board: Board | None,
     conversion: Conversion,
