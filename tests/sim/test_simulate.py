@@ -3,13 +3,11 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import cache
 
 import numpy as np
 import pytest
 
 from skyquill.errors import InputError
-from skyquill.optimize.fit import FitOptions, fit_points
 from skyquill.sim import (
     Board,
     CascadePID,
@@ -41,16 +39,6 @@ class Polynomial3:
 
     def sample(self, rate: float):  # type: ignore[no-untyped-def]
         return sample(self, rate)
-
-
-@cache
-def writing_trajectory() -> SplineTrajectory:
-    """A 0.5 m figure-eight at 1 m height, <= 1 m/s: a feasible writing stroke."""
-    th = np.linspace(0.0, 2 * np.pi, 200)
-    pts = np.column_stack([0.25 * np.cos(th), 0.125 * np.sin(2 * th), np.ones(200)])
-    fit = fit_points(pts, None, FitOptions(vmax=1.0, amax=1.0, jmax=5.0))
-    assert fit.result.verification.max_speed <= 1.0
-    return fit.result.trajectory
 
 
 class Commanding:
@@ -126,44 +114,46 @@ def test_step_from_an_offset_settles() -> None:
 
 
 # ---------------------------------------------------------------- tracking
-def test_rpt_tracks_a_writing_trajectory_within_5_mm() -> None:
-    flight = simulate(writing_trajectory())
+def test_rpt_tracks_a_writing_trajectory_within_5_mm(writing: SplineTrajectory) -> None:
+    flight = simulate(writing)
     assert flight.rmse_m <= 5e-3
     assert flight.saturations == {"thrust_max": 0, "thrust_min": 0, "tilt": 0}
 
 
-def test_rpt_with_wind_and_gusts_is_reported_and_reproducible() -> None:
+def test_rpt_with_wind_and_gusts_is_reported_and_reproducible(writing: SplineTrajectory) -> None:
     dist = Disturbances(wind_mps=np.array([2.0, 0.0, 0.0]), gust_std_mps=1.0, position_noise_m=1e-3)
-    a = simulate(writing_trajectory(), disturbances=dist, rng=np.random.default_rng(3))
-    b = simulate(writing_trajectory(), disturbances=dist, rng=np.random.default_rng(3))
+    a = simulate(writing, disturbances=dist, rng=np.random.default_rng(3))
+    b = simulate(writing, disturbances=dist, rng=np.random.default_rng(3))
     assert np.array_equal(a.p, b.p)
     assert 5e-3 < a.rmse_m < 0.5  # degraded, still flying
     summary = a.summary()
     assert summary["rmse_m"] == a.rmse_m and summary["sim"] == "skyquill"
 
 
-def test_papers_rpt_law_as_printed_is_worse_than_the_compensated_one() -> None:
-    compensated = simulate(writing_trajectory()).rmse_m
-    printed = simulate(writing_trajectory(), controller=RPTController(lag_s=0.0, drag_per_mass=0.0))
+def test_papers_rpt_law_as_printed_is_worse_than_the_compensated_one(
+    writing: SplineTrajectory,
+) -> None:
+    compensated = simulate(writing).rmse_m
+    printed = simulate(writing, controller=RPTController(lag_s=0.0, drag_per_mass=0.0))
     assert printed.rmse_m > 3 * compensated
 
 
-def test_feed_forward_matters_for_pid() -> None:
+def test_feed_forward_matters_for_pid(writing: SplineTrajectory) -> None:
     """Paper 001 Fig. 9: without velocity feed-forward the cascade lags badly."""
-    with_ff = simulate(writing_trajectory(), controller=CascadePID(feed_forward=True))
-    without = simulate(writing_trajectory(), controller=CascadePID(feed_forward=False))
+    with_ff = simulate(writing, controller=CascadePID(feed_forward=True))
+    without = simulate(writing, controller=CascadePID(feed_forward=False))
     assert without.rmse_m > 5 * with_ff.rmse_m
 
 
-def test_latency_degrades_tracking() -> None:
-    base = simulate(writing_trajectory()).rmse_m
-    late = simulate(writing_trajectory(), disturbances=Disturbances(latency_s=0.05)).rmse_m
+def test_latency_degrades_tracking(writing: SplineTrajectory) -> None:
+    base = simulate(writing).rmse_m
+    late = simulate(writing, disturbances=Disturbances(latency_s=0.05)).rmse_m
     assert late > base
 
 
-def test_linear_conversion_sags_in_turns() -> None:
-    exact = simulate(writing_trajectory())
-    linear = simulate(writing_trajectory(), conversion="linear")
+def test_linear_conversion_sags_in_turns(writing: SplineTrajectory) -> None:
+    exact = simulate(writing)
+    linear = simulate(writing, conversion="linear")
     assert (
         np.abs(linear.p[:, 2] - linear.p_ref[:, 2]).max()
         > np.abs(exact.p[:, 2] - exact.p_ref[:, 2]).max()
@@ -179,8 +169,8 @@ def test_tilt_saturation_is_counted_not_hidden() -> None:
 
 
 # ---------------------------------------------------------------- board and ink
-def test_ink_follows_the_planned_tip_path() -> None:
-    traj = writing_trajectory()
+def test_ink_follows_the_planned_tip_path(writing: SplineTrajectory) -> None:
+    traj = writing
     vehicle = Quadrotor()
     # The tip hangs brush_length below the vehicle; put the board 2 mm above it.
     board = Board(height_m=1.0 - vehicle.brush_length_m + 0.002)
@@ -203,8 +193,8 @@ def test_ink_follows_the_planned_tip_path() -> None:
     assert flight.p[:, 2].mean() > free.p[:, 2].mean()
 
 
-def test_no_contact_no_ink() -> None:
-    flight = simulate(writing_trajectory(), board=Board(height_m=0.0))
+def test_no_contact_no_ink(writing: SplineTrajectory) -> None:
+    flight = simulate(writing, board=Board(height_m=0.0))
     assert flight.ink == ()
 
 
@@ -226,14 +216,14 @@ def test_bad_parameters_are_named(make: object, message: str) -> None:
         make()  # type: ignore[operator]
 
 
-def test_noise_without_rng_is_refused() -> None:
+def test_noise_without_rng_is_refused(writing: SplineTrajectory) -> None:
     with pytest.raises(InputError, match=r"rng: got None, expected a numpy\.random\.Generator"):
-        simulate(writing_trajectory(), disturbances=Disturbances(position_noise_m=1e-3))
+        simulate(writing, disturbances=Disturbances(position_noise_m=1e-3))
 
 
-def test_bad_rate_and_dimension() -> None:
+def test_bad_rate_and_dimension(writing: SplineTrajectory) -> None:
     with pytest.raises(InputError, match="rate_hz: got 0"):
-        simulate(writing_trajectory(), rate_hz=0.0)
+        simulate(writing, rate_hz=0.0)
     one_d = SplineTrajectory(np.zeros((6, 1)), 5, 1.0)
     with pytest.raises(InputError, match="trajectory: got 1 axes, expected 2 or 3"):
         simulate(one_d)
