@@ -26,7 +26,6 @@ import scipy.sparse as sp
 from skyquill.errors import InfeasibleError
 from skyquill.optimize.problem import (
     Corridor,
-    Interpolation,
     LineDeviation,
     PlaneDeviation,
     PointDeviation,
@@ -81,10 +80,12 @@ def assemble(problem: SmoothingProblem) -> Assembled:
     alpha = problem.alpha
     M, d = problem.n_ctrl, problem.dim
 
-    G_axis = sp.csr_array((M, M))
-    for order, sigma in problem.smoothness.items():
-        if sigma:
-            G_axis = G_axis + sigma * alpha ** (2 * order - 1) * basis.gram(order)
+    smooth = [
+        sigma * alpha ** (2 * order - 1) * basis.gram(order)
+        for order, sigma in problem.smoothness.items()
+        if sigma
+    ]
+    G_axis = sp.csr_array(sum(smooth[1:], smooth[0]) if smooth else sp.csr_array((M, M)))
     F = np.zeros((M, d))
     coupled: list[tuple[sp.csr_array, FloatArray]] = []
     for term in problem.deviations:
@@ -189,56 +190,44 @@ def _equalities(problem: SmoothingProblem) -> tuple[sp.csr_array, FloatArray]:
     """Boundary conditions (eq. 42) and interpolated points (eq. 13), per axis.
 
     Derivative rows are in ``s``: ``Gamma_n C = value / alpha^n`` (O(1) rows).
+    An interpolated point at ``t = 0`` or ``t = duration`` where the boundary
+    already fixes the position repeats that row exactly (both are ``e_0`` or
+    ``e_{M-1}``) and would make the KKT matrix singular: it is dropped if it
+    agrees, and a contradiction raises :class:`InfeasibleError`.
     """
     basis, alpha, M = problem.basis, problem.alpha, problem.n_ctrl
-    rows: list[sp.csr_array] = []
+    dense_rows: list[FloatArray] = []
     rhs: list[FloatArray] = []
+    fixed: dict[float, FloatArray] = {}
     for bc in problem.boundary:
         start_row, end_row = basis.end_rows(bc.order)
         to_s = alpha**-bc.order
-        if bc.start is not None:
-            rows.append(start_row)
-            rhs.append(to_s * bc.start[None, :])
-        if bc.end is not None:
-            rows.append(end_row)
-            rhs.append(to_s * bc.end[None, :])
+        for row, value, s_end in ((start_row, bc.start, 0.0), (end_row, bc.end, basis.n_spans)):
+            if value is not None:
+                dense_rows.append(row)
+                rhs.append(to_s * value[None, :])
+                if bc.order == 0:
+                    fixed[float(s_end)] = value
+    blocks = [sp.csr_array(np.array(dense_rows))] if dense_rows else []
     for term in problem.interpolation:
-        if isinstance(term, Interpolation):
-            rows.append(basis.design_matrix(_params(problem, term.times)))
-            rhs.append(term.points)
-    if not rows:
+        s = _params(problem, term.times)
+        keep = np.ones(s.size, dtype=bool)
+        for s_end, value in fixed.items():
+            repeat = s == s_end
+            if np.any(repeat) and not np.allclose(term.points[repeat], value, rtol=1e-12,
+                                                   atol=1e-12):
+                raise InfeasibleError(
+                    "infeasible: the boundary conditions and interpolated points contradict "
+                    f"each other: the position at s = {s_end:g} is fixed to {value.tolist()} "
+                    f"and to {term.points[repeat][0].tolist()}",
+                    ("equalities",),
+                )
+            keep &= ~repeat
+        blocks.append(basis.design_matrix(s[keep]))
+        rhs.append(term.points[keep])
+    if not blocks:
         return sp.csr_array((0, M)), np.zeros((0, problem.dim))
-    return _drop_duplicate_rows(sp.csr_array(sp.vstack(rows)), np.vstack(rhs))
-
-
-def _drop_duplicate_rows(E: sp.csr_array, e: FloatArray) -> tuple[sp.csr_array, FloatArray]:
-    """Remove equality rows that repeat an earlier row exactly.
-
-    The common case: interpolating every waypoint of a rest-to-rest plan
-    repeats the boundary position rows (``e_0`` and ``e_{M-1}``), which would
-    make the KKT matrix singular. A repeat with a different right-hand side
-    is a contradiction and raises :class:`InfeasibleError`.
-    """
-    E = sp.csr_array(E, copy=True)
-    E.eliminate_zeros()  # scipy's design matrices store the k+1 entries even when 0
-    seen: dict[tuple[bytes, bytes], int] = {}
-    keep = []
-    for i in range(E.shape[0]):
-        lo, hi = E.indptr[i], E.indptr[i + 1]
-        key = (E.indices[lo:hi].tobytes(), E.data[lo:hi].tobytes())
-        if key not in seen:
-            seen[key] = i
-            keep.append(i)
-        elif not np.allclose(e[i], e[seen[key]], rtol=1e-12, atol=1e-12):
-            raise InfeasibleError(
-                "infeasible: the boundary conditions and interpolated points contradict each "
-                f"other: the same quantity is fixed to {e[seen[key]].tolist()} and "
-                f"{e[i].tolist()}",
-                ("equalities",),
-            )
-    if len(keep) == E.shape[0]:
-        return E, e
-    return sp.csr_array(E[keep]), e[keep]
+    return sp.csr_array(sp.vstack(blocks)), np.vstack(rhs)
 
 
 def _inequalities(

@@ -190,19 +190,20 @@ class ClampedUniformBasis:
             maps.append(sp.csr_array(step @ maps[-1]))
         return tuple(maps)
 
-    def end_rows(self, order: int) -> tuple[sp.csr_array, sp.csr_array]:
-        """First and last rows of :meth:`derivative_map`, each (1, M): the ``order``-th
-        ``s``-derivative at ``s = 0`` and ``s = L`` (paper 003 eq. 41). Cached.
+    def end_rows(self, order: int) -> tuple[FloatArray, FloatArray]:
+        """First and last rows of :meth:`derivative_map`, dense, each (M,): the
+        ``order``-th ``s``-derivative at ``s = 0`` and ``s = L`` (paper 003 eq. 41). Cached.
         """
         self._check_order(order)
         return self._end_rows[order]
 
     @cached_property
-    def _end_rows(self) -> tuple[tuple[sp.csr_array, sp.csr_array], ...]:
+    def _end_rows(self) -> tuple[tuple[FloatArray, FloatArray], ...]:
         rows = []
         for order in range(self.degree + 1):
             dense = self.derivative_map(order)[[0, self.n_ctrl - order - 1], :].toarray()
-            rows.append((sp.csr_array(dense[:1]), sp.csr_array(dense[1:])))
+            dense.setflags(write=False)
+            rows.append((dense[0], dense[1]))
         return tuple(rows)
 
     def gram(self, order: int) -> sp.csr_array:
