@@ -214,8 +214,9 @@ def _equalities(problem: SmoothingProblem) -> tuple[sp.csr_array, FloatArray]:
         keep = np.ones(s.size, dtype=bool)
         for s_end, value in fixed.items():
             repeat = s == s_end
-            if np.any(repeat) and not np.allclose(term.points[repeat], value, rtol=1e-12,
-                                                   atol=1e-12):
+            if np.any(repeat) and not np.allclose(
+                term.points[repeat], value, rtol=1e-12, atol=1e-12
+            ):
                 raise InfeasibleError(
                     "infeasible: the boundary conditions and interpolated points contradict "
                     f"each other: the position at s = {s_end:g} is fixed to {value.tolist()} "

@@ -1,0 +1,328 @@
+"""Read ``trajectory.csv`` back into a trajectory that can be flown; write ``flight.csv``.
+
+``trajectory.csv`` is what every planning command writes
+(:data:`skyquill.io.points.TRAJECTORY_COLUMNS`): ``t,x,y,z,vx,vy,vz,ax,ay,az``
+and optionally ``jx,jy,jz``, SI units, z-up world frame, one row per sample.
+:func:`read_trajectory_csv` turns those samples into a
+:class:`SampledTrajectory` that a simulator can fly; :func:`write_flight_csv`
+writes the time series of a :class:`~skyquill.sim.Flight`.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+from dataclasses import dataclass
+from functools import cached_property
+from pathlib import Path
+
+import numpy as np
+from scipy.interpolate import BSpline, CubicHermiteSpline, make_interp_spline
+
+from skyquill.errors import InputError
+from skyquill.sim.result import Flight
+from skyquill.trajectory import Samples, sample
+from skyquill.validation import FloatArray, as_array, as_int
+
+#: Columns :func:`read_trajectory_csv` needs (jerk ``jx,jy,jz`` is optional).
+REQUIRED_COLUMNS = ("t", "x", "y", "z", "vx", "vy", "vz", "ax", "ay", "az")
+JERK_COLUMNS = ("jx", "jy", "jz")
+
+#: ``flight.csv``: reference and flown state, commands; SI units, z-up world frame.
+FLIGHT_COLUMNS = (
+    "t",
+    "x_ref",
+    "y_ref",
+    "z_ref",
+    "x",
+    "y",
+    "z",
+    "vx_ref",
+    "vy_ref",
+    "vz_ref",
+    "vx",
+    "vy",
+    "vz",
+    "ax_cmd",
+    "ay_cmd",
+    "az_cmd",
+    "thrust",
+    "tilt",
+)
+
+#: Largest magnitude accepted in any column (m, m/s, ...): beyond it a value is
+#: almost surely in the wrong unit, and spline arithmetic would overflow.
+MAX_VALUE = 1e6
+#: Smallest accepted time step, s: finer sampling than 1 MHz is not a trajectory
+#: anyone planned, and the Hermite slopes ``dp / dt`` would overflow.
+MIN_STEP_S = 1e-6
+
+
+@dataclass(frozen=True)
+class SampledTrajectory:
+    """A trajectory known from samples, implementing the Trajectory protocol.
+
+    Interpolation between samples (time ``t`` from 0 to :attr:`duration`):
+
+    * position: cubic Hermite through ``(t_i, p_i, v_i)``
+      (:class:`scipy.interpolate.CubicHermiteSpline`): exact at the samples
+      and C1;
+    * velocity: cubic Hermite through ``(t_i, v_i, a_i)``, exact and C1. It
+      is therefore *not* exactly the derivative of the position interpolant
+      (which is only a C0 quadratic); each order is the best interpolant of
+      the samples of that order;
+    * acceleration: linear between the ``a_i`` (C0);
+    * jerk: linear between the ``j_i`` when jerk samples are given; otherwise
+      the derivative of the linear acceleration, i.e. the constant
+      ``(a_{i+1} - a_i) / (t_{i+1} - t_i)`` on each interval (right-continuous;
+      the last interval's value at ``t = duration``);
+    * order 4 and up: derivatives of the jerk interpolant (as
+      :class:`~skyquill.trajectory.SplineTrajectory` returns 0 above its
+      degree): with jerk samples, snap is the piecewise-constant slope of the
+      linear jerk and order 5 and up is 0; without them, 0 from order 4. The
+      samples carry no information about these orders -- RotorPy asks for
+      snap, and gets this.
+
+    Parameters
+    ----------
+    t
+        Sample times, shape (N,), s, N >= 2, strictly increasing (steps of at
+        least 1 µs). They may start anywhere: the trajectory's own time is
+        ``t - t[0]``, and :attr:`t0` keeps ``t[0]``.
+    p, v, a
+        Position (m), velocity (m/s) and acceleration (m/s^2), shape (N, 3),
+        z-up world frame.
+    j
+        Jerk (m/s^3), shape (N, 3), or ``None``.
+    """
+
+    t: FloatArray
+    p: FloatArray
+    v: FloatArray
+    a: FloatArray
+    j: FloatArray | None = None
+
+    def __post_init__(self) -> None:
+        t = as_array("t", self.t, ndim=1, max_abs=1e7)
+        if t.size < 2:
+            raise InputError(f"t: got {t.size} sample(s), expected at least 2")
+        steps = np.diff(t)
+        if np.any(steps < MIN_STEP_S):
+            i = int(np.argmax(steps < MIN_STEP_S))
+            raise InputError(
+                f"t: got t[{i}] = {t[i]:.9g} followed by {t[i + 1]:.9g}, expected strictly "
+                f"increasing times at least {MIN_STEP_S:g} s apart"
+            )
+        object.__setattr__(self, "t", t)
+        names = ("p", "v", "a") + (("j",) if self.j is not None else ())
+        for name in names:
+            arr = as_array(name, getattr(self, name), shape=(t.size, 3), max_abs=MAX_VALUE)
+            arr.setflags(write=False)
+            object.__setattr__(self, name, arr)
+        t.setflags(write=False)
+
+    @property
+    def t0(self) -> float:
+        """Time of the first sample in the source, s (the trajectory's time 0)."""
+        return float(self.t[0])
+
+    @property
+    def duration(self) -> float:
+        """Length in seconds; the trajectory is defined on ``[0, duration]``."""
+        return float(self.t[-1] - self.t[0])
+
+    @property
+    def dim(self) -> int:
+        """Number of axes: always 3 (x, y, z)."""
+        return 3
+
+    @cached_property
+    def _interpolants(self) -> tuple[CubicHermiteSpline | BSpline, ...]:
+        tau = self.t - self.t[0]
+        acc = make_interp_spline(tau, self.a, k=1)
+        jerk = make_interp_spline(tau, self.j, k=1) if self.j is not None else acc.derivative()
+        chain: list[CubicHermiteSpline | BSpline] = [
+            CubicHermiteSpline(tau, self.p, self.v),
+            CubicHermiteSpline(tau, self.v, self.a),
+            acc,
+            jerk,
+        ]
+        if jerk.k > 0:
+            chain.append(jerk.derivative())  # snap, piecewise constant
+        return tuple(chain)
+
+    def evaluate(self, t: FloatArray, order: int = 0) -> FloatArray:
+        """The ``order``-th time derivative at times ``t``.
+
+        Parameters
+        ----------
+        t
+            Times, shape (N,), each in ``[0, duration]`` s (trajectory time,
+            i.e. source time minus :attr:`t0`).
+        order
+            0 (position, m) to 3 (jerk, m/s^3); higher orders are the
+            derivatives of the jerk interpolant (see the class docstring).
+
+        Returns
+        -------
+        numpy.ndarray, shape (N, 3)
+        """
+        times = as_array("t", t, ndim=1)
+        as_int("order", order, low=0)
+        tol = 1e-9 * max(1.0, self.duration)
+        if times.size and (times.min() < -tol or times.max() > self.duration + tol):
+            raise InputError(
+                f"t: got times in [{times.min():g}, {times.max():g}] s, expected within "
+                f"[0, {self.duration:g}] s"
+            )
+        times = np.clip(times, 0.0, self.duration)  # only round-off reaches here
+        if order >= len(self._interpolants):
+            return np.zeros((times.size, 3))
+        values = self._interpolants[order](times)
+        return np.asarray(values, dtype=float).reshape(times.size, 3)
+
+    def sample(self, rate: float) -> Samples:
+        """Samples at ``rate`` Hz (position to jerk), from 0 to ``duration`` inclusive."""
+        return sample(self, rate)
+
+
+def read_trajectory_csv(path: str | Path) -> SampledTrajectory:
+    """Read a ``trajectory.csv`` (as written by ``skyquill fit``) into a trajectory.
+
+    Parameters
+    ----------
+    path
+        CSV file with a header naming at least ``t,x,y,z,vx,vy,vz,ax,ay,az``
+        (any order, case and surrounding spaces ignored; other columns are
+        ignored) and optionally all three of ``jx,jy,jz``. Units: s, m, m/s,
+        m/s^2, m/s^3. Blank lines are skipped.
+
+    Returns
+    -------
+    SampledTrajectory
+        Time shifted so that the first row is at 0 (see :attr:`SampledTrajectory.t0`).
+
+    Raises
+    ------
+    InputError
+        Naming the file, and the column or line, when the file is missing or
+        unreadable, a required column is missing, there are fewer than 2 rows,
+        a cell is not a finite number of magnitude at most 1e6, or the times
+        are not strictly increasing.
+    """
+    file = Path(path)
+    if not file.is_file():
+        raise InputError(f"trajectory file: got {str(file)!r}, expected an existing CSV file")
+    name = file.name
+    header, rows = _read_rows(file)
+    _check_header(name, header)
+    has_jerk = any(c in header for c in JERK_COLUMNS)
+    if has_jerk and not all(c in header for c in JERK_COLUMNS):
+        present = [c for c in JERK_COLUMNS if c in header]
+        raise InputError(
+            f"{name}: got jerk column(s) {','.join(present)}, expected all of jx,jy,jz or none"
+        )
+    columns = REQUIRED_COLUMNS + (JERK_COLUMNS if has_jerk else ())
+    index = [header.index(c) for c in columns]
+    data = np.empty((len(rows), len(columns)))
+    for r, (line, row) in enumerate(rows):
+        for c, (column, i) in enumerate(zip(columns, index, strict=True)):
+            data[r, c] = _cell(name, line, column, row, i)
+    if data.shape[0] < 2:
+        raise InputError(f"{name}: got {data.shape[0]} data row(s), expected at least 2")
+    t = data[:, 0]
+    steps = np.diff(t)
+    if np.any(steps < MIN_STEP_S):
+        k = int(np.argmax(steps < MIN_STEP_S))
+        raise InputError(
+            f"{name} line {rows[k + 1][0]}, column t: got {t[k + 1]:.9g} after {t[k]:.9g}, "
+            f"expected strictly increasing times (at least {MIN_STEP_S:g} s apart)"
+        )
+    return SampledTrajectory(
+        t=t,
+        p=data[:, 1:4],
+        v=data[:, 4:7],
+        a=data[:, 7:10],
+        j=data[:, 10:13] if has_jerk else None,
+    )
+
+
+def _read_rows(file: Path) -> tuple[list[str], list[tuple[int, list[str]]]]:
+    """Header (stripped, lower case) and the non-blank rows with their line numbers."""
+    try:
+        with file.open(newline="", encoding="utf-8") as handle:
+            reader = csv.reader(handle)
+            header = [h.strip().lower() for h in next(reader, [])]
+            rows = [(reader.line_num, row) for row in reader if row and any(c.strip() for c in row)]
+    except UnicodeDecodeError as exc:
+        raise InputError(
+            f"{file.name}: got bytes that are not UTF-8 (byte {exc.start}), expected a text CSV"
+        ) from None
+    except csv.Error as exc:
+        raise InputError(f"{file.name}: got malformed CSV ({exc}), expected a text CSV") from None
+    return header, rows
+
+
+def _check_header(name: str, header: list[str]) -> None:
+    missing = [c for c in REQUIRED_COLUMNS if c not in header]
+    if missing:
+        raise InputError(
+            f"{name}: got columns {header}, expected at least {','.join(REQUIRED_COLUMNS)} "
+            f"(optionally jx,jy,jz); missing {','.join(missing)}"
+        )
+    repeated = sorted(
+        {c for c in header if c in REQUIRED_COLUMNS + JERK_COLUMNS and header.count(c) > 1}
+    )
+    if repeated:
+        raise InputError(
+            f"{name}: got column(s) {','.join(repeated)} more than once, expected each once"
+        )
+
+
+def _cell(name: str, line: int, column: str, row: list[str], i: int) -> float:
+    text = row[i].strip() if i < len(row) else ""
+    try:
+        value = float(text)
+    except ValueError:
+        raise InputError(
+            f"{name} line {line}, column {column}: got {text!r}, expected a number"
+        ) from None
+    if not math.isfinite(value):
+        raise InputError(
+            f"{name} line {line}, column {column}: got {text!r}, expected a finite number"
+        )
+    limit = 1e7 if column == "t" else MAX_VALUE
+    if abs(value) > limit:
+        raise InputError(
+            f"{name} line {line}, column {column}: got {text!r}, expected a magnitude of at "
+            f"most {limit:g} (SI units)"
+        )
+    return value
+
+
+def flight_table(flight: Flight) -> FloatArray:
+    """The ``flight.csv`` table, shape (N, 18), columns :data:`FLIGHT_COLUMNS`."""
+    return np.column_stack(
+        [
+            flight.t,
+            flight.p_ref,
+            flight.p,
+            flight.v_ref,
+            flight.v,
+            flight.a_cmd,
+            flight.thrust,
+            flight.tilt,
+        ]
+    )
+
+
+def write_flight_csv(path: str | Path, flight: Flight) -> int:
+    """Write ``flight.csv`` (columns :data:`FLIGHT_COLUMNS`, SI units); returns the row count.
+
+    ``thrust`` is the commanded collective thrust in N, ``tilt`` the commanded
+    tilt from vertical in rad, ``a*_cmd`` the outer loop's acceleration command
+    (gravity excluded), m/s^2.
+    """
+    table = flight_table(flight)
+    np.savetxt(path, table, delimiter=",", header=",".join(FLIGHT_COLUMNS), comments="", fmt="%.9g")
+    return int(table.shape[0])
