@@ -82,18 +82,3 @@ def test_user_errors_exit_2_with_one_line(tmp_path: Path, args: list[str], messa
     assert result.exit_code == 2
     assert message in " ".join(result.output.split())
     assert "Traceback" not in result.output
-
-
-@pytest.mark.parametrize(
-    ("study", "files"),
-    [
-        ("segments", {"fig7.png", "results.json", "summary.json"}),
-        ("corridor", {"fig10.png", "corridor.png", "results.json", "summary.json"}),
-    ],
-)
-def test_reproduce_commands_write_their_files(tmp_path: Path, study: str, files: set[str]) -> None:
-    out = tmp_path / study
-    result = runner.invoke(app, ["reproduce", study, "--out", str(out)])
-    assert result.exit_code == 0, result.output
-    assert files <= {p.name for p in out.iterdir()}
-    json.loads((out / "summary.json").read_text())

@@ -1,0 +1,138 @@
+"""``skyquill fit`` and ``skyquill demo``: fit points, write trajectory.csv, plot, summary."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated, Any
+
+import typer
+
+from skyquill.cli.main import EXAMPLES, OutDir, app, console, user_errors
+from skyquill.errors import InputError
+from skyquill.io.points import read_points_csv, write_json, write_trajectory_csv
+from skyquill.optimize.fit import FitOptions, PointFit, fit_points
+from skyquill.validation import FloatArray
+
+
+def fit_summary(fit: PointFit, rows: int, rate: float) -> dict[str, Any]:
+    """The ``summary.json`` of a fit (SI units)."""
+    r, check = fit.result, fit.result.verification
+    return {
+        "duration_s": r.trajectory.duration,
+        "solve_time_s": r.solve_time_s,
+        "cost": r.cost,
+        "cost_terms": r.cost_terms,
+        "max_speed": check.max_speed,
+        "max_acc": list(check.max_acc),
+        "max_jerk": list(check.max_jerk),
+        "max_excess": check.max_excess,
+        "rms_deviation_m": fit.rms_deviation_m,
+        "max_deviation_m": fit.max_deviation_m,
+        "method": r.method,
+        "solver": r.solver,
+        "time_scale": fit.time_scale,
+        "degree": r.trajectory.degree,
+        "n_control_points": int(r.trajectory.control_points.shape[0]),
+        "n_points": int(fit.points.shape[0]),
+        "rate_hz": rate,
+        "trajectory_rows": rows,
+        "limits": [
+            {
+                "label": c.label,
+                "max_value": c.max_value,
+                "relative_excess": c.relative_excess,
+                "guaranteed": c.guaranteed,
+            }
+            for c in check.checks
+        ],
+        "dense_samples": check.n_samples,
+    }
+
+
+def run_fit(
+    points: FloatArray,
+    times: FloatArray | None,
+    options: FitOptions,
+    out: Path,
+    rate: float,
+    title: str,
+) -> dict[str, Any]:
+    """Fit, then write ``trajectory.csv``, ``plot.png`` and ``summary.json`` into ``out``."""
+    from skyquill.viz.fit_plot import plot_fit
+
+    out.mkdir(parents=True, exist_ok=True)
+    with console.status(f"fitting {points.shape[0]} points ({title})"):
+        fit = fit_points(points, times, options)
+    rows = write_trajectory_csv(out / "trajectory.csv", fit.result.trajectory, rate)
+    with console.status("plotting"):
+        plot_fit(fit, out / "plot.png", title)
+    summary = fit_summary(fit, rows, rate)
+    write_json(out / "summary.json", summary)
+    console.print(
+        f"[green]done[/] {out}: duration {summary['duration_s']:.2f} s, solve "
+        f"{1e3 * summary['solve_time_s']:.1f} ms, max excess {summary['max_excess']:.1e}, "
+        f"rms deviation {1e3 * summary['rms_deviation_m']:.2f} mm",
+        highlight=False,
+    )
+    return summary
+
+
+def _rate(rate: float) -> float:
+    if not rate > 0:
+        raise InputError(f"--rate: got {rate:g}, expected a positive number of Hz")
+    return rate
+
+
+@app.command()
+def fit(
+    points_csv: Annotated[Path, typer.Argument(help="CSV with columns x,y[,z][,t] in m and s.")],
+    out: OutDir,
+    vmax: Annotated[
+        float, typer.Option(help="Speed limit per axis (or norm if coupled), m/s.")
+    ] = 1.0,
+    amax: Annotated[float, typer.Option(help="Acceleration limit, m/s^2.")] = 2.0,
+    jmax: Annotated[float, typer.Option(help="Jerk limit, m/s^3.")] = 10.0,
+    coupled: Annotated[
+        int | None,
+        typer.Option(
+            help="Couple the horizontal axes: sides of the polygon inscribed in the norm limit."
+        ),
+    ] = None,
+    degree: Annotated[int, typer.Option(help="Spline degree (3 to 7).")] = 5,
+    weight: Annotated[float, typer.Option(help="Weight of the point deviation.")] = 1e4,
+    rate: Annotated[float, typer.Option(help="Sample rate of trajectory.csv, Hz.")] = 100.0,
+    knot_interval: Annotated[float, typer.Option(help="Seconds per knot span.")] = 0.1,
+    hull: Annotated[str, typer.Option(help="Limit hull: bspline (papers') or bezier.")] = "bspline",
+    solver: Annotated[str, typer.Option(help="QP backend: piqp, clarabel or osqp.")] = "piqp",
+) -> None:
+    """Fit a smooth trajectory to POINTS_CSV that starts and ends at rest."""
+    with user_errors():
+        options = FitOptions(
+            vmax=vmax,
+            amax=amax,
+            jmax=jmax,
+            coupled=coupled,
+            degree=degree,
+            weight=weight,
+            knot_interval=knot_interval,
+            hull=_hull(hull),
+            solver=solver,
+        )
+        points, times = read_points_csv(points_csv)
+        run_fit(points, times, options, out, _rate(rate), points_csv.stem)
+
+
+def _hull(name: str) -> Any:
+    if name not in ("bspline", "bezier"):
+        raise InputError(f"--hull: got {name!r}, expected 'bspline' or 'bezier'")
+    return name
+
+
+@app.command()
+def demo(out: OutDir = Path("out/demo")) -> None:
+    """Fit the bundled hand-drawn spiral (examples/spiral.csv) and plot it."""
+    with user_errors():
+        points, _ = read_points_csv(EXAMPLES / "spiral.csv")
+        # Time comes from the path allocation, not the tablet's clock: the hand
+        # does not start and end at rest, the drone must.
+        run_fit(points, None, FitOptions(), out, 100.0, "hand-drawn spiral")

@@ -1,0 +1,177 @@
+"""``skyquill fly``: fly a trajectory.csv in closed loop, write flight.csv, plot, summary."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import TYPE_CHECKING, Annotated, Literal
+
+import typer
+
+from skyquill.cli.fit_cmd import _rate
+from skyquill.cli.main import OutDir, app, console, user_errors
+from skyquill.errors import InputError
+from skyquill.io.points import write_json
+from skyquill.validation import FloatArray
+
+if TYPE_CHECKING:  # the fly command imports the simulator lazily
+    from skyquill.io.trajectory_csv import SampledTrajectory
+    from skyquill.sim import Disturbances, Flight, OuterLoop
+
+FLY_CONTROLLERS = ("rpt", "pid-ff", "pid", "se3")
+FLY_SIMS = ("skyquill", "rotorpy")
+#: Largest wind or gust accepted, m/s (a hurricane is ~70 m/s; more is a unit mistake).
+MAX_WIND_MPS = 100.0
+
+
+@app.command()
+def fly(
+    trajectory_csv: Annotated[
+        Path,
+        typer.Argument(
+            help="trajectory.csv as `fit` writes it: t,x,y,z,vx,vy,vz,ax,ay,az[,jx,jy,jz], SI."
+        ),
+    ],
+    out: OutDir,
+    controller: Annotated[
+        str, typer.Option(help="Outer loop: rpt, pid-ff, pid (or se3 with --sim rotorpy).")
+    ] = "rpt",
+    sim: Annotated[str, typer.Option(help="Simulator: skyquill or rotorpy.")] = "skyquill",
+    wind: Annotated[str, typer.Option(help="Constant wind x,y,z in m/s, e.g. 2,0,0.")] = "0,0,0",
+    gust: Annotated[float, typer.Option(help="Gust standard deviation per axis, m/s.")] = 0.0,
+    noise: Annotated[
+        float, typer.Option(help="Position measurement noise, standard deviation per axis, m.")
+    ] = 0.0,
+    seed: Annotated[int, typer.Option(help="Seed of the random generator (gusts, noise).")] = 0,
+    rate: Annotated[float, typer.Option(help="Control and integration rate, Hz.")] = 500.0,
+) -> None:
+    """Fly TRAJECTORY_CSV in closed loop; write summary.json, flight.csv and plot.png."""
+    import numpy as np
+
+    from skyquill.errors import SolverError
+    from skyquill.io.trajectory_csv import read_trajectory_csv, write_flight_csv
+    from skyquill.sim import Disturbances
+    from skyquill.viz.flight_plot import plot_flight
+
+    with user_errors():
+        if sim not in FLY_SIMS:
+            raise InputError(f"--sim: got {sim!r}, expected 'skyquill' or 'rotorpy'")
+        loop = _fly_controller(controller, sim)
+        wind_mps = _vector3("--wind", wind, "m/s")
+        if np.abs(wind_mps).max() > MAX_WIND_MPS:
+            raise InputError(
+                f"--wind: got {wind!r}, expected components of at most {MAX_WIND_MPS:g} m/s"
+            )
+        for option, value, most in (("--gust", gust, MAX_WIND_MPS), ("--noise", noise, 1.0)):
+            if not 0.0 <= value <= most:
+                raise InputError(f"{option}: got {value:g}, expected a number from 0 to {most:g}")
+        rate = _rate(rate)
+        trajectory = read_trajectory_csv(trajectory_csv)
+        disturbances = Disturbances(wind_mps=wind_mps, gust_std_mps=gust, position_noise_m=noise)
+        with console.status(
+            f"flying {trajectory.duration:.1f} s of {trajectory_csv.name} with "
+            f"{controller} on {sim} at {rate:g} Hz"
+        ):
+            flight = _fly_once(trajectory, loop, sim, disturbances, seed, rate)
+        if not (np.all(np.isfinite(flight.p)) and np.all(np.isfinite(flight.v))):
+            raise SolverError(
+                f"{sim}: the flight diverged (non-finite state), nothing written; "
+                "lower the disturbances"
+            )
+        out.mkdir(parents=True, exist_ok=True)
+        rows = write_flight_csv(out / "flight.csv", flight)
+        with console.status("plotting"):
+            plot_flight(flight, out / "plot.png", trajectory_csv.name)
+        summary = flight.summary() | {
+            "realtime_factor": flight.summary()["sim_time_s"] / max(flight.wall_time_s, 1e-12),
+            "trajectory": str(trajectory_csv),
+            "duration_s": trajectory.duration,
+            "rate_hz": rate,
+            "wind_mps": [float(w) for w in wind_mps],
+            "gust_std_mps": gust,
+            "position_noise_m": noise,
+            "seed": seed,
+            "flight_rows": rows,
+        }
+        write_json(out / "summary.json", summary)
+    console.print(
+        f"[green]done[/] {out}: RMSE {1e3 * summary['rmse_m']:.2f} mm, max "
+        f"{1e3 * summary['max_error_m']:.2f} mm, {summary['realtime_factor']:.0f}x real time",
+        highlight=False,
+    )
+
+
+def _fly_controller(name: str, sim: str) -> OuterLoop | Literal["se3"]:
+    """The outer loop named on the command line, or ``"se3"`` (RotorPy's own)."""
+    from skyquill.sim import CascadePID, RPTController
+
+    if name not in FLY_CONTROLLERS:
+        raise InputError(
+            f"--controller: got {name!r}, expected one of rpt, pid-ff, pid (se3 with --sim rotorpy)"
+        )
+    if name == "se3":
+        if sim != "rotorpy":
+            raise InputError(
+                "--controller: got 'se3', expected rpt, pid-ff or pid with --sim "
+                f"{sim} (se3 is RotorPy's controller: use --sim rotorpy)"
+            )
+        return "se3"
+    return RPTController() if name == "rpt" else CascadePID(feed_forward=name == "pid-ff")
+
+
+def _fly_once(
+    trajectory: SampledTrajectory,
+    loop: OuterLoop | Literal["se3"],
+    sim: str,
+    disturbances: Disturbances,
+    seed: int,
+    rate: float,
+) -> Flight:
+    """One flight on the chosen simulator (RotorPy imported only when asked for)."""
+    import numpy as np
+
+    from skyquill.sim import simulate
+
+    if sim == "skyquill":
+        if isinstance(loop, str):  # _fly_controller refuses se3 here; this narrows the type
+            raise InputError("--controller: got 'se3', expected rpt, pid-ff or pid")
+        rng = np.random.default_rng(seed)
+        return simulate(
+            trajectory, controller=loop, disturbances=disturbances, rng=rng, rate_hz=rate
+        )
+    quiet = (
+        not np.any(disturbances.wind_mps)
+        and disturbances.gust_std_mps == 0.0
+        and disturbances.position_noise_m == 0.0
+    )
+    if not quiet:
+        raise InputError(
+            "--sim rotorpy: got --wind, --gust or --noise, expected none of them (the RotorPy "
+            "adapter flies without disturbances)"
+        )
+    try:
+        from skyquill.sim.rotorpy_adapter import fly_rotorpy
+    except ImportError as exc:
+        raise InputError(f"--sim rotorpy: RotorPy adapter unavailable ({exc})") from None
+    try:
+        return fly_rotorpy(trajectory, loop, rate_hz=rate)
+    except ImportError as exc:
+        raise InputError(f"--sim rotorpy: {exc}") from None
+
+
+def _vector3(option: str, text: str, unit: str) -> FloatArray:
+    """Parse ``"x,y,z"`` into a (3,) float array; InputError naming ``option`` otherwise."""
+    import math
+
+    import numpy as np
+
+    parts = [p.strip() for p in text.split(",")]
+    try:
+        values = [float(p) for p in parts]
+    except ValueError:
+        values = []
+    if len(values) != 3 or not all(math.isfinite(v) for v in values):
+        raise InputError(
+            f"{option}: got {text!r}, expected three comma-separated finite numbers in {unit}, "
+            "e.g. 2,0,0"
+        )
+    return np.array(values)
