@@ -82,3 +82,44 @@ def test_user_errors_exit_2_with_one_line(tmp_path: Path, args: list[str], messa
     assert result.exit_code == 2
     assert message in " ".join(result.output.split())
     assert "Traceback" not in result.output
+
+
+def test_timing_choices(tmp_path: Path) -> None:
+    """Tablet clock, re-timed along the path, or rest at every waypoint."""
+    spiral = str(EXAMPLES / "spiral.csv")
+    given = runner.invoke(app, ["fit", spiral, "--out", str(tmp_path / "g")])
+    path = runner.invoke(app, ["fit", spiral, "--timing", "path", "--out", str(tmp_path / "p")])
+    assert given.exit_code == 0 and path.exit_code == 0
+    g = json.loads((tmp_path / "g" / "summary.json").read_text())
+    p = json.loads((tmp_path / "p" / "summary.json").read_text())
+    # The hand does not start at rest; re-timed, the fit follows the ink closely.
+    assert p["rms_deviation_m"] < 0.005 < g["rms_deviation_m"]
+    seg = runner.invoke(
+        app,
+        [
+            "fit",
+            str(EXAMPLES / "segments.csv"),
+            "--timing",
+            "segments",
+            "--out",
+            str(tmp_path / "s"),
+        ],
+    )
+    assert seg.exit_code == 0
+    s = json.loads((tmp_path / "s" / "summary.json").read_text())
+    assert s["max_deviation_m"] < 1e-3
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["--timing", "given"], "segments.csv has no t column"),
+        (["--timing", "clock"], "--timing: got 'clock', expected given, path or segments"),
+    ],
+)
+def test_bad_timing(tmp_path: Path, args: list[str], message: str) -> None:
+    result = runner.invoke(
+        app, ["fit", str(EXAMPLES / "segments.csv"), *args, "--out", str(tmp_path / "o")]
+    )
+    assert result.exit_code == 2
+    assert message in " ".join(result.output.split())

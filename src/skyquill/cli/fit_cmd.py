@@ -104,6 +104,14 @@ def fit(
     knot_interval: Annotated[float, typer.Option(help="Seconds per knot span.")] = 0.1,
     hull: Annotated[str, typer.Option(help="Limit hull: bspline (papers') or bezier.")] = "bspline",
     solver: Annotated[str, typer.Option(help="QP backend: piqp, clarabel or osqp.")] = "piqp",
+    timing: Annotated[
+        str | None,
+        typer.Option(
+            help="given (the CSV's t column), path (along the path, slowing in turns) or "
+            "segments (rest to rest at every point). Default: given if there is a t column, "
+            "else path."
+        ),
+    ] = None,
 ) -> None:
     """Fit a smooth trajectory to POINTS_CSV that starts and ends at rest."""
     with user_errors():
@@ -117,8 +125,15 @@ def fit(
             knot_interval=knot_interval,
             hull=_hull(hull),
             solver=solver,
+            timing="segments" if timing == "segments" else "path",
         )
         points, times = read_points_csv(points_csv)
+        if timing not in (None, "given", "path", "segments"):
+            raise InputError(f"--timing: got {timing!r}, expected given, path or segments")
+        if timing == "given" and times is None:
+            raise InputError(f"--timing: got 'given', but {points_csv.name} has no t column")
+        if timing in ("path", "segments"):
+            times = None
         run_fit(points, times, options, out, _rate(rate), points_csv.stem)
 
 

@@ -1,6 +1,8 @@
 """Fit a smooth, limit-respecting trajectory to sampled points (``skyquill fit``).
 
-The pipeline: time the points (given, or :func:`allocate_path_times`),
+The pipeline: time the points (given; or along the path,
+:func:`allocate_path_times`; or rest to rest at every point, the paper's
+:func:`allocate_segment_times` for waypoint plans),
 minimum-jerk smoothing with point deviation (paper 000 §5.2-5.3, paper 003
 §3.3.1), rest at both ends, the vehicle's limits through the convex hull. If
 the limits cannot be met in the time given (jerk is not part of the
@@ -12,6 +14,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Literal
 
 import numpy as np
 
@@ -19,7 +22,11 @@ from skyquill.errors import InfeasibleError, InputError
 from skyquill.limits import DerivativeLimit, vehicle_limits
 from skyquill.optimize.problem import Boundary, PointDeviation, SmoothingProblem
 from skyquill.optimize.solve import FitResult, solve
-from skyquill.optimize.timing import MAX_COORDINATE_M, allocate_path_times
+from skyquill.optimize.timing import (
+    MAX_COORDINATE_M,
+    allocate_path_times,
+    allocate_segment_times,
+)
 from skyquill.solvers import DEFAULT_BACKEND
 from skyquill.spline import HullKind
 from skyquill.validation import FloatArray, as_array, as_float, as_int, strictly_increasing
@@ -48,8 +55,13 @@ class FitOptions:
         ``"bspline"`` or ``"bezier"``.
     solver
         QP backend.
+    timing
+        How points without times are timed: ``"path"`` (one rest-to-rest
+        profile along the whole path, slowing in turns: drawings) or
+        ``"segments"`` (rest to rest between consecutive points, paper 003
+        §3.5: sparse waypoint plans, flown through every corner).
     allocation_accel_fraction
-        The path allocation plans with this fraction of ``amax``. It knows
+        The allocation plans with this fraction of ``amax``. It knows
         nothing of jerk, and at full ``amax`` the jerk-limited fit cannot
         brake in time at the ends and cuts the last turn (spiral example: max
         deviation 51 mm at 1.0, 10 mm at 0.5, 7 mm at 0.35 for 19% more time).
@@ -65,6 +77,7 @@ class FitOptions:
     weight: float = 1e4
     knot_interval: float = 0.1
     hull: HullKind = "bspline"
+    timing: Literal["path", "segments"] = "path"
     solver: str = DEFAULT_BACKEND
     allocation_accel_fraction: float = 0.5
     stretch_factor: float = 1.25
@@ -79,6 +92,8 @@ class FitOptions:
         if as_float("stretch_factor", self.stretch_factor) <= 1.0:
             raise InputError(f"stretch_factor: got {self.stretch_factor:g}, expected > 1")
         as_int("max_stretches", self.max_stretches, low=0)
+        if self.timing not in ("path", "segments"):
+            raise InputError(f"timing: got {self.timing!r}, expected 'path' or 'segments'")
         fraction = as_float(
             "allocation_accel_fraction", self.allocation_accel_fraction, positive=True
         )
@@ -134,7 +149,8 @@ def fit_points(
     if pts.shape[1] not in (2, 3) or pts.shape[0] < 2:
         raise InputError(f"points: got shape {pts.shape}, expected (N >= 2, 2 or 3)")
     if times is None:
-        t = allocate_path_times(pts, opts.vmax, opts.allocation_accel_fraction * opts.amax)
+        allocate = allocate_path_times if opts.timing == "path" else allocate_segment_times
+        t = allocate(pts, opts.vmax, opts.allocation_accel_fraction * opts.amax)
     else:
         t = as_array("times", times, shape=(pts.shape[0],), max_abs=1e7)
         strictly_increasing("times", t)
