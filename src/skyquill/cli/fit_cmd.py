@@ -28,6 +28,7 @@ def fit_summary(fit: PointFit, rows: int, rate: float) -> dict[str, Any]:
         "max_excess": check.max_excess,
         "rms_deviation_m": fit.rms_deviation_m,
         "max_deviation_m": fit.max_deviation_m,
+        "status": r.status,
         "method": r.method,
         "solver": r.solver,
         "time_scale": fit.time_scale,

@@ -86,6 +86,11 @@ class FitResult:
     n_equalities: int
     n_inequalities: int
 
+    @property
+    def status(self) -> Literal["optimal"]:
+        """Always ``"optimal"``: an infeasible or failed solve raises instead of returning."""
+        return "optimal"
+
     @cached_property
     def verification(self) -> Verification:
         """The dense check against the problem's limits and corridors.
