@@ -9,8 +9,9 @@ import numpy as np
 import pytest
 
 from skyquill.errors import InputError
+from skyquill.geometry import polyline_distance
 from skyquill.optimize.timing import allocate_segment_times
-from skyquill.reproduce.segments import fit_segment_chain, polyline_distance, run_segment_study
+from skyquill.reproduce.segments import fit_segment_chain, run_segment_study
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 pytest.importorskip("minsnap_trajectories")

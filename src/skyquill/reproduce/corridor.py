@@ -119,12 +119,13 @@ from typing import Any
 import numpy as np
 
 from skyquill.errors import InfeasibleError, InputError
+from skyquill.geometry import polyline_distance
 from skyquill.io.corridor import BoxCorridor, load_box_corridor
 from skyquill.io.points import write_json
 from skyquill.limits import BoxLimit, CylinderLimit, DerivativeLimit
 from skyquill.optimize import Boundary, Corridor, FitResult, SmoothingProblem, solve
 from skyquill.optimize.timing import allocate_segment_times, segment_chain_terms
-from skyquill.reproduce.segments import DEVIATION_WEIGHT, KAPPA, polyline_distance
+from skyquill.reproduce.segments import DEVIATION_WEIGHT, KAPPA
 from skyquill.solvers import DEFAULT_BACKEND
 from skyquill.spline import HullKind
 from skyquill.validation import FloatArray, as_float, as_int

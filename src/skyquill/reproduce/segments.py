@@ -89,7 +89,7 @@ from typing import Any
 
 import numpy as np
 
-from skyquill.errors import InputError
+from skyquill.geometry import polyline_distance
 from skyquill.io.points import read_points_csv, write_json
 from skyquill.optimize import Boundary, PointDeviation, SmoothingProblem, solve
 from skyquill.optimize.problem import Deviation
@@ -103,7 +103,6 @@ __all__ = [
     "KAPPA",
     "PAPER_FIG7",
     "fit_segment_chain",
-    "polyline_distance",
     "run_segment_study",
     "snap_cost",
 ]
@@ -120,38 +119,6 @@ PAPER_FIG7: dict[str, dict[str, float]] = {
 N_SAMPLES = 20_001
 _WEIGHT_SWEEP = (10.0, 100.0, 1e3, 1e4, 1e5)
 _KAPPA_SWEEP = (0.1, 0.25, 0.4)
-
-
-def polyline_distance(points: FloatArray, vertices: FloatArray) -> FloatArray:
-    """Distance from each point to the nearest point of a polyline.
-
-    Parameters
-    ----------
-    points
-        Shape (N, d), m.
-    vertices
-        The polyline's vertices in order, shape (V, d), V >= 2, m. Repeated
-        consecutive vertices (zero-length segments) are allowed.
-
-    Returns
-    -------
-    numpy.ndarray, shape (N,), m
-    """
-    p = as_array("points", points, ndim=2)
-    v = as_array("vertices", vertices, shape=(None, p.shape[1]))
-    if v.shape[0] < 2:
-        raise InputError(f"vertices: got {v.shape[0]} vertex, expected at least 2")
-    a = v[:-1]  # (S, d)
-    ab = v[1:] - a
-    length2 = np.einsum("sd,sd->s", ab, ab)
-    best = np.full(p.shape[0], np.inf)
-    for start in range(0, p.shape[0], 4096):  # bounded (chunk, S, d) temporaries
-        q = p[start : start + 4096, None, :] - a[None, :, :]
-        s = np.einsum("nsd,sd->ns", q, ab) / np.where(length2 > 0.0, length2, 1.0)
-        s = np.clip(s, 0.0, 1.0)
-        gap = q - s[:, :, None] * ab[None, :, :]
-        best[start : start + 4096] = np.sqrt(np.einsum("nsd,nsd->ns", gap, gap).min(axis=1))
-    return best
 
 
 def snap_cost(traj: PolynomialTrajectory | SplineTrajectory) -> float:
