@@ -10,6 +10,7 @@ from __future__ import annotations
 import csv
 import json
 import math
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -81,12 +82,24 @@ def trajectory_table(traj: Trajectory, rate: float) -> FloatArray:
     return np.column_stack([s.t, as3(s.p), as3(s.v), as3(s.a), as3(s.j)])
 
 
-def write_trajectory_csv(path: str | Path, traj: Trajectory, rate: float) -> int:
-    """Write ``trajectory.csv`` sampled at ``rate`` Hz; returns the number of rows."""
+def write_trajectory_csv(
+    path: str | Path,
+    traj: Trajectory,
+    rate: float,
+    pen: Callable[[FloatArray], FloatArray] | None = None,
+) -> int:
+    """Write ``trajectory.csv`` sampled at ``rate`` Hz; returns the number of rows.
+
+    With ``pen`` (times (N,) -> 1.0 where the brush is down, else 0.0) two
+    columns follow the engine's: ``yaw`` (rad, constant 0: paper 000 writes
+    with a fixed heading) and ``pen``.
+    """
     table = trajectory_table(traj, rate)
-    np.savetxt(
-        path, table, delimiter=",", header=",".join(TRAJECTORY_COLUMNS), comments="", fmt="%.9g"
-    )
+    columns = list(TRAJECTORY_COLUMNS)
+    if pen is not None:
+        table = np.column_stack([table, np.zeros(table.shape[0]), pen(table[:, 0])])
+        columns += ["yaw", "pen"]
+    np.savetxt(path, table, delimiter=",", header=",".join(columns), comments="", fmt="%.9g")
     return int(table.shape[0])
 
 

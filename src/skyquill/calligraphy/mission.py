@@ -1,0 +1,431 @@
+"""Writing missions: strokes on a board to one continuous pen-up / pen-down flight.
+
+Paper 000 §4-5: the strokes are sampled densely, their turning points found
+by split-and-merge, and one minimum-jerk B-spline is fitted through them with
+the vehicle's limits. Here the whole mission -- take-off, approach, every
+stroke, the lifts between strokes, retreat and landing -- is *one* smoothing
+problem, so the trajectory is continuous up to jerk everywhere and starts and
+ends at rest:
+
+* stroke samples: point deviation with a high weight, the turning points with
+  a higher one (corners stay sharp);
+* lifts and transits: straight lines sampled every centimetre with a lower
+  weight, so the smoothed path stays near them and never dips into the board;
+* timing: one rest-to-rest profile along the whole polyline that slows to a
+  stop at corners (:func:`~skyquill.optimize.timing.allocate_path_times`);
+* if the limits cannot be met, or the pen-down path strays beyond the
+  tolerance, the timing is stretched and the problem solved again -- the
+  factor is reported.
+
+The plan is of the brush tip; the vehicle flies it offset by the brush
+(:meth:`Mission.vehicle_trajectory`). The pen is down (``pen = 1``) from a stroke's first
+sample time to its last.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from skyquill.calligraphy.board import Board
+from skyquill.errors import InfeasibleError, InputError
+from skyquill.geometry import polyline_distance
+from skyquill.limits import DerivativeLimit, vehicle_limits
+from skyquill.optimize import Boundary, PointDeviation, SmoothingProblem, solve
+from skyquill.optimize.solve import FitResult
+from skyquill.optimize.timing import allocate_path_times
+from skyquill.strokes import Strokes, turning_points
+from skyquill.trajectory import SplineTrajectory
+from skyquill.validation import FloatArray, as_array, as_float, as_int
+
+#: Spacing of the samples that hold lifts and transits near their straight lines, m.
+TRANSIT_SPACING_M = 0.01
+
+
+@dataclass(frozen=True)
+class WritingOptions:
+    """Knobs of :func:`plan_writing` (SI units).
+
+    Attributes
+    ----------
+    size_m
+        The strokes' larger side is scaled to this (paper 000: 0.5 m boards).
+    vmax, amax, jmax
+        Limits, m/s, m/s^2, m/s^3 (per axis, or norms if ``coupled``).
+    coupled
+        ``None`` or the sides of the inscribed horizontal polygon.
+    tolerance_m
+        Fidelity tolerance; ``None``: 1 % of ``size_m``.
+    turning_threshold_m
+        Split-and-merge threshold; ``None``: a quarter of the tolerance.
+    data_weight, turning_weight, transit_weight
+        Weights of the stroke samples, turning points and transit samples
+        against the jerk cost.
+    knot_interval
+        Seconds per knot span.
+    degree
+        Spline degree.
+    brush_length_m
+        Tip to vehicle distance along the board normal, m (the default
+        simulated vehicle's brush).
+    stretch_factor, max_stretches
+        Timing stretch when infeasible or unfaithful.
+    """
+
+    size_m: float = 0.5
+    vmax: float = 1.0
+    amax: float = 2.0
+    jmax: float = 10.0
+    coupled: int | None = None
+    tolerance_m: float | None = None
+    turning_threshold_m: float | None = None
+    data_weight: float = 1e4
+    turning_weight: float = 1e5
+    transit_weight: float = 1e2
+    knot_interval: float = 0.05
+    degree: int = 5
+    brush_length_m: float = 0.3
+    stretch_factor: float = 1.25
+    max_stretches: int = 8
+
+    def __post_init__(self) -> None:
+        for name in ("size_m", "vmax", "amax", "jmax", "knot_interval", "stretch_factor"):
+            as_float(name, getattr(self, name), positive=True)
+        for name in ("data_weight", "turning_weight", "transit_weight", "brush_length_m"):
+            as_float(name, getattr(self, name), nonneg=True)
+        for name in ("tolerance_m", "turning_threshold_m"):
+            if getattr(self, name) is not None:
+                as_float(name, getattr(self, name), positive=True)
+        if self.coupled is not None:
+            as_int("coupled", self.coupled, low=3, high=1024)
+        as_int("degree", self.degree, low=3, high=7)
+        as_int("max_stretches", self.max_stretches, low=0)
+        if self.stretch_factor <= 1.0:
+            raise InputError(f"stretch_factor: got {self.stretch_factor:g}, expected > 1")
+
+    @property
+    def tolerance(self) -> float:
+        """Fidelity tolerance, m."""
+        return self.tolerance_m if self.tolerance_m is not None else 0.01 * self.size_m
+
+    def limits(self) -> tuple[DerivativeLimit, ...]:
+        """The vehicle limits in 3-D."""
+        return vehicle_limits(3, self.vmax, self.amax, self.jmax, self.coupled)
+
+
+@dataclass(frozen=True)
+class Deviation:
+    """Two-sided distance between the pen-down path and the input strokes, m.
+
+    ``max_m`` is the Hausdorff distance: the larger of the two one-sided maxima.
+    """
+
+    path_to_input_max_m: float
+    input_to_path_max_m: float
+    mean_m: float
+
+    @property
+    def max_m(self) -> float:
+        """Largest of both one-sided distances (the Hausdorff distance), m."""
+        return max(self.path_to_input_max_m, self.input_to_path_max_m)
+
+    def as_dict(self) -> dict[str, float]:
+        """``summary.json`` form."""
+        return {
+            "max_m": self.max_m,
+            "mean_m": self.mean_m,
+            "hausdorff_m": self.max_m,
+            "path_to_input_max_m": self.path_to_input_max_m,
+            "input_to_path_max_m": self.input_to_path_max_m,
+        }
+
+
+@dataclass(frozen=True)
+class Mission:
+    """A planned writing flight.
+
+    Attributes
+    ----------
+    fit
+        The engine's result; ``fit.trajectory`` is the brush-tip trajectory.
+    board
+        Where it writes.
+    strokes_world
+        The input strokes on the board, world frame, each (K, 3), m.
+    pen_windows
+        ``(t_start, t_end)`` of every stroke, s.
+    deviation
+        Fidelity of the pen-down path.
+    time_scale
+        Stretch applied to the initial timing.
+    planning_time_s
+        Wall time of the whole planning.
+    options
+        The options it was planned with.
+    """
+
+    fit: FitResult
+    board: Board
+    strokes_world: tuple[FloatArray, ...]
+    pen_windows: tuple[tuple[float, float], ...]
+    deviation: Deviation
+    time_scale: float
+    planning_time_s: float
+    options: WritingOptions
+
+    @property
+    def trajectory(self) -> SplineTrajectory:
+        """The brush-tip trajectory."""
+        return self.fit.trajectory
+
+    def pen(self, t: FloatArray) -> FloatArray:
+        """1.0 where the pen is down at times ``t`` (N,), else 0.0."""
+        t = np.asarray(t, dtype=float)
+        down = np.zeros(t.size)
+        for t0, t1 in self.pen_windows:
+            down[(t >= t0) & (t <= t1)] = 1.0
+        return down
+
+    @property
+    def brush_offset(self) -> FloatArray:
+        """Vehicle position minus tip position (3,), m."""
+        return self.options.brush_length_m * self.board.normal
+
+    def vehicle_trajectory(self) -> SplineTrajectory:
+        """The vehicle's trajectory: the tip's, offset by the brush along the board normal.
+
+        A constant offset of every control point offsets the curve (partition
+        of unity), so limits and smoothness are unchanged.
+        """
+        tip = self.trajectory
+        return SplineTrajectory(tip.control_points + self.brush_offset, tip.degree, tip.duration)
+
+    @property
+    def faithful(self) -> bool:
+        """Whether the pen-down path is within the tolerance of the input."""
+        return self.deviation.max_m <= self.options.tolerance
+
+
+def _segment(a: FloatArray, b: FloatArray) -> FloatArray:
+    """Samples of the straight line from ``a`` to ``b`` (excluding ``a``), every 1 cm."""
+    n = max(1, math.ceil(float(np.linalg.norm(b - a)) / TRANSIT_SPACING_M))
+    return np.asarray(a + np.outer(np.arange(1, n + 1) / n, b - a))
+
+
+def densify(polyline: FloatArray, spacing: float = TRANSIT_SPACING_M) -> FloatArray:
+    """``polyline`` (K, 3) with points inserted so no gap exceeds ``spacing``; vertices kept.
+
+    Sparse input (a straight stroke given by its two ends) would leave the
+    spline free between samples; dense samples hold it to the line.
+    """
+    out = [polyline[:1]]
+    for a, b in itertools.pairwise(polyline):
+        out.append(_segment(a, b) if np.linalg.norm(b - a) > spacing else b[None, :])
+    return np.vstack(out)
+
+
+@dataclass
+class _Route:
+    """The mission polyline with a role per sample: stroke index or -1 (transit)."""
+
+    points: list[FloatArray] = field(default_factory=list)
+    role: list[FloatArray] = field(default_factory=list)
+
+    def add(self, points: FloatArray, role: int) -> None:
+        self.points.append(points)
+        self.role.append(np.full(len(points), role))
+
+    def go_to(self, target: FloatArray, include_target: bool = True) -> None:
+        line = _segment(self.points[-1][-1], target)
+        self.add(line if include_target else line[:-1], -1)
+
+
+def _route(
+    strokes_world: tuple[FloatArray, ...], board: Board, home: FloatArray | None
+) -> tuple[FloatArray, FloatArray]:
+    """All samples (N, 3) and their roles (N,): take-off, strokes with lifts, landing."""
+    lift = board.lift_m * board.normal
+    route = _Route()
+    first = strokes_world[0][0] + lift
+    if home is not None:
+        route.add(home[None, :], -1)
+        route.go_to(np.array([home[0], home[1], first[2]]))  # climb straight up
+        route.go_to(first)
+    else:
+        route.add(first[None, :], -1)
+    for i, stroke in enumerate(strokes_world):
+        route.go_to(stroke[0] + lift)
+        route.go_to(stroke[0], include_target=False)  # touch down: the stroke's first point
+        route.add(densify(stroke), i)
+        route.go_to(stroke[-1] + lift)
+    if home is not None:
+        route.go_to(np.array([home[0], home[1], route.points[-1][-1][2]]))
+        route.go_to(home)
+    return np.vstack(route.points), np.concatenate(route.role)
+
+
+def plan_writing(
+    strokes: Strokes,
+    board: Board | None = None,
+    options: WritingOptions | None = None,
+    home: FloatArray | None = None,
+) -> Mission:
+    """Plan one continuous writing flight of ``strokes`` on ``board``.
+
+    Parameters
+    ----------
+    strokes
+        The input, any units (scaled so that its larger side is ``size_m``).
+    board
+        Writing surface (default: horizontal at 1 m).
+    options
+        :class:`WritingOptions`.
+    home
+        The vehicle's take-off and landing position (3,), m (the tip hangs
+        ``brush_length_m`` below it); ``None`` starts and ends hovering above
+        the first and last stroke.
+
+    Raises
+    ------
+    InfeasibleError
+        The limits cannot be met, or the pen-down path stays beyond the
+        tolerance, even after ``max_stretches`` stretches.
+    """
+    start = time.perf_counter()
+    opts = options or WritingOptions()
+    board = board or Board()
+    home_pos = None if home is None else as_array("home", home, shape=(3,))
+    if home_pos is not None:
+        home_pos = home_pos - opts.brush_length_m * board.normal  # the tip's home
+    scaled = strokes.scaled(opts.size_m)
+    strokes_world = tuple(board.to_world(path) for path in scaled.paths)
+    points, roles = _route(strokes_world, board, home_pos)
+    times = allocate_path_times(points, opts.vmax, 0.5 * opts.amax)
+    threshold = opts.turning_threshold_m or 0.25 * opts.tolerance
+    corners = _turning_samples(strokes_world, board, points, roles, threshold)
+    scale = 1.0
+    for attempt in range(opts.max_stretches + 1):
+        try:
+            fit = solve(_problem(points, roles, corners, times * scale, opts))
+        except InfeasibleError:
+            if attempt == opts.max_stretches:
+                raise
+            scale *= opts.stretch_factor
+            continue
+        windows = _pen_windows(roles, times * scale, len(strokes_world))
+        deviation = measure_deviation(fit.trajectory, windows, strokes_world)
+        if deviation.max_m <= opts.tolerance or attempt == opts.max_stretches:
+            break
+        scale *= opts.stretch_factor
+    return Mission(
+        fit, board, strokes_world, windows, deviation, scale, time.perf_counter() - start, opts
+    )
+
+
+def _turning_samples(
+    strokes_world: tuple[FloatArray, ...],
+    board: Board,
+    points: FloatArray,
+    roles: FloatArray,
+    threshold: float,
+) -> FloatArray:
+    """Indices into the route of every stroke's turning points (paper 000 §4)."""
+    picked = []
+    for i, stroke in enumerate(strokes_world):
+        corners = stroke[turning_points(board.to_board(stroke)[:, :2], threshold)]
+        where = np.flatnonzero(roles == i)
+        # Densifying keeps the vertices: find each corner among the stroke's samples.
+        gaps = np.linalg.norm(points[where][:, None, :] - corners[None, :, :], axis=2)
+        picked.append(where[np.argmin(gaps, axis=0)])
+    return np.concatenate(picked)
+
+
+def _problem(
+    points: FloatArray,
+    roles: FloatArray,
+    corners: FloatArray,
+    times: FloatArray,
+    opts: WritingOptions,
+) -> SmoothingProblem:
+    duration = float(times[-1])
+    stroke = roles >= 0
+    deviations = [
+        PointDeviation(times[stroke], points[stroke], opts.data_weight),
+        PointDeviation(times[corners], points[corners], opts.turning_weight),
+    ]
+    if np.any(~stroke) and opts.transit_weight > 0:
+        deviations.append(PointDeviation(times[~stroke], points[~stroke], opts.transit_weight))
+    return SmoothingProblem(
+        dim=3,
+        degree=opts.degree,
+        n_ctrl=max(1, math.ceil(duration / opts.knot_interval)) + opts.degree,
+        duration=duration,
+        smoothness={3: 1.0},
+        deviations=tuple(deviations),
+        boundary=Boundary.rest(points[0], points[-1], 3),
+        limits=opts.limits(),
+    )
+
+
+def _pen_windows(roles: FloatArray, times: FloatArray, n: int) -> tuple[tuple[float, float], ...]:
+    windows = []
+    for i in range(n):
+        where = np.flatnonzero(roles == i)
+        windows.append((float(times[where[0]]), float(times[where[-1]])))
+    return tuple(windows)
+
+
+def measure_deviation(
+    traj: SplineTrajectory,
+    windows: tuple[tuple[float, float], ...],
+    strokes_world: tuple[FloatArray, ...],
+    samples_per_stroke: int = 400,
+) -> Deviation:
+    """Two-sided distance between the pen-down path and the input strokes.
+
+    For each stroke: the largest distance from pen-down samples to the
+    stroke's polyline, and from the stroke's points to the pen-down path
+    (its dense samples as a polyline). 3-D distances: lifting off the board
+    counts.
+    """
+    forward, backward, total, count = 0.0, 0.0, 0.0, 0
+    for (t0, t1), stroke in zip(windows, strokes_world, strict=True):
+        path = traj.evaluate(np.linspace(t0, t1, samples_per_stroke))
+        to_input = polyline_distance(path, stroke)
+        to_path = polyline_distance(stroke, path)
+        forward = max(forward, float(to_input.max()))
+        backward = max(backward, float(to_path.max()))
+        total += float(to_input.sum())
+        count += to_input.size
+    return Deviation(forward, backward, total / count)
+
+
+def check_separation(
+    trajectories: list[SplineTrajectory], minimum_m: float = 1.0, rate_hz: float = 50.0
+) -> float:
+    """Smallest pairwise distance over the whole flight, m; raise if below ``minimum_m``.
+
+    Drones that finish early hold their last position (landed at home).
+    """
+    minimum = as_float("minimum_m", minimum_m, positive=True)
+    horizon = max(t.duration for t in trajectories)
+    t = np.linspace(0.0, horizon, max(2, math.ceil(horizon * rate_hz) + 1))
+    tracks = [tr.evaluate(np.minimum(t, tr.duration)) for tr in trajectories]
+    closest = math.inf
+    for i in range(len(tracks)):
+        for j in range(i + 1, len(tracks)):
+            gap = np.linalg.norm(tracks[i] - tracks[j], axis=1)
+            k = int(np.argmin(gap))
+            if gap[k] < closest:
+                closest = float(gap[k])
+            if gap[k] < minimum:
+                raise InfeasibleError(
+                    f"separation: drones {i} and {j} come within {gap[k]:.3f} m at "
+                    f"t = {t[k]:.2f} s, expected at least {minimum:g} m",
+                    ("separation",),
+                )
+    return closest

@@ -1,0 +1,207 @@
+"""``skyquill write``: text, strokes or an SVG to writing flights, one or several drones."""
+
+from __future__ import annotations
+
+import itertools
+import json
+import unicodedata
+from pathlib import Path
+from typing import Annotated, Any
+
+import numpy as np
+import typer
+
+from skyquill.cli.fit_cmd import _rate
+from skyquill.cli.main import OutDir, app, console, user_errors
+from skyquill.errors import InputError
+from skyquill.io.points import write_json, write_trajectory_csv
+
+#: How far the simulated board is raised into the brush's planned path, m.
+PRESS_M = 0.002
+
+
+def is_cjk(text: str) -> bool:
+    """Whether ``text`` holds CJK ideographs (written from hanzi medians, not Hershey)."""
+    return any(unicodedata.name(c, "").startswith("CJK UNIFIED IDEOGRAPH") for c in text)
+
+
+def split_text(text: str, parts: int) -> list[str]:
+    """``text`` in ``parts`` consecutive chunks: characters for hanzi, words otherwise."""
+    units = [c for c in text if not c.isspace()] if is_cjk(text) else text.split()
+    if len(units) < parts:
+        raise InputError(
+            f"--drones: got {parts} drones for {len(units)} character(s)/word(s) in "
+            f"{text!r}, expected at most one drone per character or word"
+        )
+    joiner = "" if is_cjk(text) else " "
+    bounds = np.linspace(0, len(units), parts + 1).round().astype(int)
+    return [joiner.join(units[a:b]) for a, b in itertools.pairwise(bounds)]
+
+
+def load_input(
+    text: str | None, strokes: Path | None, svg: Path | None, hanzi: Path | None, font: str
+) -> Any:
+    """The single input as :class:`~skyquill.strokes.Strokes` (imported lazily)."""
+    from skyquill.strokes import hanzi_text, load_stroke_json, load_svg, text_strokes
+
+    given = [
+        name
+        for name, v in (("TEXT", text), ("--strokes", strokes), ("--svg", svg))
+        if v is not None
+    ]
+    if len(given) != 1:
+        raise InputError(
+            f"input: got {', '.join(given) or 'nothing'}, expected exactly one of TEXT, "
+            "--strokes FILE or --svg FILE"
+        )
+    if strokes is not None:
+        return load_stroke_json(strokes)
+    if svg is not None:
+        return load_svg(svg)
+    assert text is not None
+    return hanzi_text(text, source=hanzi) if is_cjk(text) else text_strokes(text, font)
+
+
+@app.command()
+def write(
+    out: OutDir,
+    text: Annotated[str | None, typer.Argument(help="Text to write (Latin or Chinese).")] = None,
+    strokes: Annotated[Path | None, typer.Option(help='Stroke JSON {"strokes": [...]}')] = None,
+    svg: Annotated[Path | None, typer.Option(help="SVG file: every path is a stroke.")] = None,
+    hanzi: Annotated[
+        Path | None, typer.Option(help="hanzi-writer-data JSON file or directory.")
+    ] = None,
+    font: Annotated[str, typer.Option(help="Hershey font for Latin text.")] = "futural",
+    size: Annotated[float, typer.Option(help="Larger side of each drone's writing, m.")] = 0.5,
+    vmax: Annotated[float, typer.Option(help="Speed limit, m/s.")] = 1.0,
+    amax: Annotated[float, typer.Option(help="Acceleration limit, m/s^2.")] = 2.0,
+    jmax: Annotated[float, typer.Option(help="Jerk limit, m/s^3.")] = 10.0,
+    coupled: Annotated[int | None, typer.Option(help="Sides of the coupled polygon.")] = None,
+    drones: Annotated[int, typer.Option(help="Drones writing at once, boards side by side.")] = 1,
+    rate: Annotated[float, typer.Option(help="Sample rate of the CSVs, Hz.")] = 100.0,
+    fly: Annotated[bool, typer.Option(help="Also fly each drone in simulation (RPT).")] = False,
+) -> None:
+    """Plan pen-up / pen-down writing flights; write CSVs, input_strokes.json, plot, summary."""
+    from skyquill.calligraphy.mission import WritingOptions
+    from skyquill.calligraphy.show import plan_show
+    from skyquill.strokes import hanzi_text, text_strokes
+
+    with user_errors():
+        rate = _rate(rate)
+        options = WritingOptions(size_m=size, vmax=vmax, amax=amax, jmax=jmax, coupled=coupled)
+        if drones != 1:
+            if text is None or strokes is not None or svg is not None:
+                raise InputError("--drones: several drones need TEXT to share out, got a file")
+            parts = [
+                hanzi_text(p, source=hanzi) if is_cjk(p) else text_strokes(p, font)
+                for p in split_text(text, drones)
+            ]
+        else:
+            parts = [load_input(text, strokes, svg, hanzi, font)]
+        with console.status(f"planning {len(parts)} writing flight(s)"):
+            show = plan_show(parts, options)
+        summary = write_outputs(show, out, rate, fly)
+    console.print(
+        f"[green]done[/] {out}: {summary['duration_s']:.1f} s of flight, planned in "
+        f"{summary['planning_time_s']:.2f} s, deviation {1e3 * summary['deviation']['max_m']:.2f}"
+        f" mm, max excess {summary['max_excess']:.1e}",
+        highlight=False,
+    )
+
+
+def write_outputs(show: Any, out: Path, rate: float, fly: bool) -> dict[str, Any]:
+    """Trajectory CSVs, ``input_strokes.json``, ``plot.png`` and ``summary.json``."""
+    from skyquill.viz.writing_plot import plot_missions
+
+    out.mkdir(parents=True, exist_ok=True)
+    missions = list(show.missions)
+    per_drone = []
+    strokes_json: list[Any] = []
+    for i, mission in enumerate(missions):
+        name = "trajectory.csv" if len(missions) == 1 else f"trajectory_{i}.csv"
+        vehicle = mission.vehicle_trajectory()
+        write_trajectory_csv(out / name, vehicle, rate, pen=mission.pen)
+        strokes_json.append([(s + mission.brush_offset).tolist() for s in mission.strokes_world])
+        per_drone.append(_drone_summary(mission, name, fly, vehicle))
+    payload: dict[str, Any] = (
+        {"strokes": strokes_json[0]}
+        if len(missions) == 1
+        else {"drones": [{"strokes": s} for s in strokes_json]}
+    )
+    payload["frame"] = "world, z up, m; the vehicle's positions (brush tip + brush offset)"
+    (out / "input_strokes.json").write_text(json.dumps(payload) + "\n", encoding="utf-8")
+    plot_missions(missions, out / "plot.png", "skyquill write")
+    closest = show.min_separation_m if len(missions) > 1 else None
+    summary = _merge(per_drone) | {"min_separation_m": closest, "drones": per_drone}
+    write_json(out / "summary.json", summary)
+    return summary
+
+
+def _drone_summary(mission: Any, name: str, fly: bool, vehicle: Any) -> dict[str, Any]:
+    check = mission.fit.verification
+    entry: dict[str, Any] = {
+        "file": name,
+        "duration_s": mission.trajectory.duration,
+        "planning_time_s": mission.planning_time_s,
+        "limits": [
+            {"label": c.label, "max_value": c.max_value, "relative_excess": c.relative_excess}
+            for c in check.checks
+        ],
+        "max_speed": check.max_speed,
+        "max_acc": list(check.max_acc),
+        "max_jerk": list(check.max_jerk),
+        "max_excess": check.max_excess,
+        "deviation": mission.deviation.as_dict(),
+        "tolerance_m": mission.options.tolerance,
+        "faithful": mission.faithful,
+        "strokes": len(mission.strokes_world),
+        "time_scale": mission.time_scale,
+    }
+    if fly:
+        entry["flight"] = _fly(mission, vehicle)
+    return entry
+
+
+def _fly(mission: Any, vehicle: Any) -> dict[str, Any]:
+    """Fly the vehicle trajectory with RPT over the board; compare the ink with the input."""
+    from skyquill.geometry import polyline_distance
+    from skyquill.sim import Board, Quadrotor, simulate
+
+    corner = mission.board.origin
+    margin = 0.1
+    # The plan touches the surface; the simulated board sits PRESS_M higher so
+    # that the brush presses into it and tracking errors do not lift it off.
+    board = Board(
+        height_m=float(corner[2]) + PRESS_M,
+        extent=(
+            corner[0] - margin,
+            corner[0] + mission.options.size_m + margin,
+            corner[1] - margin,
+            corner[1] + mission.options.size_m + margin,
+        ),
+    )
+    flight = simulate(
+        vehicle, Quadrotor(brush_length_m=mission.options.brush_length_m), board=board
+    )
+    ink = np.vstack(flight.ink) if flight.ink else np.zeros((0, 3))
+    gap = (
+        np.min([polyline_distance(ink, s) for s in mission.strokes_world], axis=0)
+        if len(ink)
+        else np.zeros(0)
+    )
+    return flight.summary() | {"ink_max_deviation_m": float(gap.max(initial=0.0))}
+
+
+def _merge(drones: list[dict[str, Any]]) -> dict[str, Any]:
+    """The summary's top level: worst case over drones."""
+    return {
+        "duration_s": max(d["duration_s"] for d in drones),
+        "planning_time_s": sum(d["planning_time_s"] for d in drones),
+        "limits": drones[0]["limits"],
+        "max_speed": max(d["max_speed"] for d in drones),
+        "max_acc": np.max([d["max_acc"] for d in drones], axis=0).tolist(),
+        "max_jerk": np.max([d["max_jerk"] for d in drones], axis=0).tolist(),
+        "max_excess": max(d["max_excess"] for d in drones),
+        "deviation": {k: max(d["deviation"][k] for d in drones) for k in drones[0]["deviation"]},
+        "strokes": sum(d["strokes"] for d in drones),
+    }

@@ -1,0 +1,147 @@
+"""Writing missions: continuity, pen windows, fidelity, limits, boards, several drones."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from skyquill.calligraphy.board import Board
+from skyquill.calligraphy.mission import (
+    WritingOptions,
+    check_separation,
+    densify,
+    measure_deviation,
+    plan_writing,
+)
+from skyquill.calligraphy.show import layout, plan_show
+from skyquill.errors import InfeasibleError, InputError
+from skyquill.strokes import Strokes, hanzi_strokes, text_strokes
+from skyquill.trajectory import SplineTrajectory
+
+H = Strokes(
+    paths=(
+        np.array([[0.0, 0.0], [0.0, 1.0]]),
+        np.array([[0.6, 0.0], [0.6, 1.0]]),
+        np.array([[0.0, 0.5], [0.6, 0.5]]),
+    )
+)
+HOME = np.array([0.25, -1.0, 0.0])
+
+
+@pytest.fixture(scope="module")
+def h_mission():  # type: ignore[no-untyped-def]
+    return plan_writing(H, Board(), WritingOptions(), home=HOME)
+
+
+def test_one_continuous_flight_from_home_to_home(h_mission) -> None:  # type: ignore[no-untyped-def]
+    traj = h_mission.trajectory
+    ends = traj.evaluate(np.array([0.0, traj.duration]))
+    tip_home = HOME - [0.0, 0.0, 0.3]  # the brush hangs 0.3 m below the vehicle
+    assert np.allclose(ends, [tip_home, tip_home], atol=1e-9)
+    assert np.allclose(traj.evaluate(np.array([0.0, traj.duration]), 1), 0.0, atol=1e-9)
+    assert h_mission.fit.verification.max_excess <= 1e-9
+
+
+def test_pen_windows_are_on_the_board_and_within_tolerance(h_mission) -> None:  # type: ignore[no-untyped-def]
+    assert len(h_mission.pen_windows) == 3
+    assert h_mission.faithful
+    assert h_mission.deviation.max_m <= 0.005
+    for t0, t1 in h_mission.pen_windows:
+        z = h_mission.trajectory.evaluate(np.linspace(t0, t1, 200))[:, 2]
+        assert np.abs(z - 1.0).max() <= 0.005
+    # Between strokes the brush is lifted.
+    gaps = [
+        (a[1], b[0])
+        for a, b in zip(h_mission.pen_windows[:-1], h_mission.pen_windows[1:], strict=True)
+    ]
+    for t0, t1 in gaps:
+        z = h_mission.trajectory.evaluate(np.array([0.5 * (t0 + t1)]))[0, 2]
+        assert z > 1.0 + 0.02
+
+
+def test_pen_column_matches_windows(h_mission) -> None:  # type: ignore[no-untyped-def]
+    t = np.linspace(0.0, h_mission.trajectory.duration, 1000)
+    pen = h_mission.pen(t)
+    assert set(np.unique(pen)) == {0.0, 1.0}
+    assert pen[0] == 0.0 and pen[-1] == 0.0
+
+
+def test_vehicle_trajectory_is_offset_by_the_brush(h_mission) -> None:  # type: ignore[no-untyped-def]
+    vehicle = h_mission.vehicle_trajectory()
+    t = np.linspace(0, vehicle.duration, 50)
+    assert np.allclose(vehicle.evaluate(t) - h_mission.trajectory.evaluate(t), [0, 0, 0.3])
+    assert np.allclose(vehicle.evaluate(t, 2), h_mission.trajectory.evaluate(t, 2))
+
+
+def test_measure_deviation_is_two_sided() -> None:
+    line = SplineTrajectory(
+        np.column_stack([np.linspace(0, 1, 6), np.zeros(6), np.ones(6)]), 5, 1.0
+    )
+    stroke = np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 1.0]])
+    assert measure_deviation(line, ((0.0, 1.0),), (stroke,)).max_m < 1e-9
+    longer = np.array([[0.0, 0.0, 1.0], [1.5, 0.0, 1.0]])  # the path misses the last 0.5 m
+    dev = measure_deviation(line, ((0.0, 1.0),), (longer,))
+    assert dev.path_to_input_max_m < 1e-9
+    assert dev.input_to_path_max_m == pytest.approx(0.5, abs=1e-6)
+
+
+def test_densify_keeps_vertices_and_spacing() -> None:
+    poly = np.array([[0.0, 0, 0], [0.1, 0, 0], [0.1, 0.005, 0]])
+    dense = densify(poly, 0.01)
+    assert np.all(np.linalg.norm(np.diff(dense, axis=0), axis=1) <= 0.01 + 1e-12)
+    for v in poly:
+        assert np.min(np.linalg.norm(dense - v, axis=1)) < 1e-12
+
+
+def test_wall_board() -> None:
+    wall = Board("wall", np.array([0.0, 2.0, 1.0]))
+    mission = plan_writing(H, wall, WritingOptions(size_m=0.4))
+    assert mission.faithful
+    for (t0, t1), stroke in zip(mission.pen_windows, mission.strokes_world, strict=True):
+        y = mission.trajectory.evaluate(np.linspace(t0, t1, 50))[:, 1]
+        assert np.abs(y - 2.0).max() <= 0.004
+        assert np.allclose(stroke[:, 1], 2.0)
+
+
+def test_text_and_hanzi_are_written_faithfully() -> None:
+    for strokes in (text_strokes("Hi"), hanzi_strokes("永")):
+        mission = plan_writing(strokes)
+        assert mission.faithful, strokes.source
+        assert mission.fit.verification.max_excess <= 1e-9
+
+
+def test_coupled_limits() -> None:
+    mission = plan_writing(H, options=WritingOptions(coupled=8, vmax=0.8, amax=1.0, jmax=5.0))
+    check = mission.fit.verification
+    assert check.max_excess <= 1e-9 and mission.faithful
+
+
+def test_separation_violation_is_an_error() -> None:
+    a = SplineTrajectory(np.zeros((6, 3)), 5, 1.0)
+    b = SplineTrajectory(np.tile([0.5, 0.0, 0.0], (6, 1)), 5, 2.0)
+    with pytest.raises(InfeasibleError, match=r"drones 0 and 1 come within 0\.500 m"):
+        check_separation([a, b], 1.0)
+    assert check_separation([a, b], 0.4) == pytest.approx(0.5)
+
+
+def test_four_drones_write_yi_ma_dang_xian() -> None:
+    parts = [hanzi_strokes(c) for c in "一马当先"]
+    show = plan_show(parts, WritingOptions(size_m=0.5), separation_m=1.0, workers=2)
+    assert len(show.missions) == 4
+    assert show.min_separation_m >= 1.0
+    assert all(m.faithful for m in show.missions)
+    homes = [m.vehicle_trajectory().evaluate(np.array([0.0]))[0] for m in show.missions]
+    assert np.allclose(homes, show.homes)
+
+
+def test_layout_spacing() -> None:
+    boards = layout(3, 0.5, 1.0)
+    xs = [b.origin[0] for b, _ in boards]
+    assert np.diff(xs).min() >= 0.5 + 1.0
+
+
+def test_bad_options() -> None:
+    with pytest.raises(InputError, match="size_m: got 0, expected a number > 0"):
+        WritingOptions(size_m=0.0)
+    with pytest.raises(InputError, match="board kind: got 'floor'"):
+        Board("floor")  # type: ignore[arg-type]
