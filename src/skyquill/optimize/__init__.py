@@ -9,6 +9,12 @@ from skyquill.optimize.problem import (
     PointDeviation,
     SmoothingProblem,
 )
+from skyquill.optimize.resegment import (
+    ResegmentResult,
+    point_fit_factory,
+    resegment,
+    time_gradient,
+)
 from skyquill.optimize.solve import FitResult, solve
 
 __all__ = [
@@ -19,6 +25,10 @@ __all__ = [
     "LineDeviation",
     "PlaneDeviation",
     "PointDeviation",
+    "ResegmentResult",
     "SmoothingProblem",
+    "point_fit_factory",
+    "resegment",
     "solve",
+    "time_gradient",
 ]
