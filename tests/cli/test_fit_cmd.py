@@ -58,14 +58,6 @@ def test_fit_writes_trajectory_plot_and_summary(tmp_path: Path) -> None:
     assert (out / "plot.png").stat().st_size > 10_000
 
 
-def test_demo(tmp_path: Path) -> None:
-    result = runner.invoke(app, ["demo", "--out", str(tmp_path / "demo")])
-    assert result.exit_code == 0, result.output
-    summary = json.loads((tmp_path / "demo" / "summary.json").read_text())
-    assert summary["max_excess"] <= 1e-9
-    assert summary["rms_deviation_m"] < 0.005
-
-
 @pytest.mark.parametrize(
     ("args", "message"),
     [

@@ -7,7 +7,7 @@ from typing import Annotated, Any
 
 import typer
 
-from skyquill.cli.main import EXAMPLES, OutDir, app, console, user_errors
+from skyquill.cli.main import OutDir, app, console, user_errors
 from skyquill.errors import InputError
 from skyquill.io.points import read_points_csv, write_json, write_trajectory_csv
 from skyquill.optimize.fit import FitOptions, PointFit, fit_points
@@ -142,13 +142,3 @@ def _hull(name: str) -> Any:
     if name not in ("bspline", "bezier"):
         raise InputError(f"--hull: got {name!r}, expected 'bspline' or 'bezier'")
     return name
-
-
-@app.command()
-def demo(out: OutDir = Path("out/demo")) -> None:
-    """Fit the bundled hand-drawn spiral (examples/spiral.csv) and plot it."""
-    with user_errors():
-        points, _ = read_points_csv(EXAMPLES / "spiral.csv")
-        # Time comes from the path allocation, not the tablet's clock: the hand
-        # does not start and end at rest, the drone must.
-        run_fit(points, None, FitOptions(), out, 100.0, "hand-drawn spiral")

@@ -205,3 +205,26 @@ def _merge(drones: list[dict[str, Any]]) -> dict[str, Any]:
         "deviation": {k: max(d["deviation"][k] for d in drones) for k in drones[0]["deviation"]},
         "strokes": sum(d["strokes"] for d in drones),
     }
+
+
+@app.command()
+def demo(out: OutDir = Path("out/demo")) -> None:
+    """Write 永 on a horizontal board, fly it with the RPT controller, plot and summarise."""
+    from skyquill.calligraphy.mission import WritingOptions
+    from skyquill.calligraphy.show import plan_show
+    from skyquill.strokes import hanzi_strokes
+
+    with user_errors():
+        with console.status("planning 永 (eternity: the eight strokes of calligraphy)"):
+            show = plan_show([hanzi_strokes("永")], WritingOptions())
+        with console.status("flying it in closed loop"):
+            summary = write_outputs(show, out, 100.0, fly=True)
+    flight = summary["drones"][0]["flight"]
+    console.print(
+        f"[green]done[/] wrote 永 in {summary['duration_s']:.1f} s of flight "
+        f"(planned in {summary['planning_time_s']:.2f} s, pen-down deviation "
+        f"{1e3 * summary['deviation']['max_m']:.2f} mm, max excess {summary['max_excess']:.1e}); "
+        f"flown with RPT: RMSE {1e3 * flight['rmse_m']:.2f} mm.\n"
+        f"  {out / 'plot.png'}\n  {out / 'summary.json'}\n  {out / 'trajectory.csv'}",
+        highlight=False,
+    )

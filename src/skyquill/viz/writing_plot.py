@@ -28,7 +28,14 @@ def plot_missions(missions: list[Mission], path: str | Path, title: str = "") ->
         Figure title.
     """
     rows = len(missions)
-    fig, axes = plt.subplots(rows, 4, figsize=(16, 3.8 * rows), layout="constrained", squeeze=False)
+    fig, axes = plt.subplots(
+        rows,
+        4,
+        figsize=(17, 4.2 * rows),
+        layout="constrained",
+        squeeze=False,
+        gridspec_kw={"width_ratios": [1.4, 1, 1, 1]},
+    )
     for row, mission in zip(axes, missions, strict=True):
         _board_view(row[0], mission)
         _derivatives(row[1:], mission)
@@ -66,6 +73,9 @@ def _board_view(ax: Axes, mission: Mission) -> None:
         color="C3",
         label="pen down",
     )
+    margin = 0.1 * mission.options.size_m  # the board, not the take-off transit
+    ax.set_xlim(-margin, mission.options.size_m + margin)
+    ax.set_ylim(-margin, mission.options.size_m + margin)
     ax.set(
         aspect="equal",
         xlabel="u [m]",

@@ -1,0 +1,87 @@
+"""``skyquill write`` and ``skyquill demo``: files, columns, summary, bad input."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from skyquill.cli.main import app
+from skyquill.cli.write_cmd import split_text
+from skyquill.geometry import polyline_distance
+
+runner = CliRunner()
+COLUMNS = "t,x,y,z,vx,vy,vz,ax,ay,az,jx,jy,jz,yaw,pen"
+
+
+def test_demo_writes_and_flies_yong(tmp_path: Path) -> None:
+    result = runner.invoke(app, ["demo", "--out", str(tmp_path)])
+    assert result.exit_code == 0, result.output
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert summary["max_excess"] <= 1e-9
+    assert summary["deviation"]["max_m"] <= 0.005
+    assert summary["drones"][0]["flight"]["rmse_m"] < 0.01
+    assert (tmp_path / "plot.png").stat().st_size > 10_000
+
+
+def test_write_text_gives_pen_column_and_input_strokes(tmp_path: Path) -> None:
+    result = runner.invoke(app, ["write", "Hi", "--size", "0.4", "--out", str(tmp_path)])
+    assert result.exit_code == 0, result.output
+    header = (tmp_path / "trajectory.csv").read_text().splitlines()[0]
+    assert header == COLUMNS
+    data = np.loadtxt(tmp_path / "trajectory.csv", delimiter=",", skiprows=1)
+    assert set(np.unique(data[:, -1])) == {0.0, 1.0}
+    strokes = json.loads((tmp_path / "input_strokes.json").read_text())["strokes"]
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert len(strokes) == summary["strokes"]
+    # Pen-down samples of the CSV lie near the input strokes (same world frame).
+    down = data[data[:, -1] == 1.0, 1:4]
+    nearest = np.min([polyline_distance(down, np.array(s)) for s in strokes], axis=0)
+    assert nearest.max() <= 0.01 * 0.4
+    for key in (
+        "duration_s",
+        "planning_time_s",
+        "limits",
+        "max_speed",
+        "max_acc",
+        "max_jerk",
+        "max_excess",
+        "deviation",
+        "strokes",
+        "drones",
+    ):
+        assert key in summary
+    assert {"max_m", "mean_m", "hausdorff_m"} <= summary["deviation"].keys()
+
+
+def test_write_several_drones(tmp_path: Path) -> None:
+    result = runner.invoke(app, ["write", "一马当先", "--drones", "4", "--out", str(tmp_path)])
+    assert result.exit_code == 0, result.output
+    for i in range(4):
+        assert (tmp_path / f"trajectory_{i}.csv").exists()
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert summary["min_separation_m"] >= 1.0
+    assert len(summary["drones"]) == 4
+
+
+def test_split_text() -> None:
+    assert split_text("一马当先", 4) == ["一", "马", "当", "先"]
+    assert split_text("one two three", 2) == ["one two", "three"]
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["write"], "expected exactly one of TEXT, --strokes FILE or --svg FILE"),
+        (["write", "一马", "--drones", "3"], "got 3 drones for 2 character(s)"),
+        (["write", "Hi", "--size", "-1"], "size_m: got -1"),
+        (["write", "Hi", "--rate", "0"], "--rate: got 0"),
+    ],
+)
+def test_bad_input(tmp_path: Path, args: list[str], message: str) -> None:
+    result = runner.invoke(app, [*args, "--out", str(tmp_path / "o")])
+    assert result.exit_code == 2, result.output
+    assert message in " ".join(result.output.split())
