@@ -1,0 +1,188 @@
+"""Strokes of Chinese characters from the Make Me a Hanzi stroke medians.
+
+The data is that of the npm package ``hanzi-writer-data`` (derived from Make Me a
+Hanzi, under the Arphic Public License, see ``data/hanzi/ARPHICPL.TXT``): one
+JSON per character with ``"strokes"`` (SVG outlines of the brush shapes) and
+``"medians"`` (per stroke, the ``[x, y]`` points of its centre line in writing
+direction). Only the medians are used: they are what a brush held by a drone
+follows. Coordinates are in a 1024-unit em box with y already up: top-left
+``(0, 900)``, bottom-right ``(1024, -124)``.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from functools import cache
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from skyquill.errors import InputError
+from skyquill.strokes.json_io import read_json
+from skyquill.strokes.model import Strokes
+from skyquill.validation import as_float
+
+#: Environment variable naming a directory of ``<char>.json`` files (for example
+#: an unpacked ``hanzi-writer-data`` package) searched before the bundled set.
+HANZI_DIR_ENV = "SKYQUILL_HANZI_DIR"
+
+#: Side of the em box the medians are given in, and the default advance of
+#: :func:`hanzi_text`.
+EM = 1024.0
+
+_BUNDLE = "hanzi_medians.json"
+
+
+@cache
+def _bundle() -> dict[str, Any]:
+    ref = resources.files("skyquill.strokes").joinpath("data", "hanzi", _BUNDLE)
+    data: dict[str, Any] = json.loads(ref.read_text(encoding="utf-8"))
+    return data
+
+
+def bundled_hanzi() -> str:
+    """The characters bundled with skyquill, in bundle order, as one string."""
+    return "".join(_bundle())
+
+
+def _medians_in(entry: Any, char: str, where: str) -> Any:
+    """The medians of one character's record (a medians list, or an object with them)."""
+    if isinstance(entry, dict):
+        if "medians" not in entry:
+            raise InputError(f'{where}: the record of {char!r} has no "medians" field')
+        return entry["medians"]
+    return entry
+
+
+def _lookup_file(path: Path, char: str) -> Any | None:
+    data = read_json(path, f"hanzi-writer data for {char!r}")
+    if isinstance(data, dict) and "medians" in data:
+        return data["medians"]  # one character's file, as in hanzi-writer-data
+    if isinstance(data, dict):
+        if char in data:
+            return _medians_in(data[char], char, str(path))
+        return None
+    raise InputError(
+        f'{path}: got a JSON {type(data).__name__}, expected an object with "medians" or '
+        "{character: medians}"
+    )
+
+
+def _lookup_dir(directory: Path, char: str) -> Any | None:
+    file = directory / f"{char}.json"
+    if not file.is_file():
+        return None
+    return _lookup_file(file, char)
+
+
+def _lookup(place: Path, char: str) -> Any | None:
+    if place.is_dir():
+        return _lookup_dir(place, char)
+    if place.is_file():
+        return _lookup_file(place, char)
+    raise InputError(f"{place}: no such file or directory, expected hanzi data")
+
+
+def hanzi_strokes(char: str, source: str | Path | None = None) -> Strokes:
+    """Strokes of one Chinese character, in stroke order and writing direction.
+
+    Lookup order: ``source`` alone if given; otherwise the directory named by the
+    environment variable ``SKYQUILL_HANZI_DIR`` (if set) and then the bundled set
+    (:func:`bundled_hanzi`: 57 common characters, among them 永 光 成 一 马 当 先).
+
+    Parameters
+    ----------
+    char
+        Exactly one character.
+    source
+        A JSON file (one character's ``hanzi-writer-data`` file with a
+        ``"medians"`` field, or an object ``{character: medians}``) or a
+        directory of ``<character>.json`` files.
+
+    Returns
+    -------
+    Strokes
+        One stroke per brush stroke (its median), in em-box units (1024 per em),
+        y up; ``source`` reads ``"hanzi 永"``.
+
+    Raises
+    ------
+    InputError
+        If ``char`` is not a single character, or is not found (the message
+        names it and every place searched), or its data is malformed.
+    """
+    if not isinstance(char, str) or len(char) != 1:
+        raise InputError(
+            f"char: got {char!r}, expected exactly one character (use hanzi_text for several)"
+        )
+    looked: list[str] = []
+    medians: Any | None = None
+    where = ""
+    if source is not None:
+        place = Path(source)
+        medians = _lookup(place, char)
+        looked.append(str(place))
+        where = str(place)
+    else:
+        env = os.environ.get(HANZI_DIR_ENV)
+        if env:
+            place = Path(env)
+            medians = _lookup(place, char)
+            looked.append(f"{place} (${HANZI_DIR_ENV})")
+            where = str(place)
+        if medians is None:
+            medians = _bundle().get(char)
+            looked.append(f"the bundled set of {len(_bundle())} characters")
+            where = "bundled hanzi data"
+    if medians is None:
+        raise InputError(
+            f"char: {char!r} (U+{ord(char):04X}) not found; looked in {'; '.join(looked)}"
+        )
+    if not isinstance(medians, list):
+        raise InputError(
+            f"{where}: medians of {char!r} are a JSON {type(medians).__name__}, "
+            "expected a list of strokes"
+        )
+    return Strokes(paths=tuple(medians), source=f"hanzi {char}")
+
+
+def hanzi_text(text: str, source: str | Path | None = None, *, advance: float = EM) -> Strokes:
+    """Strokes of several Chinese characters laid left to right.
+
+    Parameters
+    ----------
+    text
+        The characters; a space leaves an empty cell.
+    source
+        As for :func:`hanzi_strokes`.
+    advance
+        Horizontal distance between successive characters' em boxes, em-box
+        units (> 0); the default 1024 puts the boxes side by side.
+
+    Returns
+    -------
+    Strokes
+        All strokes, character after character, in em-box units, y up; the first
+        character's box starts at ``x = 0``.
+
+    Raises
+    ------
+    InputError
+        If ``text`` is empty or only spaces, ``advance`` is not > 0, or any
+        character is not found (as :func:`hanzi_strokes`).
+    """
+    if not isinstance(text, str):
+        raise InputError(f"text: got {type(text).__name__}, expected a str")
+    if not text.strip():
+        raise InputError(f"text: got {text!r}, expected at least one character")
+    step = as_float("advance", advance, positive=True)
+    paths: list[Any] = []
+    for i, ch in enumerate(text):
+        if ch.isspace():
+            continue
+        shift = np.array([i * step, 0.0])
+        paths.extend(p + shift for p in hanzi_strokes(ch, source).paths)
+    return Strokes(paths=tuple(paths), source=f"hanzi {text}")
