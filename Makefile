@@ -33,6 +33,7 @@ bench: $(STAMP)
 	$(BIN)/python bench/engine.py
 	$(BIN)/python bench/sim.py
 	$(BIN)/python bench/resegment.py
+	$(BIN)/python bench/calligraphy.py
 
 clean:
 	rm -rf $(VENV) out .pytest_cache .mypy_cache .ruff_cache
