@@ -63,7 +63,7 @@ def test_empty_stroke_list() -> None:
 
 def test_one_point_stroke() -> None:
     with pytest.raises(InputError, match=r"stroke 1: got 1 point\(s\), expected at least 2"):
-        Strokes(paths=(np.zeros((2, 2)) + [[0, 0], [1, 0]], np.array([[3.0, 4.0]])))
+        Strokes(paths=(np.array([[0.0, 0.0], [1.0, 0.0]]), np.array([[3.0, 4.0]])))
 
 
 def test_repeated_points_name_the_stroke() -> None:

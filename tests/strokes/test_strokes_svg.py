@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 from pathlib import Path
 
 import numpy as np
@@ -55,7 +56,7 @@ def test_transform_and_cubic(tmp_path: Path) -> None:
     exact[:, 1] = -exact[:, 1]
     # every vertex lies on the curve (on a dense polyline of it, chord error ~1e-6) ...
     on_curve = np.min(
-        [segment_distances(curve, a, b) for a, b in zip(exact[:-1], exact[1:], strict=True)],
+        [segment_distances(curve, a, b) for a, b in itertools.pairwise(exact)],
         axis=0,
     )
     assert on_curve.max() < 1e-5
@@ -64,7 +65,7 @@ def test_transform_and_cubic(tmp_path: Path) -> None:
     hi = np.array([150.0, 150.0])
     tol = 1e-3 * float(np.hypot(*(hi - lo)))
     dist = np.min(
-        [segment_distances(exact, a, b) for a, b in zip(curve[:-1], curve[1:], strict=True)],
+        [segment_distances(exact, a, b) for a, b in itertools.pairwise(curve)],
         axis=0,
     )
     assert dist.max() <= tol * 1.01

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import time
 
 import numpy as np
@@ -22,7 +23,7 @@ def _noisy_polyline(
     """Points every ``step`` along the corner polyline, plus uniform noise; corner indices."""
     parts = [_CORNERS[:1]]
     index = [0]
-    for a, b in zip(_CORNERS[:-1], _CORNERS[1:], strict=True):
+    for a, b in itertools.pairwise(_CORNERS):
         n = int(np.ceil(np.linalg.norm(b - a) / step))
         t = np.linspace(0.0, 1.0, n + 1)[1:, None]
         parts.append(a + t * (b - a))
@@ -38,7 +39,7 @@ def _max_excess(stroke: np.ndarray, idx: np.ndarray) -> float:
     test: the foot of the perpendicular clamped to the segment.
     """
     worst = 0.0
-    for a, b in zip(idx[:-1], idx[1:], strict=True):
+    for a, b in itertools.pairwise(idx):
         p0, p1 = stroke[a], stroke[b]
         for q in stroke[a : b + 1]:
             v = p1 - p0

@@ -49,7 +49,18 @@ def segment_distances(points: FloatArray, a: FloatArray, b: FloatArray) -> Float
 
 
 def segment_distances_pairwise(p: FloatArray, a: FloatArray, b: FloatArray) -> FloatArray:
-    """Distance of each ``p[i]`` to the segment ``a[i]``-``b[i]``; all ``(N, 2)``."""
+    """Distance of each point ``p[i]`` to its own segment ``a[i]``-``b[i]``.
+
+    Parameters
+    ----------
+    p, a, b
+        ``(N, 2)`` points and segment endpoints, one length unit.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(N,)`` distances, same unit.
+    """
     ab = b - a
     ap = p - a
     denom = np.einsum("ij,ij->i", ab, ab)
@@ -60,17 +71,11 @@ def segment_distances_pairwise(p: FloatArray, a: FloatArray, b: FloatArray) -> F
     return np.hypot(diff[:, 0], diff[:, 1])
 
 
-def _fits(stroke: FloatArray, i: int, j: int, threshold: float) -> tuple[bool, int, float]:
-    """Whether points ``i..j`` lie within ``threshold`` of segment ``i``-``j``.
-
-    Returns the verdict, the index of the farthest inner point and its distance.
-    """
+def _fits(stroke: FloatArray, i: int, j: int, threshold: float) -> bool:
+    """Whether points ``i..j`` all lie within ``threshold`` of segment ``i``-``j``."""
     if j - i < 2:
-        return True, i, 0.0
-    d = segment_distances(stroke[i + 1 : j], stroke[i], stroke[j])
-    k = int(np.argmax(d))
-    far = float(d[k])
-    return far <= threshold, i + 1 + k, far
+        return True
+    return bool(segment_distances(stroke[i + 1 : j], stroke[i], stroke[j]).max() <= threshold)
 
 
 def turning_points(stroke: Any, threshold: float) -> IndexArray:
@@ -144,6 +149,8 @@ def _farthest_batched(
     seg = np.repeat(np.arange(lo.size), inner)
     starts = np.cumsum(inner) - inner
     idx = np.arange(seg.size) - starts[seg] + lo[seg] + 1
+    # Distance to each chord as a segment, not as a line: a stroke that doubles
+    # back lies on the line through its ends (see turning_points).
     d = segment_distances_pairwise(pts[idx], pts[lo][seg], pts[hi][seg])
     far = np.maximum.reduceat(d, starts)
     # the first point of each interval that attains its maximum, as np.argmax
@@ -212,7 +219,7 @@ def _merge(pts: FloatArray, ends: IndexArray, threshold: float) -> IndexArray:
         if merged[-1] == int(ends[n - 2]) and stuck[n - 2]:
             fits = False
         else:
-            fits = _fits(pts, merged[-1], nxt, threshold)[0]
+            fits = _fits(pts, merged[-1], nxt, threshold)
         if not fits:
             merged.append(pending)
         pending = nxt
