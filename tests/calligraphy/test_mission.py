@@ -145,3 +145,14 @@ def test_bad_options() -> None:
         WritingOptions(size_m=0.0)
     with pytest.raises(InputError, match="board kind: got 'floor'"):
         Board("floor")  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize("mode", ["fixed", "free"])
+def test_resegmentation_lowers_the_cost_and_keeps_fidelity(mode: str) -> None:
+    strokes = hanzi_strokes("永")
+    before = plan_writing(strokes, options=WritingOptions(resegment="off"))
+    after = plan_writing(strokes, options=WritingOptions(resegment=mode))  # type: ignore[arg-type]
+    assert after.fit.cost < before.fit.cost
+    assert after.faithful and after.fit.verification.max_excess <= 1e-9
+    if mode == "fixed":
+        assert after.trajectory.duration == pytest.approx(before.trajectory.duration, rel=1e-12)

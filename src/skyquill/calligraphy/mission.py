@@ -28,6 +28,7 @@ import itertools
 import math
 import time
 from dataclasses import dataclass, field
+from typing import Literal
 
 import numpy as np
 
@@ -35,7 +36,7 @@ from skyquill.calligraphy.board import Board
 from skyquill.errors import InfeasibleError, InputError
 from skyquill.geometry import polyline_distance
 from skyquill.limits import DerivativeLimit, vehicle_limits
-from skyquill.optimize import Boundary, PointDeviation, SmoothingProblem, solve
+from skyquill.optimize import Boundary, PointDeviation, SmoothingProblem, resegment, solve
 from skyquill.optimize.solve import FitResult
 from skyquill.optimize.timing import allocate_path_times
 from skyquill.strokes import Strokes, turning_points
@@ -72,6 +73,14 @@ class WritingOptions:
     brush_length_m
         Tip to vehicle distance along the board normal, m (the default
         simulated vehicle's brush).
+    resegment
+        Time re-segmentation after the first feasible, faithful plan (paper
+        000 §5.4): ``"fixed"`` keeps the total time, ``"free"`` lets it move
+        at a time penalty that makes the initial total time stationary under
+        uniform scaling (without a penalty the jerk cost falls for ever as
+        time grows); ``"off"`` skips it.
+    resegment_iterations
+        Descent steps at most (each is one solve and one analytic gradient).
     stretch_factor, max_stretches
         Timing stretch when infeasible or unfaithful.
     """
@@ -89,6 +98,8 @@ class WritingOptions:
     knot_interval: float = 0.05
     degree: int = 5
     brush_length_m: float = 0.3
+    resegment: Literal["off", "fixed", "free"] = "fixed"
+    resegment_iterations: int = 10
     stretch_factor: float = 1.25
     max_stretches: int = 8
 
@@ -104,6 +115,11 @@ class WritingOptions:
             as_int("coupled", self.coupled, low=3, high=1024)
         as_int("degree", self.degree, low=3, high=7)
         as_int("max_stretches", self.max_stretches, low=0)
+        as_int("resegment_iterations", self.resegment_iterations, low=0)
+        if self.resegment not in ("off", "fixed", "free"):
+            raise InputError(
+                f"resegment: got {self.resegment!r}, expected 'off', 'fixed' or 'free'"
+            )
         if self.stretch_factor <= 1.0:
             raise InputError(f"stretch_factor: got {self.stretch_factor:g}, expected > 1")
 
@@ -240,6 +256,8 @@ class _Route:
         self.role.append(np.full(len(points), role))
 
     def go_to(self, target: FloatArray, include_target: bool = True) -> None:
+        if np.linalg.norm(target - self.points[-1][-1]) < 1e-9:
+            return  # already there: no repeated sample (times must increase)
         line = _segment(self.points[-1][-1], target)
         self.add(line if include_target else line[:-1], -1)
 
@@ -321,9 +339,62 @@ def plan_writing(
         if deviation.max_m <= opts.tolerance or attempt == opts.max_stretches:
             break
         scale *= opts.stretch_factor
+    if opts.resegment != "off" and opts.resegment_iterations > 0:
+        samples = _Samples(points, roles, corners, strokes_world)
+        fit, windows, deviation = _resegment(
+            samples, times * scale, (fit, windows, deviation), opts
+        )
     return Mission(
         fit, board, strokes_world, windows, deviation, scale, time.perf_counter() - start, opts
     )
+
+
+@dataclass(frozen=True)
+class _Samples:
+    """The mission's route: samples (N, 3), roles (N,), corner indices, the input strokes."""
+
+    points: FloatArray
+    roles: FloatArray
+    corners: FloatArray
+    strokes_world: tuple[FloatArray, ...]
+
+
+def _resegment(
+    samples: _Samples,
+    times: FloatArray,
+    current: tuple[FitResult, tuple[tuple[float, float], ...], Deviation],
+    opts: WritingOptions,
+) -> tuple[FitResult, tuple[tuple[float, float], ...], Deviation]:
+    """Paper 000 §5.4 on the mission's sample times; keep the result only if still faithful."""
+    fit = current[0]
+    n_ctrl = fit.trajectory.control_points.shape[0]
+
+    def make(ts: FloatArray) -> SmoothingProblem:
+        return _problem(samples.points, samples.roles, samples.corners, ts, opts, n_ctrl=n_ctrl)
+
+    penalty = 0.0
+    if opts.resegment == "free":
+        # Uniform scaling by k multiplies the jerk energy by k^-5: this rho
+        # makes the current total time stationary, so the descent trades time
+        # between segments and moves the total only where that pays.
+        penalty = 5.0 * fit.cost_terms["smoothness"] / float(times[-1])
+    try:
+        result = resegment(
+            samples.points,
+            times,
+            make,
+            mode="free" if opts.resegment == "free" else "fixed",
+            time_penalty=penalty,
+            max_iter=opts.resegment_iterations,
+        )
+    except InfeasibleError:
+        return current
+    strokes = samples.strokes_world
+    windows = _pen_windows(samples.roles, result.times, len(strokes))
+    deviation = measure_deviation(result.result.trajectory, windows, strokes)
+    if deviation.max_m > max(opts.tolerance, current[2].max_m):
+        return current  # never trade fidelity for smoothness
+    return result.result, windows, deviation
 
 
 def _turning_samples(
@@ -350,6 +421,8 @@ def _problem(
     corners: FloatArray,
     times: FloatArray,
     opts: WritingOptions,
+    *,
+    n_ctrl: int | None = None,
 ) -> SmoothingProblem:
     duration = float(times[-1])
     stroke = roles >= 0
@@ -362,7 +435,7 @@ def _problem(
     return SmoothingProblem(
         dim=3,
         degree=opts.degree,
-        n_ctrl=max(1, math.ceil(duration / opts.knot_interval)) + opts.degree,
+        n_ctrl=n_ctrl or max(1, math.ceil(duration / opts.knot_interval)) + opts.degree,
         duration=duration,
         smoothness={3: 1.0},
         deviations=tuple(deviations),

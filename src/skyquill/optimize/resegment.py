@@ -322,10 +322,17 @@ def _check_problem(problem: SmoothingProblem, t: FloatArray, n_ctrl: int | None)
         )
 
 
-def _matches(term_times: FloatArray, t: FloatArray) -> bool:
-    return term_times.shape == t.shape and bool(
-        np.all(np.abs(term_times - t) <= 1e-12 * max(1.0, float(t[-1])))
-    )
+def _positions(term_times: FloatArray, t: FloatArray) -> NDArray[np.intp] | None:
+    """Indices of ``term_times`` in ``t`` when every one is one of the moving times, else None.
+
+    A term may use a subset of the times (a writing mission weights stroke
+    samples, corners and transits differently); its points move with theirs.
+    """
+    tol = 1e-12 * max(1.0, float(t[-1]))
+    idx = np.clip(np.searchsorted(t, term_times - tol), 0, t.size - 1)
+    if term_times.size and bool(np.all(np.abs(t[idx] - term_times) <= tol)):
+        return idx
+    return None
 
 
 def time_gradient(
@@ -390,8 +397,9 @@ def _lagrangian_gradient(
         # g_s = dL/ds_i for the points at term_times; s_i = alpha * t_i.
         nonlocal g_alpha
         g_alpha += float(term_times @ g_s)
-        if _matches(term_times, t):
-            grad_t[:] += alpha * g_s
+        idx = _positions(term_times, t)
+        if idx is not None:
+            np.add.at(grad_t, idx, alpha * g_s)
 
     moving_boundary = any(
         bc.order > 0 and any(v is not None and bool(np.any(v)) for v in (bc.start, bc.end))
