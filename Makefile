@@ -34,6 +34,7 @@ bench: $(STAMP)
 	$(BIN)/python bench/sim.py
 	$(BIN)/python bench/resegment.py
 	$(BIN)/python bench/calligraphy.py
+	$(BIN)/python bench/paper000_figs.py
 
 clean:
 	rm -rf $(VENV) out .pytest_cache .mypy_cache .ruff_cache
