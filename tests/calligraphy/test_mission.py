@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 from skyquill.calligraphy.board import Board
 from skyquill.calligraphy.mission import (
@@ -14,7 +16,7 @@ from skyquill.calligraphy.mission import (
     plan_writing,
 )
 from skyquill.calligraphy.show import layout, plan_show
-from skyquill.errors import InfeasibleError, InputError
+from skyquill.errors import InfeasibleError, InputError, SkyquillError
 from skyquill.strokes import Strokes, hanzi_strokes, text_strokes
 from skyquill.trajectory import SplineTrajectory
 
@@ -156,3 +158,40 @@ def test_resegmentation_lowers_the_cost_and_keeps_fidelity(mode: str) -> None:
     assert after.faithful and after.fit.verification.max_excess <= 1e-9
     if mode == "fixed":
         assert after.trajectory.duration == pytest.approx(before.trajectory.duration, rel=1e-12)
+
+
+def test_a_million_points_is_refused_quickly() -> None:
+    import time
+
+    t = np.linspace(0.0, 60.0, 1_000_000)
+    huge = Strokes(paths=(np.column_stack([np.cos(t), np.sin(t) + 0.001 * t]),))
+    start = time.perf_counter()
+    with pytest.raises(InputError, match=r"strokes: got 1,000,000 points, expected at most"):
+        plan_writing(huge)
+    assert time.perf_counter() - start < 2.0
+
+
+@settings(max_examples=15, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(
+    st.lists(
+        st.lists(
+            st.tuples(st.floats(-1e3, 1e3, allow_nan=False), st.floats(-1e3, 1e3, allow_nan=False)),
+            min_size=0,
+            max_size=12,
+        ),
+        min_size=0,
+        max_size=3,
+    )
+)
+def test_random_strokes_through_the_whole_pipeline(paths: list[list[tuple[float, float]]]) -> None:
+    """Only skyquill's own errors, or a plan that respects the limits."""
+    try:
+        mission = plan_writing(
+            Strokes(paths=tuple(np.array(p, dtype=float).reshape(-1, 2) for p in paths)),
+            options=WritingOptions(resegment="off", max_stretches=2),
+        )
+    except SkyquillError as exc:
+        assert str(exc)
+        return
+    assert mission.fit.verification.max_excess <= 1e-9
+    assert np.isfinite(mission.deviation.max_m)

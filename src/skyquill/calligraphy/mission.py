@@ -45,6 +45,8 @@ from skyquill.validation import FloatArray, as_array, as_float, as_int
 
 #: Spacing of the samples that hold lifts and transits near their straight lines, m.
 TRANSIT_SPACING_M = 0.01
+#: Largest input a mission takes, points: a tablet at 200 Hz for 15 minutes.
+MAX_INPUT_POINTS = 200_000
 
 
 @dataclass(frozen=True)
@@ -314,6 +316,11 @@ def plan_writing(
         tolerance, even after ``max_stretches`` stretches.
     """
     start = time.perf_counter()
+    if strokes.n_points > MAX_INPUT_POINTS:
+        raise InputError(
+            f"strokes: got {strokes.n_points:,} points, expected at most {MAX_INPUT_POINTS:,} "
+            "(resample the input: a 0.5 m character needs a few hundred)"
+        )
     opts = options or WritingOptions()
     board = board or Board()
     home_pos = None if home is None else as_array("home", home, shape=(3,))

@@ -4,6 +4,10 @@ Each drone gets its own board and home, its mission is planned in a process
 of its own (planning is CPU-bound and independent), they all start together,
 and the pairwise separation is checked over the whole flight, take-off and
 landing included: a violation is an error.
+
+For large shows the planning can go to a ``dask.distributed`` cluster instead
+of the local process pool (``plan_show(..., scheduler="tcp://host:8786")``,
+needs ``pip install 'skyquill[dask]'``); the missions are the same.
 """
 
 from __future__ import annotations
@@ -11,16 +15,25 @@ from __future__ import annotations
 from collections.abc import Sequence
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
+from types import ModuleType
+from typing import Any
 
 import numpy as np
 
 from skyquill.calligraphy.board import Board
 from skyquill.calligraphy.mission import Mission, WritingOptions, check_separation, plan_writing
+from skyquill.errors import InputError
 from skyquill.strokes import Strokes
 from skyquill.validation import FloatArray, as_float, as_int
 
 #: Extra room between boards beyond the required separation, m (lifts, transits).
 BOARD_MARGIN_M = 0.25
+
+#: How long to wait for a ``dask.distributed`` scheduler to answer, s.
+SCHEDULER_TIMEOUT_S = 5.0
+
+#: One drone's planning job: the arguments of :func:`plan_writing`.
+Job = tuple[Strokes, Board, WritingOptions, FloatArray]
 
 
 @dataclass(frozen=True)
@@ -51,6 +64,8 @@ def plan_show(
     options: WritingOptions | None = None,
     separation_m: float = 1.0,
     workers: int | None = None,
+    *,
+    scheduler: str | None = None,
 ) -> Show:
     """Plan one mission per part (one drone each) and check their separation.
 
@@ -64,20 +79,83 @@ def plan_show(
         Minimum distance between any two drones at any time, m.
     workers
         Processes for planning; ``None``: one per drone up to the CPU count;
-        1 plans in this process.
+        1 plans in this process. Ignored when ``scheduler`` is given.
+    scheduler
+        ``None``: plan locally (see ``workers``). Otherwise the address of a
+        ``dask.distributed`` scheduler (e.g. ``"tcp://127.0.0.1:8786"``) the
+        jobs are submitted to, or ``"local"``: a
+        ``distributed.LocalCluster(n_workers=2, threads_per_worker=1,
+        processes=False)`` started for this call and closed after it. Needs
+        ``pip install 'skyquill[dask]'`` here, and skyquill on a remote
+        cluster's workers. The missions are the same as planned locally.
+
+    Returns
+    -------
+    Show
+        The missions, homes and closest approach.
+
+    Raises
+    ------
+    InputError
+        Separation not positive, dask not installed, or the scheduler not
+        reachable within :data:`SCHEDULER_TIMEOUT_S`.
     """
     opts = options or WritingOptions()
     separation = as_float("separation_m", separation_m, positive=True)
     places = layout(len(parts), opts.size_m, separation)
     jobs = [(part, board, opts, home) for part, (board, home) in zip(parts, places, strict=True)]
-    if len(jobs) == 1 or workers == 1:
-        missions = [plan_writing(*job) for job in jobs]
-    else:
-        with ProcessPoolExecutor(max_workers=workers) as pool:
-            missions = list(pool.map(_plan, jobs))
+    missions = _plan_all(jobs, workers, scheduler)
     closest = check_separation([m.trajectory for m in missions], separation)
     return Show(tuple(missions), tuple(home for _, home in places), closest)
 
 
-def _plan(job: tuple[Strokes, Board, WritingOptions, FloatArray]) -> Mission:
+def _plan_all(jobs: list[Job], workers: int | None, scheduler: str | None) -> list[Mission]:
+    """Plan every job: on a dask cluster, in this process or in a process pool."""
+    if scheduler is not None:
+        return _plan_on_cluster(jobs, scheduler)
+    if len(jobs) == 1 or workers == 1:
+        return [_plan(job) for job in jobs]
+    with ProcessPoolExecutor(max_workers=workers) as pool:
+        return list(pool.map(_plan, jobs))
+
+
+def _plan(job: Job) -> Mission:
     return plan_writing(*job)
+
+
+def _plan_on_cluster(jobs: list[Job], scheduler: str) -> list[Mission]:
+    """Plan the jobs on the ``dask.distributed`` scheduler ``scheduler`` (or a local one)."""
+    if not isinstance(scheduler, str) or not scheduler:
+        raise InputError(f"scheduler: expected an address or 'local', got {scheduler!r}")
+    distributed = _import_distributed()
+    if scheduler != "local":
+        return _plan_with_client(distributed, scheduler, jobs)
+    with distributed.LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=False, dashboard_address=None
+    ) as cluster:
+        return _plan_with_client(distributed, cluster.scheduler_address, jobs)
+
+
+def _import_distributed() -> ModuleType:
+    try:
+        import distributed
+    except ImportError as exc:
+        raise InputError(
+            "scheduler: dask.distributed is not installed; pip install 'skyquill[dask]'"
+        ) from exc
+    return distributed
+
+
+def _plan_with_client(distributed: ModuleType, address: str, jobs: list[Job]) -> list[Mission]:
+    """Submit one task per job to the scheduler at ``address`` and gather the missions."""
+    try:
+        client = distributed.Client(address, timeout=SCHEDULER_TIMEOUT_S, set_as_default=False)
+    except (OSError, TimeoutError, ValueError) as exc:
+        raise InputError(
+            f"scheduler: cannot reach the dask scheduler at {address!r} "
+            f"within {SCHEDULER_TIMEOUT_S:g} s ({exc})"
+        ) from exc
+    with client:
+        futures: list[Any] = client.map(_plan, jobs, pure=False)
+        missions: list[Mission] = client.gather(futures)
+    return missions
