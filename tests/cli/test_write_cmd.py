@@ -57,14 +57,23 @@ def test_write_text_gives_pen_column_and_input_strokes(tmp_path: Path) -> None:
     assert {"max_m", "mean_m", "hausdorff_m"} <= summary["deviation"].keys()
 
 
-def test_write_several_drones(tmp_path: Path) -> None:
-    result = runner.invoke(app, ["write", "一马当先", "--drones", "4", "--out", str(tmp_path)])
+def test_four_drones_write_yi_ma_dang_xian_and_fly(tmp_path: Path) -> None:
+    """Paper 000 Fig. 11b: 一马当先 by four drones at once, each flown in simulation."""
+    result = runner.invoke(
+        app, ["write", "一马当先", "--drones", "4", "--fly", "--out", str(tmp_path)]
+    )
     assert result.exit_code == 0, result.output
     for i in range(4):
         assert (tmp_path / f"trajectory_{i}.csv").exists()
     summary = json.loads((tmp_path / "summary.json").read_text())
     assert summary["min_separation_m"] >= 1.0
     assert len(summary["drones"]) == 4
+    for drone in summary["drones"]:
+        assert drone["faithful"] and drone["max_excess"] <= 1e-9
+        assert drone["flight"]["rmse_m"] < 0.01
+        assert drone["flight"]["saturations"] == {"thrust_max": 0, "thrust_min": 0, "tilt": 0}
+    strokes = json.loads((tmp_path / "input_strokes.json").read_text())
+    assert strokes["first_stroke_of_drone"][-1] == len(strokes["strokes"]) == summary["strokes"]
 
 
 def test_split_text() -> None:

@@ -123,12 +123,13 @@ def write_outputs(show: Any, out: Path, rate: float, fly: bool) -> dict[str, Any
         write_trajectory_csv(out / name, vehicle, rate, pen=mission.pen)
         strokes_json.append([(s + mission.brush_offset).tolist() for s in mission.strokes_world])
         per_drone.append(_drone_summary(mission, name, fly, vehicle))
-    payload: dict[str, Any] = (
-        {"strokes": strokes_json[0]}
-        if len(missions) == 1
-        else {"drones": [{"strokes": s} for s in strokes_json]}
-    )
-    payload["frame"] = "world, z up, m; the vehicle's positions (brush tip + brush offset)"
+    firsts = np.cumsum([0] + [len(s) for s in strokes_json]).tolist()
+    payload: dict[str, Any] = {
+        "strokes": [stroke for drone in strokes_json for stroke in drone],
+        "frame": "world, z up, m; the vehicle's positions (brush tip + brush offset)",
+        # Drone i wrote strokes[first[i]:first[i + 1]] (its trajectory_<i>.csv).
+        "first_stroke_of_drone": firsts,
+    }
     (out / "input_strokes.json").write_text(json.dumps(payload) + "\n", encoding="utf-8")
     plot_missions(missions, out / "plot.png", "skyquill write")
     closest = show.min_separation_m if len(missions) > 1 else None
