@@ -94,3 +94,13 @@ def test_bad_input(tmp_path: Path, args: list[str], message: str) -> None:
     result = runner.invoke(app, [*args, "--out", str(tmp_path / "o")])
     assert result.exit_code == 2, result.output
     assert message in " ".join(result.output.split())
+
+
+def test_wall_board(tmp_path: Path) -> None:
+    result = runner.invoke(app, ["write", "Hi", "--board", "wall", "--out", str(tmp_path)])
+    assert result.exit_code == 0, result.output
+    strokes = json.loads((tmp_path / "input_strokes.json").read_text())["strokes"]
+    # On the wall y = 0 the vehicle flies the brush length in front of it.
+    assert np.allclose([p[1] for s in strokes for p in s], -0.3)
+    bad = runner.invoke(app, ["write", "Hi", "--board", "wall", "--fly", "--out", str(tmp_path)])
+    assert bad.exit_code == 2

@@ -16,7 +16,7 @@ from collections.abc import Sequence
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
 from types import ModuleType
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 
@@ -46,16 +46,26 @@ class Show:
 
 
 def layout(
-    n: int, size_m: float, separation_m: float, height_m: float = 1.0
+    n: int,
+    size_m: float,
+    separation_m: float,
+    *,
+    height_m: float = 1.0,
+    kind: Literal["horizontal", "wall"] = "horizontal",
+    lift_m: float = 0.05,
 ) -> list[tuple[Board, FloatArray]]:
-    """Boards side by side along x, each with a home on the ground 1 m in front of it."""
+    """Boards side by side along x, each with a home on the ground 1 m in front of it.
+
+    A horizontal board lies at ``height_m``; a wall is the plane ``y = 0`` with
+    the character's bottom at ``height_m``.
+    """
     as_int("drones", n, low=1, high=64)
     pitch = as_float("size_m", size_m, positive=True) + separation_m + BOARD_MARGIN_M
     out = []
     for i in range(n):
         origin = np.array([i * pitch, 0.0, height_m])
         home = np.array([i * pitch + 0.5 * size_m, -1.0, 0.0])
-        out.append((Board("horizontal", origin), home))
+        out.append((Board(kind, origin, lift_m), home))
     return out
 
 
@@ -66,6 +76,8 @@ def plan_show(
     workers: int | None = None,
     *,
     scheduler: str | None = None,
+    board_kind: Literal["horizontal", "wall"] = "horizontal",
+    lift_m: float = 0.05,
 ) -> Show:
     """Plan one mission per part (one drone each) and check their separation.
 
@@ -102,7 +114,7 @@ def plan_show(
     """
     opts = options or WritingOptions()
     separation = as_float("separation_m", separation_m, positive=True)
-    places = layout(len(parts), opts.size_m, separation)
+    places = layout(len(parts), opts.size_m, separation, kind=board_kind, lift_m=lift_m)
     jobs = [(part, board, opts, home) for part, (board, home) in zip(parts, places, strict=True)]
     missions = _plan_all(jobs, workers, scheduler)
     closest = check_separation([m.trajectory for m in missions], separation)

@@ -80,6 +80,12 @@ def write(
     drones: Annotated[int, typer.Option(help="Drones writing at once, boards side by side.")] = 1,
     rate: Annotated[float, typer.Option(help="Sample rate of the CSVs, Hz.")] = 100.0,
     fly: Annotated[bool, typer.Option(help="Also fly each drone in simulation (RPT).")] = False,
+    board: Annotated[str, typer.Option(help="horizontal (the paper's) or wall.")] = "horizontal",
+    lift: Annotated[float, typer.Option(help="Brush lift between strokes, m.")] = 0.05,
+    scheduler: Annotated[
+        str | None,
+        typer.Option(help="dask.distributed scheduler address (or 'local') for large shows."),
+    ] = None,
 ) -> None:
     """Plan pen-up / pen-down writing flights; write CSVs, input_strokes.json, plot, summary."""
     from skyquill.calligraphy.mission import WritingOptions
@@ -99,7 +105,13 @@ def write(
         else:
             parts = [load_input(text, strokes, svg, hanzi, font)]
         with console.status(f"planning {len(parts)} writing flight(s)"):
-            show = plan_show(parts, options)
+            show = plan_show(
+                parts,
+                options,
+                scheduler=scheduler,
+                board_kind=_board_kind(board, fly),
+                lift_m=lift,
+            )
         summary = write_outputs(show, out, rate, fly)
     console.print(
         f"[green]done[/] {out}: {summary['duration_s']:.1f} s of flight, planned in "
@@ -107,6 +119,14 @@ def write(
         f" mm, max excess {summary['max_excess']:.1e}",
         highlight=False,
     )
+
+
+def _board_kind(name: str, fly: bool) -> Any:
+    if name not in ("horizontal", "wall"):
+        raise InputError(f"--board: got {name!r}, expected horizontal or wall")
+    if fly and name == "wall":
+        raise InputError("--fly: got --board wall, expected horizontal (the simulated board)")
+    return name
 
 
 def write_outputs(show: Any, out: Path, rate: float, fly: bool) -> dict[str, Any]:
