@@ -49,7 +49,7 @@ def read_points_csv(path: str | Path) -> tuple[FloatArray, FloatArray | None]:
     data = np.empty((len(rows), len(columns)))
     for r, row in enumerate(rows):
         for c, (name, i) in enumerate(zip(columns, index, strict=True)):
-            data[r, c] = _cell(file.name, r + 2, name, row, i)
+            data[r, c] = parse_cell(file.name, r + 2, name, row, i)
     if data.shape[0] < 2:
         raise InputError(f"{file.name}: got {data.shape[0]} data row(s), expected at least 2")
     has_t = columns[-1] == "t"
@@ -57,7 +57,8 @@ def read_points_csv(path: str | Path) -> tuple[FloatArray, FloatArray | None]:
     return points, (data[:, -1] if has_t else None)
 
 
-def _cell(name: str, line: int, column: str, row: list[str], i: int) -> float:
+def parse_cell(name: str, line: int, column: str, row: list[str], i: int) -> float:
+    """Cell ``i`` of a CSV ``row`` as a finite float; InputError naming file, line, column."""
     text = row[i].strip() if i < len(row) else ""
     try:
         value = float(text)

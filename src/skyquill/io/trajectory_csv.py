@@ -11,7 +11,6 @@ writes the time series of a :class:`~skyquill.sim.Flight`.
 from __future__ import annotations
 
 import csv
-import math
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
@@ -20,6 +19,7 @@ import numpy as np
 from scipy.interpolate import BSpline, CubicHermiteSpline, make_interp_spline
 
 from skyquill.errors import InputError
+from skyquill.io.points import parse_cell
 from skyquill.sim.result import Flight
 from skyquill.trajectory import Samples, sample
 from skyquill.validation import FloatArray, as_array, as_int
@@ -280,17 +280,8 @@ def _check_header(name: str, header: list[str]) -> None:
 
 
 def _cell(name: str, line: int, column: str, row: list[str], i: int) -> float:
-    text = row[i].strip() if i < len(row) else ""
-    try:
-        value = float(text)
-    except ValueError:
-        raise InputError(
-            f"{name} line {line}, column {column}: got {text!r}, expected a number"
-        ) from None
-    if not math.isfinite(value):
-        raise InputError(
-            f"{name} line {line}, column {column}: got {text!r}, expected a finite number"
-        )
+    value = parse_cell(name, line, column, row, i)
+    text = row[i].strip()
     limit = 1e7 if column == "t" else MAX_VALUE
     if abs(value) > limit:
         raise InputError(
