@@ -82,6 +82,9 @@ def write(
     fly: Annotated[bool, typer.Option(help="Also fly each drone in simulation (RPT).")] = False,
     board: Annotated[str, typer.Option(help="horizontal (the paper's) or wall.")] = "horizontal",
     lift: Annotated[float, typer.Option(help="Brush lift between strokes, m.")] = 0.05,
+    tilt_compensation: Annotated[
+        bool, typer.Option(help="Plan against the hanging brush's swing (horizontal board).")
+    ] = False,
     scheduler: Annotated[
         str | None,
         typer.Option(help="dask.distributed scheduler address (or 'local') for large shows."),
@@ -94,7 +97,14 @@ def write(
 
     with user_errors():
         rate = _rate(rate)
-        options = WritingOptions(size_m=size, vmax=vmax, amax=amax, jmax=jmax, coupled=coupled)
+        options = WritingOptions(
+            size_m=size,
+            vmax=vmax,
+            amax=amax,
+            jmax=jmax,
+            coupled=coupled,
+            tilt_compensation=tilt_compensation,
+        )
         if drones != 1:
             if text is None or strokes is not None or svg is not None:
                 raise InputError("--drones: several drones need TEXT to share out, got a file")
