@@ -8,7 +8,7 @@ bench/results/calligraphy.json."
 This run plans each bundled Make Me a Hanzi character on a 0.5 m horizontal
 board with the default limits (1 m/s, 2 m/s^2, 10 m/s^3, per axis), starting
 and ending in hover, with the default time re-segmentation (total time fixed,
-10 analytic-gradient steps) included in the planning time. BLAS is pinned to
+8 analytic-gradient steps) included in the planning time. BLAS is pinned to
 one thread; medians over 3 runs per character.
 
 Run: ``.venv/bin/python bench/calligraphy.py``.

@@ -112,7 +112,7 @@ class WritingOptions:
     degree: int = 5
     brush_length_m: float = 0.3
     resegment: Literal["off", "fixed", "free"] = "fixed"
-    resegment_iterations: int = 10
+    resegment_iterations: int = 8
     tilt_compensation: bool = False
     stretch_factor: float = 1.25
     max_stretches: int = 8
@@ -350,7 +350,10 @@ def plan_writing(
     for attempt in range(opts.max_stretches + 1):
         last = attempt == opts.max_stretches
         try:
-            fit, windows, deviation, scaled_times = _plan_at(samples, times * scale, opts)
+            # Re-segmenting every attempt is needed only when the swung tip decides.
+            fit, windows, deviation, scaled_times = _plan_at(
+                samples, times * scale, opts, resegment=compensate
+            )
         except InfeasibleError:
             if last:
                 raise
@@ -361,6 +364,10 @@ def plan_writing(
         if deviation.max_m <= opts.tolerance or last:
             break
         scale *= opts.stretch_factor  # slower: less tracking error and less brush swing
+    if not compensate and opts.resegment != "off" and opts.resegment_iterations > 0:
+        fit, windows, deviation, _ = _resegment(
+            samples, scaled_times, (fit, windows, deviation), opts
+        )
     return Mission(
         fit, board, strokes_world, windows, deviation, scale, time.perf_counter() - start, opts
     )
@@ -377,13 +384,13 @@ class _Samples:
 
 
 def _plan_at(
-    samples: _Samples, times: FloatArray, opts: WritingOptions
+    samples: _Samples, times: FloatArray, opts: WritingOptions, *, resegment: bool
 ) -> tuple[FitResult, tuple[tuple[float, float], ...], Deviation, FloatArray]:
     """Solve at ``times``, then re-segment if asked; the times it ends with."""
     fit = solve(_problem(samples.points, samples.roles, samples.corners, times, opts))
     windows = _pen_windows(samples.roles, times, len(samples.strokes_world))
     deviation = measure_deviation(fit.trajectory, windows, samples.strokes_world)
-    if opts.resegment == "off" or opts.resegment_iterations == 0:
+    if not resegment or opts.resegment == "off" or opts.resegment_iterations == 0:
         return fit, windows, deviation, times
     return _resegment(samples, times, (fit, windows, deviation), opts)
 
