@@ -10,6 +10,7 @@ import typer
 from skyquill.cli.main import OutDir, app, console, user_errors
 from skyquill.errors import InputError
 from skyquill.io.points import read_points_csv, write_json, write_trajectory_csv
+from skyquill.io.spline_json import write_spline_json
 from skyquill.optimize.fit import FitOptions, PointFit, fit_points
 from skyquill.validation import FloatArray
 
@@ -65,6 +66,7 @@ def run_fit(
     with console.status(f"fitting {points.shape[0]} points ({title})"):
         fit = fit_points(points, times, options)
     rows = write_trajectory_csv(out / "trajectory.csv", fit.result.trajectory, rate)
+    write_spline_json(out / "trajectory.json", fit.result.trajectory)
     with console.status("plotting"):
         plot_fit(fit, out / "plot.png", title)
     summary = fit_summary(fit, rows, rate)

@@ -15,6 +15,7 @@ from skyquill.cli.fit_cmd import _rate
 from skyquill.cli.main import OutDir, app, console, user_errors
 from skyquill.errors import InputError
 from skyquill.io.points import write_json, write_trajectory_csv
+from skyquill.io.spline_json import write_spline_json
 
 #: How far the simulated board is raised into the brush's planned path, m.
 PRESS_M = 0.002
@@ -151,6 +152,11 @@ def write_outputs(show: Any, out: Path, rate: float, fly: bool) -> dict[str, Any
         name = "trajectory.csv" if len(missions) == 1 else f"trajectory_{i}.csv"
         vehicle = mission.vehicle_trajectory()
         write_trajectory_csv(out / name, vehicle, rate, pen=mission.pen)
+        write_spline_json(
+            out / name.replace(".csv", ".json"),
+            vehicle,
+            pen_windows_s=[list(w) for w in mission.pen_windows],
+        )
         strokes_json.append([(s + mission.brush_offset).tolist() for s in mission.strokes_world])
         per_drone.append(_drone_summary(mission, name, fly, vehicle))
     firsts = np.cumsum([0] + [len(s) for s in strokes_json]).tolist()
