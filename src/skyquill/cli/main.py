@@ -48,9 +48,9 @@ def user_errors() -> Iterator[None]:
 
 
 # Register the commands (each module adds its own to ``app``).
-from skyquill.cli import fit_cmd, fly_cmd, reproduce_cmd, write_cmd  # noqa: E402
+from skyquill.cli import export_cmd, fit_cmd, fly_cmd, reproduce_cmd, write_cmd  # noqa: E402
 
-__all__ = ["app", "fit_cmd", "fly_cmd", "reproduce_cmd", "write_cmd"]
+__all__ = ["app", "export_cmd", "fit_cmd", "fly_cmd", "reproduce_cmd", "write_cmd"]
 
 if __name__ == "__main__":  # pragma: no cover
     app()

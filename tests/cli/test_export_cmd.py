@@ -1,0 +1,113 @@
+"""``skyquill export``: every format from a fit and from a several-drone write; bad input."""
+
+from __future__ import annotations
+
+import json
+import zipfile
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from skyquill.cli.main import app
+
+EXAMPLES = Path(__file__).parents[2] / "examples"
+runner = CliRunner()
+
+
+@pytest.fixture(scope="module")
+def fitted(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    out = tmp_path_factory.mktemp("fit")
+    result = runner.invoke(
+        app, ["fit", str(EXAMPLES / "segments.csv"), "--timing", "segments", "--out", str(out)]
+    )
+    assert result.exit_code == 0, result.output
+    return out
+
+
+@pytest.mark.parametrize("fmt", ["crazyswarm", "skyc", "px4", "csv", "json"])
+def test_every_format_from_a_fit(fitted: Path, tmp_path: Path, fmt: str) -> None:
+    out = tmp_path / f"show.{'skyc' if fmt == 'skyc' else 'csv'}"
+    result = runner.invoke(app, ["export", str(fitted), "--format", fmt, "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    summary = json.loads((tmp_path / "show.summary.json").read_text())
+    assert summary["format"] == fmt and summary["files"]
+    for name in summary["files"]:
+        assert Path(name).exists()
+    if fmt == "skyc":
+        with zipfile.ZipFile(summary["files"][0]) as archive:
+            assert "show.json" in archive.namelist()
+
+
+def test_crazyswarm_splits_long_trajectories_and_says_so(fitted: Path, tmp_path: Path) -> None:
+    result = runner.invoke(
+        app, ["export", str(fitted), "--format", "crazyswarm", "--out", str(tmp_path / "cf.csv")]
+    )
+    assert result.exit_code == 0, result.output
+    summary = json.loads((tmp_path / "cf.summary.json").read_text())
+    for name in summary["files"]:
+        rows = Path(name).read_text().strip().splitlines()[1:]
+        assert len(rows) <= 31
+    if len(summary["files"]) > 1:
+        assert "split" in summary["message"]
+
+
+def test_several_drones_give_several_files_or_one_show(tmp_path: Path) -> None:
+    written = tmp_path / "write"
+    result = runner.invoke(app, ["write", "一人", "--drones", "2", "--out", str(written)])
+    assert result.exit_code == 0, result.output
+    csv = runner.invoke(
+        app, ["export", str(written), "--format", "csv", "--out", str(tmp_path / "d.csv")]
+    )
+    assert csv.exit_code == 0, csv.output
+    assert (tmp_path / "d_trajectory_0.csv").exists() and (tmp_path / "d_trajectory_1.csv").exists()
+    show = runner.invoke(
+        app, ["export", str(written), "--format", "skyc", "--out", str(tmp_path / "s.skyc")]
+    )
+    assert show.exit_code == 0, show.output
+    with zipfile.ZipFile(tmp_path / "s.skyc") as archive:
+        data = json.loads(archive.read("show.json"))
+    assert len(data["swarm"]["drones"]) == 2
+
+
+def test_bad_input(tmp_path: Path, fitted: Path) -> None:
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    result = runner.invoke(app, ["export", str(empty), "--out", str(tmp_path / "x.csv")])
+    assert result.exit_code == 2
+    assert "without trajectory.json" in " ".join(result.output.split())
+    result = runner.invoke(
+        app, ["export", str(fitted), "--format", "kml", "--out", str(tmp_path / "x.csv")]
+    )
+    assert result.exit_code == 2 and "--format: got 'kml'" in " ".join(result.output.split())
+    broken = tmp_path / "nan"
+    broken.mkdir()
+    data = json.loads((fitted / "trajectory.json").read_text())
+    data["control_points"][3][0] = float("nan")
+    (broken / "trajectory.json").write_text(json.dumps(data))
+    result = runner.invoke(app, ["export", str(broken), "--out", str(tmp_path / "x.csv")])
+    assert result.exit_code == 2 and "NaN" in " ".join(result.output.split())
+
+
+def test_crazyswarm_round_trip_flies_in_the_simulator(fitted: Path, tmp_path: Path) -> None:
+    """Import the (split) Crazyswarm upload and fly it: the same trajectory, the same limits."""
+    from skyquill.io.crazyswarm import read_crazyswarm
+    from skyquill.io.spline_json import read_spline_json
+    from skyquill.sim import simulate
+
+    runner.invoke(
+        app, ["export", str(fitted), "--format", "crazyswarm", "--out", str(tmp_path / "cf.csv")]
+    )
+    files = json.loads((tmp_path / "cf.summary.json").read_text())["files"]
+    imported = read_crazyswarm([Path(f) for f in files])
+    original = read_spline_json(fitted / "trajectory.json")
+    t = np.linspace(0.0, original.duration, 3000)
+    for order in range(4):
+        assert np.allclose(
+            imported.evaluate(t, order),
+            original.evaluate(t, order),
+            atol=1e-9 * max(1.0, np.abs(original.evaluate(t, order)).max()),
+        )
+    flight = simulate(imported)
+    assert flight.rmse_m < 0.01
