@@ -54,7 +54,6 @@ Cases (the issue's text, quoted):
 from __future__ import annotations
 
 import argparse
-import gc
 import hashlib
 import json
 import math
@@ -62,8 +61,7 @@ import os
 import platform
 import sys
 import time
-from collections.abc import Callable, Iterator
-from contextlib import contextmanager
+from collections.abc import Callable
 from dataclasses import dataclass
 from datetime import UTC, datetime
 from importlib import metadata
@@ -83,6 +81,7 @@ from rich.progress import (
 from rich.table import Table
 from threadpoolctl import threadpool_info, threadpool_limits
 
+from common import gc_off
 from skyquill.errors import InfeasibleError, SolverError
 from skyquill.limits import DerivativeLimit, vehicle_limits
 from skyquill.optimize import (
@@ -160,18 +159,6 @@ class Timing:
         }
 
 
-@contextmanager
-def _gc_off() -> Iterator[None]:
-    gc.collect()
-    enabled = gc.isenabled()
-    gc.disable()
-    try:
-        yield
-    finally:
-        if enabled:
-            gc.enable()
-
-
 def _once(fn: Callable[[], Any]) -> tuple[float, Any]:
     start = time.perf_counter()
     out = fn()
@@ -187,7 +174,7 @@ def measure(
     rejects its result (e.g. a QP backend fell back to another one), it is the
     only measurement reported (``runs = 1``, a cold run, with a note).
     """
-    with _gc_off():
+    with gc_off():
         first, out = _once(fn)
     if first > SLOW_S or (accept is not None and not accept(out)):
         why = (
@@ -200,7 +187,7 @@ def measure(
         out = fn()
     runs = 3 if quick else max(MIN_RUNS, min(MAX_RUNS, int(BUDGET_S / max(first, 1e-6))))
     times = np.empty(runs)
-    with _gc_off():
+    with gc_off():
         for i in range(runs):
             times[i], out = _once(fn)
     return Timing(times, WARMUP, "", out)
@@ -219,7 +206,7 @@ def measure_pair(
     runs = 3 if quick else max(MIN_RUNS, min(MAX_RUNS, int(2 * BUDGET_S / max(slowest, 1e-6))))
     t_ours, t_peer = np.empty(runs), np.empty(runs)
     out_ours = out_peer = None
-    with _gc_off():
+    with gc_off():
         for i in range(runs):
             t_ours[i], out_ours = _once(ours)
             t_peer[i], out_peer = _once(peer)

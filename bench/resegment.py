@@ -51,15 +51,13 @@ Measured per size and route:
 from __future__ import annotations
 
 import argparse
-import gc
 import itertools
 import json
 import math
 import platform
 import sys
 import time
-from collections.abc import Callable, Iterator
-from contextlib import contextmanager
+from collections.abc import Callable
 from datetime import UTC, datetime
 from importlib import metadata
 from pathlib import Path
@@ -68,6 +66,7 @@ from typing import Any, Literal
 import numpy as np
 from threadpoolctl import threadpool_info, threadpool_limits
 
+from common import gc_off
 from skyquill.io.points import read_points_csv
 from skyquill.limits import vehicle_limits
 from skyquill.optimize import SmoothingProblem, solve
@@ -95,18 +94,6 @@ STEP_RULES: tuple[Literal["bb", "double"], ...] = ("bb", "double")
 
 
 # ----------------------------------------------------------------------- timing
-@contextmanager
-def _gc_off() -> Iterator[None]:
-    gc.collect()
-    enabled = gc.isenabled()
-    gc.disable()
-    try:
-        yield
-    finally:
-        if enabled:
-            gc.enable()
-
-
 def measure(fn: Callable[[], Any], min_runs: int, quick: bool) -> dict[str, Any]:
     """``WARMUP`` calls, then timed calls (about ``BUDGET_S`` of work, >= ``min_runs``)."""
     for _ in range(WARMUP):
@@ -116,7 +103,7 @@ def measure(fn: Callable[[], Any], min_runs: int, quick: bool) -> dict[str, Any]
     first = time.perf_counter() - start
     runs = 3 if quick else max(min_runs, min(200, int(BUDGET_S / max(first, 1e-6))))
     times = np.empty(runs)
-    with _gc_off():
+    with gc_off():
         for i in range(runs):
             start = time.perf_counter()
             fn()

@@ -70,6 +70,21 @@ class Trajectory(Protocol):
         ...
 
 
+def evaluation_times(t: object, duration: float) -> FloatArray:
+    """Times ``t`` (N,) checked to lie in ``[0, duration]`` (to round-off), clipped there.
+
+    The check every trajectory's ``evaluate`` shares; :class:`InputError` otherwise.
+    """
+    times = as_array("t", t, ndim=1)
+    tol = 1e-9 * max(1.0, duration)
+    if times.size and (times.min() < -tol or times.max() > duration + tol):
+        raise InputError(
+            f"t: got times in [{times.min():g}, {times.max():g}] s, expected within "
+            f"[0, {duration:g}] s"
+        )
+    return np.clip(times, 0.0, duration)  # only round-off reaches the clip
+
+
 def sample_times(duration: float, rate: float) -> FloatArray:
     """``0, 1/rate, ...`` up to and including ``duration``; shape (N,)."""
     rate = as_float("rate", rate, positive=True)
@@ -152,15 +167,8 @@ class SplineTrajectory:
         -------
         numpy.ndarray, shape (N, d)
         """
-        times = as_array("t", t, ndim=1)
+        times = evaluation_times(t, self.duration)
         as_int("order", order, low=0)
-        tol = 1e-9 * max(1.0, self.duration)
-        if times.size and (times.min() < -tol or times.max() > self.duration + tol):
-            raise InputError(
-                f"t: got times in [{times.min():g}, {times.max():g}] s, expected within "
-                f"[0, {self.duration:g}] s"
-            )
-        times = np.clip(times, 0.0, self.duration)  # only round-off reaches here
         if order > self.degree:
             return np.zeros((times.size, self.dim))
         return np.asarray(self._splines[order](times), dtype=float).reshape(times.size, self.dim)

@@ -36,7 +36,7 @@ from numpy.typing import NDArray
 
 from skyquill.errors import InputError
 from skyquill.io.points import parse_cell
-from skyquill.trajectory import Samples, SplineTrajectory, sample
+from skyquill.trajectory import Samples, SplineTrajectory, evaluation_times, sample
 from skyquill.validation import FloatArray, as_array, as_float, as_int, strictly_increasing
 
 #: Pieces the Crazyflie can hold at once: 4096 B of trajectory memory / 132 B a piece.
@@ -277,14 +277,7 @@ class PolynomialTrajectory:
         return int(self.breaks.size - 1)
 
     def _locate(self, t: FloatArray) -> tuple[FloatArray, NDArray[np.intp]]:
-        times = as_array("t", t, ndim=1)
-        tol = 1e-9 * max(1.0, self.duration)
-        if times.size and (times.min() < -tol or times.max() > self.duration + tol):
-            raise InputError(
-                f"t: got times in [{times.min():g}, {times.max():g}] s, expected within "
-                f"[0, {self.duration:g}] s"
-            )
-        times = np.clip(times, 0.0, self.duration)  # only round-off reaches here
+        times = evaluation_times(t, self.duration)
         # A break belongs to the piece on its right; the end to the last piece.
         idx = np.clip(np.searchsorted(self.breaks, times, side="right") - 1, 0, self.n_pieces - 1)
         return times - self.breaks[idx], idx

@@ -21,7 +21,7 @@ from scipy.interpolate import BSpline, CubicHermiteSpline, make_interp_spline
 from skyquill.errors import InputError
 from skyquill.io.points import parse_cell
 from skyquill.sim.result import Flight
-from skyquill.trajectory import Samples, sample
+from skyquill.trajectory import Samples, evaluation_times, sample
 from skyquill.validation import FloatArray, as_array, as_int
 
 #: Columns :func:`read_trajectory_csv` needs (jerk ``jx,jy,jz`` is optional).
@@ -167,15 +167,8 @@ class SampledTrajectory:
         -------
         numpy.ndarray, shape (N, 3)
         """
-        times = as_array("t", t, ndim=1)
+        times = evaluation_times(t, self.duration)
         as_int("order", order, low=0)
-        tol = 1e-9 * max(1.0, self.duration)
-        if times.size and (times.min() < -tol or times.max() > self.duration + tol):
-            raise InputError(
-                f"t: got times in [{times.min():g}, {times.max():g}] s, expected within "
-                f"[0, {self.duration:g}] s"
-            )
-        times = np.clip(times, 0.0, self.duration)  # only round-off reaches here
         if order >= len(self._interpolants):
             return np.zeros((times.size, 3))
         values = self._interpolants[order](times)
