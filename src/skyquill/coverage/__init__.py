@@ -1,0 +1,1 @@
+"""Area coverage: regions, covering paths, time-optimal jerk-limited speed planning (paper 001)."""

@@ -1,0 +1,121 @@
+"""Regions to cover: GeoJSON Polygon, WKT or a vertex list, in local metric coordinates.
+
+A region is a shapely ``Polygon`` that is valid (no self-intersection), has
+positive area and no holes (holes are not supported yet: said, not ignored).
+:func:`coverage_fraction` measures how much of it a covering path sweeps with
+a disc of the coverage diameter (issue 5's metric).
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import shapely
+from shapely.geometry import LineString, Polygon, shape
+
+from skyquill.errors import InputError
+from skyquill.validation import FloatArray, as_array, as_float
+
+#: Region coordinates beyond this (m) are refused: a local metric frame, not degrees or mm.
+MAX_COORDINATE_M = 1e5
+
+
+def region_from_vertices(vertices: Any, name: str = "vertices") -> Polygon:
+    """A region from its boundary vertices (K, 2), m, in order; closing is optional."""
+    pts = as_array(name, vertices, ndim=2, max_abs=MAX_COORDINATE_M)
+    if pts.shape[1] != 2 or pts.shape[0] < 3:
+        raise InputError(f"{name}: got shape {pts.shape}, expected (K >= 3, 2) boundary vertices")
+    return _checked(Polygon(pts), name)
+
+
+def load_region(source: str | Path) -> Polygon:
+    """Read a region: a ``.geojson``/``.json`` file (Polygon, Feature or one-feature
+    FeatureCollection), a ``.wkt`` file, or a WKT string.
+    """
+    text = str(source)
+    path = Path(text)
+    if text.lstrip().upper().startswith("POLYGON"):
+        return _from_wkt(text, "region")
+    if not path.is_file():
+        raise InputError(f"region: got {text!r}, expected a GeoJSON or WKT file or a WKT string")
+    content = path.read_text(encoding="utf-8")
+    if path.suffix.lower() == ".wkt":
+        return _from_wkt(content, path.name)
+    try:
+        data = json.loads(content)
+    except json.JSONDecodeError as exc:
+        raise InputError(f"{path.name}: got invalid JSON ({exc}), expected GeoJSON") from None
+    return _from_geojson(data, path.name)
+
+
+def _from_wkt(text: str, name: str) -> Polygon:
+    try:
+        geometry = shapely.from_wkt(text.strip())
+    except shapely.errors.GEOSException as exc:
+        raise InputError(f"{name}: got unreadable WKT ({exc}), expected a POLYGON") from None
+    if not isinstance(geometry, Polygon):
+        raise InputError(f"{name}: got a {geometry.geom_type}, expected a Polygon")
+    return _checked(geometry, name)
+
+
+def _from_geojson(data: Any, name: str) -> Polygon:
+    if isinstance(data, dict) and data.get("type") == "FeatureCollection":
+        features = data.get("features") or []
+        if len(features) != 1:
+            raise InputError(
+                f"{name}: got a FeatureCollection of {len(features)} features, expected one"
+            )
+        data = features[0]
+    if isinstance(data, dict) and data.get("type") == "Feature":
+        data = data.get("geometry")
+    if not isinstance(data, dict) or data.get("type") != "Polygon":
+        kind = data.get("type") if isinstance(data, dict) else type(data).__name__
+        raise InputError(f"{name}: got GeoJSON of type {kind!r}, expected a Polygon")
+    try:
+        geometry = shape(data)
+    except (ValueError, TypeError, IndexError, shapely.errors.GEOSException) as exc:
+        raise InputError(f"{name}: got malformed Polygon coordinates ({exc})") from None
+    assert isinstance(geometry, Polygon)
+    return _checked(geometry, name)
+
+
+def _checked(polygon: Polygon, name: str) -> Polygon:
+    coords = np.asarray(polygon.exterior.coords)
+    if not np.all(np.isfinite(coords)) or (coords.size and np.abs(coords).max() > MAX_COORDINATE_M):
+        raise InputError(
+            f"{name}: got non-finite or huge coordinates, expected finite metres within "
+            f"±{MAX_COORDINATE_M:g}"
+        )
+    if polygon.interiors:
+        raise InputError(
+            f"{name}: got a polygon with {len(polygon.interiors)} hole(s), expected none "
+            "(holes are not supported yet)"
+        )
+    if not polygon.is_valid:
+        reason = shapely.is_valid_reason(polygon)
+        raise InputError(f"{name}: got an invalid polygon ({reason}), expected a simple one")
+    if polygon.area <= 0.0:
+        raise InputError(f"{name}: got a polygon of zero area, expected a region")
+    return shapely.normalize(polygon)
+
+
+def check_width(region: Polygon, width: float) -> float:
+    """The coverage diameter ``width`` (m), > 0 and small enough to need a path at all."""
+    w = as_float("width", width, positive=True)
+    if region.buffer(-0.5 * w).is_empty:
+        minx, miny, maxx, maxy = region.bounds
+        raise InputError(
+            f"width: got {w:g} m, expected less than the region's inner width (bounds "
+            f"{maxx - minx:.3g} x {maxy - miny:.3g} m): one disc would already cover it"
+        )
+    return w
+
+
+def coverage_fraction(region: Polygon, path: FloatArray, width: float) -> float:
+    """Area of (region ∩ swept discs of diameter ``width`` along ``path`` (N, >=2)) / area."""
+    pts = as_array("path", path, ndim=2)
+    swept = LineString(pts[:, :2]).buffer(0.5 * as_float("width", width, positive=True))
+    return float(region.intersection(swept).area / region.area)
