@@ -1,0 +1,170 @@
+"""Tests for skyquill.coverage.speed (LP speed planning, §2.1-2.2)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.interpolate import BSpline, CubicSpline, make_interp_spline
+
+from skyquill.coverage.speed import plan_speed
+from skyquill.errors import InputError
+
+
+def _line(length: float) -> BSpline:
+    x = np.linspace(0.0, 1.0, 8)
+    return make_interp_spline(x, np.column_stack([length * x, 0.0 * x]), k=3)
+
+
+def _circle(radius: float = 1.0) -> BSpline:
+    th = np.linspace(0.0, 1.0, 60)
+    pts = np.column_stack([np.cos(2 * np.pi * th), np.sin(2 * np.pi * th)]) * radius
+    return make_interp_spline(th, pts, k=5)
+
+
+def _bang_bang_time(length: float, vmax: float, amax: float) -> float:
+    d_acc = vmax**2 / amax
+    if d_acc >= length:
+        return 2.0 * np.sqrt(length / amax)
+    return 2.0 * vmax / amax + (length - d_acc) / vmax
+
+
+def _s_curve_time(length: float, vmax: float, amax: float, jmax: float) -> float:
+    # Only the case used below: vmax = amax**2 / jmax (triangular acc profile).
+    assert np.isclose(vmax, amax**2 / jmax)
+    t_acc = 2.0 * amax / jmax
+    d_acc = vmax * t_acc / 2.0
+    assert 2 * d_acc <= length
+    return 2.0 * t_acc + (length - 2 * d_acc) / vmax
+
+
+@pytest.mark.parametrize(("n", "tol"), [(100, 1e-3), (1000, 1e-5)])
+def test_line_matches_bang_bang(n: int, tol: float) -> None:
+    plan = plan_speed(_line(2.0), 1.0, 1.0, None, n=n)
+    exact = _bang_bang_time(2.0, 1.0, 1.0)
+    assert abs(plan.duration - exact) / exact < tol
+    short = plan_speed(_line(0.5), 1.0, 1.0, None, n=n)
+    assert abs(short.duration - _bang_bang_time(0.5, 1.0, 1.0)) / short.duration < 10 * tol
+    ver = plan.verify()
+    assert ver.max_excess <= 0.02
+    sp = plan.setpoints()
+    assert abs(sp.t[-1] - exact) <= 0.021
+
+
+def test_endpoints_at_rest() -> None:
+    for jmax in (None, 3.0):
+        plan = plan_speed(_circle(), 1.0, 2.0, jmax, n=300)
+        assert plan.b[0] == 0.0 and plan.b[-1] == 0.0
+        sp = plan.setpoints()
+        assert np.allclose(sp.v[0], 0.0) and np.allclose(sp.v[-1], 0.0)
+        assert np.allclose(sp.p[0], _circle()(0.0)) and np.allclose(sp.p[-1], _circle()(1.0))
+
+
+def test_circle_speed_capped_by_centripetal_limit() -> None:
+    radius, amax = 1.0, 1.0
+    plan = plan_speed(_circle(radius), 10.0, amax, None, n=1000)
+    speed = np.sqrt(plan.b) * np.linalg.norm(_circle(radius)(plan.u, 1), axis=1)
+    mid = slice(300, 700)
+    # Per-axis limit: v**2/R * max(|cos|, |sin|) <= amax, so the speed lies
+    # between sqrt(amax R) (on the axes) and sqrt(sqrt(2) amax R) (diagonals).
+    cap = np.sqrt(amax * radius)
+    assert np.min(speed[mid]) == pytest.approx(cap, rel=0.02)
+    assert np.max(speed) <= np.sqrt(np.sqrt(2.0) * amax * radius) * 1.02
+    assert plan.verify().max_excess <= 0.02
+
+
+def test_chord_error_caps_speed() -> None:
+    eps, period = 1e-4, 0.02
+    plan = plan_speed(_circle(), 10.0, 100.0, None, n=400, chord_error=eps, control_period=period)
+    speed = np.sqrt(plan.b) * np.linalg.norm(_circle()(plan.u, 1), axis=1)
+    assert np.max(speed) <= np.sqrt(8 * 1.0 * eps / period**2) * 1.01
+
+
+def test_jerk_line_matches_s_curve_and_verifies() -> None:
+    plan = plan_speed(_line(3.0), 1.0, 1.0, 1.0, n=1000)
+    exact = _s_curve_time(3.0, 1.0, 1.0, 1.0)
+    # Conservative (end caps + grid): ~1.3 % slower than the analytic S-curve.
+    assert exact <= plan.duration <= exact * 1.02
+    ver = plan.verify()
+    assert ver.jerk_excess <= 0.02
+    assert ver.max_excess <= 0.02
+
+
+def test_jerk_circle_excess_within_two_percent() -> None:
+    plan = plan_speed(_circle(), 1.0, 2.0, 3.0, n=1000)
+    fine = plan.verify()
+    ctrl = plan.verify(plan.control_period)
+    assert fine.max_jerk is not None
+    assert fine.max_excess <= 0.02, fine
+    assert ctrl.max_excess <= 0.02, ctrl
+    # The jerk limit binds: measured jerk reaches the limit.
+    assert np.max(fine.max_jerk / 3.0) > 0.95
+
+
+def test_pseudo_jerk_iteration_converges_monotonically() -> None:
+    plan = plan_speed(_circle(), 1.0, 2.0, 3.0, n=500, jerk_iterations=30, jerk_tol=1e-4)
+    changes = np.asarray(plan.jerk_changes)
+    assert plan.iterations == changes.size >= 2
+    assert np.all(np.diff(changes) < 0.0)  # contraction
+    assert changes[-1] < 1e-4
+    # Iterates alternate around the fixed point; the brackets shrink.
+    obj = np.asarray(plan.objectives[2:-1])
+    gaps = np.abs(np.diff(obj))
+    assert np.all(np.diff(gaps) < 0.0)
+    # Jerk-free optimum bounds everything from above.
+    assert plan.objectives[0] >= max(plan.objectives[1:])
+
+
+def test_cubic_spline_curve_accepted() -> None:
+    ss = np.linspace(0.0, 1.0, 6)
+    pts = np.column_stack([ss, np.sin(3 * ss), 0.2 * ss**2])
+    plan = plan_speed(CubicSpline(ss, pts), 0.8, [1.0, 1.5, 2.0], [4.0, 4.0, 4.0], n=300)
+    assert plan.duration > 0.0 and plan.amax.shape == (3,)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"vmax": 0.0}, "vmax"),
+        ({"vmax": -1.0}, "vmax"),
+        ({"n": 2}, "n must"),
+        ({"amax": [1.0, 2.0, 3.0]}, "amax"),
+        ({"jmax": -1.0}, "jmax"),
+        ({"chord_error": 0.0}, "chord_error"),
+        ({"control_period": 0.0}, "control_period"),
+    ],
+)
+def test_bad_input(kwargs: dict[str, object], match: str) -> None:
+    args: dict[str, object] = {"vmax": 1.0, "amax": 1.0, "jmax": None, "n": 50}
+    args.update(kwargs)
+    with pytest.raises(InputError, match=match):
+        plan_speed(_line(1.0), **args)  # type: ignore[arg-type]
+
+
+def test_non_callable_curve() -> None:
+    with pytest.raises(InputError, match="callable"):
+        plan_speed(np.zeros((3, 2)), 1.0, 1.0)  # type: ignore[arg-type]
+
+
+def test_matches_toppra_without_jerk() -> None:
+    ta = pytest.importorskip("toppra")
+    import toppra.algorithm as algo
+    from toppra import constraint
+
+    ta.setup_logging("WARNING")
+    ss = np.linspace(0.0, 1.0, 7)
+    pts = np.column_stack([2.0 * ss, 0.5 * np.sin(2.0 * np.pi * ss)])
+    curve = CubicSpline(ss, pts)
+    amax = np.array([1.0, 1.5])
+    vlim = np.array([[-100.0, 100.0]] * 2)
+    alim = np.column_stack([-amax, amax])
+    path = ta.SplineInterpolator(ss, pts)
+    inst = algo.TOPPRA(
+        [constraint.JointVelocityConstraint(vlim), constraint.JointAccelerationConstraint(alim)],
+        path,
+        gridpoints=np.linspace(0.0, 1.0, 2001),
+        parametrizer="ParametrizeConstAccel",
+    )
+    traj = inst.compute_trajectory(0, 0)
+    assert traj is not None
+    plan = plan_speed(curve, 100.0, amax, None, n=2001)
+    assert plan.duration == pytest.approx(float(traj.duration), rel=1e-3)  # measured ~4e-6
