@@ -266,9 +266,9 @@ class SmoothingProblem:
         as_int("dim", self.dim, low=1, high=16)
         ClampedUniformBasis(self.degree, self.n_ctrl)
         as_float("duration", self.duration, positive=True)
-        # Fix: a non-str hull (an array: ambiguous truth value) and non-mapping
-        # smoothness or non-term entries in the term tuples (AttributeError,
-        # TypeError) escaped as other exception types.
+        # Checked by type first: a non-str hull (an array has no truth value),
+        # a non-mapping smoothness or a stray object among the terms would
+        # otherwise escape as AttributeError / TypeError instead of InputError.
         if not isinstance(self.hull, str) or self.hull not in ("bspline", "bezier"):
             raise InputError(f"hull: got {self.hull!r}, expected 'bspline' or 'bezier'")
         if not isinstance(self.smoothness, Mapping):

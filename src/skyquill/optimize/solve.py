@@ -152,12 +152,11 @@ def solve(problem: SmoothingProblem, solver: str = DEFAULT_BACKEND) -> FitResult
 def _closed_form(asm: Assembled) -> FloatArray:
     """Minimise the quadratic subject to the equalities by one sparse LU.
 
-    Fix: consistent but redundant equalities (an interpolated point at ``t = 0``
-    that a boundary condition also fixes) made the KKT matrix singular, so the
-    closed form raised where the QP route solves the same problem. On a
-    singular factorisation the redundant rows are dropped and the system is
-    solved again; contradictory rows raise :class:`InfeasibleError`, as on the
-    QP route.
+    Consistent but redundant equalities that assembly cannot see as exact
+    repeats make the KKT matrix singular although the QP route would solve
+    the problem. On a singular factorisation the dependent rows are dropped
+    and the system solved again; contradictory rows raise
+    :class:`InfeasibleError`, as on the QP route.
     """
     try:
         return _closed_form_kkt(asm)

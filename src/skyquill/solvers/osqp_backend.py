@@ -32,8 +32,8 @@ def solve_osqp(qp: QuadraticProgram, tol: float) -> QPSolution:
         max_iter=200_000,
         polishing=True,
     )
-    # Fix: explicit raise_error=False -- osqp warns that its default will become True,
-    # which would turn 'infeasible' / 'failed' statuses into exceptions here.
+    # raise_error=False explicitly: osqp's default is to become True, which would
+    # turn 'infeasible' / 'failed' statuses into exceptions here.
     result = problem.solve(raise_error=False)
     elapsed = time.perf_counter() - start
     name = str(result.info.status)
