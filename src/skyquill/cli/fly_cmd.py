@@ -81,8 +81,9 @@ def fly(
         rows = write_flight_csv(out / "flight.csv", flight)
         with console.status("plotting"):
             plot_flight(flight, out / "plot.png", trajectory_csv.name)
-        summary = flight.summary() | {
-            "realtime_factor": flight.summary()["sim_time_s"] / max(flight.wall_time_s, 1e-12),
+        summary = flight.summary()
+        summary |= {
+            "realtime_factor": summary["sim_time_s"] / max(flight.wall_time_s, 1e-12),
             "trajectory": str(trajectory_csv),
             "duration_s": trajectory.duration,
             "rate_hz": rate,

@@ -36,6 +36,7 @@ from numpy.typing import NDArray
 
 from skyquill.errors import InputError
 from skyquill.io.points import parse_cell
+from skyquill.polynomial import horner
 from skyquill.trajectory import Samples, SplineTrajectory, evaluation_times, sample
 from skyquill.validation import FloatArray, as_array, as_float, as_int, strictly_increasing
 
@@ -203,25 +204,6 @@ def write_crazyswarm(
     )
 
 
-def _horner(coeffs: FloatArray, tau: FloatArray, order: int) -> FloatArray:
-    """Derivative ``order`` of ``sum_j coeffs[:, j] tau^j``.
-
-    ``coeffs`` (N, K, ...) per sample, ``tau`` (N,); returns (N, ...).
-    """
-    n_coef = coeffs.shape[1]
-    if order >= n_coef:
-        return np.zeros((coeffs.shape[0], *coeffs.shape[2:]))
-    # d^n/dtau^n tau^j = j! / (j - n)! tau^(j - n)
-    j = np.arange(order, n_coef)
-    scale = np.array([math.perm(int(m), order) for m in j], dtype=float)
-    c = coeffs[:, order:] * scale.reshape((1, -1) + (1,) * (coeffs.ndim - 2))
-    tau_b = tau.reshape((-1,) + (1,) * (coeffs.ndim - 2))
-    out = c[:, -1]
-    for m in range(c.shape[1] - 2, -1, -1):
-        out = out * tau_b + c[:, m]
-    return np.asarray(out, dtype=float)
-
-
 @dataclass(frozen=True)
 class PolynomialTrajectory:
     """Piecewise polynomial trajectory, as flown from a Crazyswarm CSV.
@@ -298,13 +280,13 @@ class PolynomialTrajectory:
         """
         order = as_int("order", order, low=0)
         tau, idx = self._locate(t)
-        return _horner(self.coeffs[idx], tau, order).reshape(tau.size, 3)
+        return horner(self.coeffs[idx], tau, order).reshape(tau.size, 3)
 
     def evaluate_yaw(self, t: FloatArray, order: int = 0) -> FloatArray:
         """The ``order``-th time derivative of yaw, shape (N,), rad / s^order."""
         order = as_int("order", order, low=0)
         tau, idx = self._locate(t)
-        return _horner(self.yaw_coeffs[idx], tau, order).reshape(tau.size)
+        return horner(self.yaw_coeffs[idx], tau, order).reshape(tau.size)
 
     def sample(self, rate: float) -> Samples:
         """Samples at ``rate`` Hz (position to jerk), including both ends."""

@@ -29,6 +29,7 @@ import numpy.polynomial.polynomial as npoly
 from numpy.typing import NDArray
 
 from skyquill.errors import InputError
+from skyquill.polynomial import horner
 
 __all__ = ["PolynomialTrajectory", "minsnap_interpolate"]
 
@@ -148,15 +149,10 @@ class PolynomialTrajectory:
                 f"t: expected times within [{lo}, {hi}] s, got range "
                 f"[{float(ts.min())}, {float(ts.max())}]"
             )
-        c = self._derivative_coeffs(order)
-        n_pieces = c.shape[0]
+        self._derivative_coeffs(order)  # validates the order
+        n_pieces = self.coeffs.shape[0]
         idx = np.clip(np.searchsorted(self.breaks, ts, side="right") - 1, 0, n_pieces - 1)
-        tau = (ts - self.breaks[idx])[:, None]
-        piece = c[idx]  # (N, n, d)
-        out = piece[:, -1, :].copy()
-        for j in range(c.shape[1] - 2, -1, -1):  # Horner
-            out = out * tau + piece[:, j, :]
-        return out
+        return horner(self.coeffs[idx], ts - self.breaks[idx], int(order))
 
     def squared_derivative_integral(self, order: int) -> float:
         """Exact integral of the squared norm of a derivative over the trajectory.
