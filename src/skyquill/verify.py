@@ -112,6 +112,18 @@ class Verification:
         """JSON-ready dictionary."""
         return asdict(self)
 
+    def limits_report(self) -> list[dict[str, Any]]:
+        """Per limit: label, largest value, relative excess, guaranteed (for summary.json)."""
+        return [
+            {
+                "label": c.label,
+                "max_value": c.max_value,
+                "relative_excess": c.relative_excess,
+                "guaranteed": c.guaranteed,
+            }
+            for c in self.checks
+        ]
+
 
 def verify(
     traj: DenseTrajectory,

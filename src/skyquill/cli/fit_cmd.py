@@ -38,15 +38,7 @@ def fit_summary(fit: PointFit, rows: int, rate: float) -> dict[str, Any]:
         "n_points": int(fit.points.shape[0]),
         "rate_hz": rate,
         "trajectory_rows": rows,
-        "limits": [
-            {
-                "label": c.label,
-                "max_value": c.max_value,
-                "relative_excess": c.relative_excess,
-                "guaranteed": c.guaranteed,
-            }
-            for c in check.checks
-        ],
+        "limits": check.limits_report(),
         "dense_samples": check.n_samples,
     }
 

@@ -180,10 +180,7 @@ def _drone_summary(mission: Any, name: str, fly: bool, vehicle: Any) -> dict[str
         "file": name,
         "duration_s": mission.trajectory.duration,
         "planning_time_s": mission.planning_time_s,
-        "limits": [
-            {"label": c.label, "max_value": c.max_value, "relative_excess": c.relative_excess}
-            for c in check.checks
-        ],
+        "limits": check.limits_report(),
         "max_speed": check.max_speed,
         "max_acc": list(check.max_acc),
         "max_jerk": list(check.max_jerk),
