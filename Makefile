@@ -6,6 +6,8 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
+CHROMIUM := /usr/bin/chromium
+
 .PHONY: run test lint bench install clean
 
 $(STAMP): pyproject.toml
@@ -16,12 +18,23 @@ $(STAMP): pyproject.toml
 
 install: $(STAMP)
 
+# The studio's end-to-end test drives Debian's chromium (not a Playwright-downloaded browser).
+$(CHROMIUM):
+	@if [ "$$(id -u)" = 0 ]; then \
+		echo "installing Debian's chromium for the browser tests"; \
+		apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium >/dev/null; \
+	else \
+		echo "error: the browser tests need Debian's chromium at $(CHROMIUM);" \
+			"run 'sudo apt-get install chromium' (make test installs it itself only as root)" >&2; \
+		exit 1; \
+	fi
+
 ## make run: plan, verify and plot the bundled hand-drawn spiral into out/demo
 run: $(STAMP)
 	$(BIN)/skyquill demo --out out/demo
 
 ## make test: the whole test suite (unit, property-based, paper reproductions)
-test: $(STAMP)
+test: $(STAMP) $(CHROMIUM)
 	$(BIN)/python -m pytest -n 2 -q
 
 lint: $(STAMP)
