@@ -115,3 +115,15 @@ def strictly_increasing(name: str, times: FloatArray) -> None:
             f"{name}: got {name}[{i}] = {times[i]:g} followed by {times[i + 1]:g}, "
             "expected strictly increasing values"
         )
+
+
+def per_axis(name: str, value: Any, dim: int) -> FloatArray:
+    """A positive finite limit per axis, (dim,), from a scalar or a (dim,) sequence."""
+    arr = as_array(name, value)
+    if arr.ndim == 0:
+        arr = np.full(dim, float(arr))
+    if arr.shape != (dim,):
+        raise InputError(f"{name}: got shape {arr.shape}, expected a number or shape ({dim},)")
+    if np.any(arr <= 0.0):
+        raise InputError(f"{name}: got {arr.tolist()}, expected positive limits")
+    return arr

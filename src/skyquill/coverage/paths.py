@@ -37,6 +37,7 @@ from skyquill.validation import as_array, as_float, as_int
 
 FloatArray = NDArray[np.float64]
 ContourMode = Literal["offset", "homothetic"]
+DriftMode = Literal["lap", "step"]
 
 #: Relative tolerance (of the region's size) for coincident points.
 _REL_TOL = 1e-12
@@ -63,7 +64,8 @@ def contours(
         ring is ``width`` from the next on every side. ``"homothetic"``: the
         paper's rings, shrunk toward the vertex centroid (eq. 1-3).
     epsilon
-        The paper's density factor ``ε in (0, 1]`` (homothetic only).
+        The paper's density factor ``ε in (0, 1]``: the ring spacing is
+        ``ε width`` (offset rings: the first at ``ε width / 2`` inside).
     sigma
         The paper's offset σ of the first homothetic ring (m), measured at the
         vertex farthest from the centre (the ring is a homothety, so nearer
@@ -76,12 +78,12 @@ def contours(
         each starting at its vertex nearest to the previous ring's start.
     """
     w = check_width(region, width)
+    eps = as_float("epsilon", epsilon, positive=True)
+    if eps > 1.0:
+        raise InputError(f"epsilon: got {eps:g}, expected a value in (0, 1]")
     if mode == "offset":
-        rings = _offset_rings(region, w)
+        rings = _offset_rings(region, eps * w)
     elif mode == "homothetic":
-        eps = as_float("epsilon", epsilon, positive=True)
-        if eps > 1.0:
-            raise InputError(f"epsilon: got {eps:g}, expected a value in (0, 1]")
         s = 0.5 * w if sigma is None else as_float("sigma", sigma, nonneg=True)
         rings = _homothetic_rings(region, w, eps, s)
     else:
@@ -154,7 +156,9 @@ def _aligned(rings: list[FloatArray]) -> list[FloatArray]:
     return out
 
 
-def spiral_control_points(rings: list[FloatArray], delta: float) -> FloatArray:
+def spiral_control_points(
+    rings: list[FloatArray], delta: float, *, drift: DriftMode = "lap"
+) -> FloatArray:
     """The spiral control polygon of eq. 4-5 with corner points at ``delta``.
 
     Eq. 4 moves vertex ``j`` (``j = 0 .. n-1``) of ring ``i`` toward its
@@ -186,6 +190,11 @@ def spiral_control_points(rings: list[FloatArray], delta: float) -> FloatArray:
         starts, as returned by :func:`contours`.
     delta
         Distance (m) of the corner control points from each corner, > 0.
+    drift
+        ``"lap"``: the paper's eq. 4, each lap drifting one ring inward all
+        along. ``"step"``: every ring is flown whole and the path steps to
+        the next ring on the last side (:func:`_stepped`) -- no undrifted
+        extra lap, so a shorter path with the same spacing.
 
     Returns
     -------
@@ -197,10 +206,54 @@ def spiral_control_points(rings: list[FloatArray], delta: float) -> FloatArray:
     if not checked:
         raise InputError("rings: got an empty list, expected at least one ring")
     core = _core(checked[-1])
-    laps = [_drifted(ring, _counterparts(checked, i, core)) for i, ring in enumerate(checked)]
-    centre = np.asarray(core.centroid.coords, dtype=np.float64)
-    polygon = np.vstack([checked[0], *laps, centre])
-    return _with_corner_points(_dedupe(polygon), d)
+    if drift == "step":
+        polygon = _stepped(checked, core)
+    elif drift == "lap":
+        laps = [_drifted(ring, _counterparts(checked, i, core)) for i, ring in enumerate(checked)]
+        centre = np.asarray(core.centroid.coords, dtype=np.float64)
+        polygon = np.vstack([checked[0], *laps, centre])
+    else:
+        raise InputError(f"drift: got {drift!r}, expected 'lap' or 'step'")
+    return with_corner_points(_dedupe(polygon), d)
+
+
+def _stepped(rings: list[FloatArray], core: BaseGeometry) -> FloatArray:
+    """Whole rings joined by a step on each ring's last side, then the core's spine.
+
+    Ring ``i`` is flown from its start round to its last vertex, then back
+    along its last side to the foot of the perpendicular from ring ``i+1``'s
+    start, and across to that start (a ring spacing). After the innermost ring
+    the path steps onto the core's spine and runs along it: the innermost
+    ring's inradius is below one swath (else another ring would fit), so
+    every point it encloses lies within half a swath of the ring or of the
+    spine.
+    """
+    spine = _spine(core, rings[-1][0])
+    pieces: list[FloatArray] = []
+    for i, ring in enumerate(rings):
+        target = rings[i + 1][0] if i + 1 < len(rings) else spine[0]
+        foot = _foot(ring[-1], ring[0], target)
+        pieces.append(np.vstack([ring, foot]))
+    pieces.append(spine)
+    return np.vstack(pieces)
+
+
+def _spine(core: BaseGeometry, near: FloatArray) -> FloatArray:
+    """The core's longest chord ``(2, 2)`` (one point twice if it is a point), near end first."""
+    pts = shapely.get_coordinates(core)
+    gaps = np.linalg.norm(pts[:, None, :] - pts[None, :, :], axis=2)
+    i, j = np.unravel_index(int(np.argmax(gaps)), gaps.shape)
+    ends = pts[[i, j]]
+    if np.linalg.norm(ends[1] - near) < np.linalg.norm(ends[0] - near):
+        ends = ends[::-1]
+    return np.asarray(ends, dtype=np.float64)
+
+
+def _foot(a: FloatArray, b: FloatArray, p: FloatArray) -> FloatArray:
+    """The point of segment ``a``-``b`` nearest ``p``."""
+    ab = b - a
+    s = float(np.clip(np.dot(p - a, ab) / max(float(np.dot(ab, ab)), 1e-300), 0.0, 1.0))
+    return np.asarray(a + s * ab, dtype=np.float64)
 
 
 def _checked_ring(name: str, ring: object) -> FloatArray:
@@ -239,7 +292,7 @@ def _drifted(ring: FloatArray, target: FloatArray) -> FloatArray:
     return ring + frac * (target - ring)
 
 
-def _with_corner_points(polygon: FloatArray, delta: float) -> FloatArray:
+def with_corner_points(polygon: FloatArray, delta: float) -> FloatArray:
     """Insert points at ``min(delta, leg / 2)`` from both ends of every leg."""
     out = [polygon[:1]]
     for a, b in itertools.pairwise(polygon):
@@ -410,7 +463,9 @@ def _sweep_segment(shrunk: Polygon, y: float) -> FloatArray:
                 return np.asarray(xy[:1], dtype=np.float64)
         raise _concave_error()
     xy = np.asarray(pieces[0].coords, dtype=np.float64)
-    return xy[np.argsort(xy[:, 0])][[0, -1]]
+    ends = xy[np.argsort(xy[:, 0])][[0, -1]]
+    # A row that only touches a vertex is one point (two would make a cusp).
+    return ends[:1] if ends[1, 0] - ends[0, 0] <= 1e-6 * max(1.0, maxx - minx) else ends
 
 
 def _concave_error() -> InputError:

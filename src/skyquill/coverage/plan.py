@@ -1,0 +1,385 @@
+"""Coverage missions end to end: region -> covering path -> timed, verified setpoints.
+
+Three patterns, compared on equal terms (paper ``001_61beb0e01a19013a`` §4):
+
+* ``spiral`` -- the paper's spiral spline (§1): contours, spiral control
+  points with corner points at ``delta``, a degree-4 B-spline with
+  Hartley-Judd knots, timed by the jerk-limited speed LP (§2);
+* ``zigzag`` -- the fair baseline: the boustrophedon's waypoints through the
+  *same* corner points, spline and speed LP;
+* ``zigzag-stop`` -- the paper's baseline: straight legs, rest at every
+  corner, each leg time-optimal under the same limits (Ruckig).
+
+Concave regions are split into convex parts whose spirals (or zigzags) are
+joined into one path (:mod:`skyquill.coverage.decompose`, the paper's Fig. 5).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import asdict, dataclass, replace
+from typing import Any, Literal
+
+import numpy as np
+from numpy.typing import NDArray
+from shapely.geometry import LineString, Polygon
+
+from skyquill.coverage.paths import (
+    ContourMode,
+    DriftMode,
+    contours,
+    spiral_control_points,
+    spiral_curve,
+    with_corner_points,
+    zigzag,
+)
+from skyquill.coverage.regions import check_width, coverage_fraction
+from skyquill.coverage.speed import Setpoints, SpeedPlan, plan_speed
+from skyquill.coverage.stopgo import stop_and_go_legs, stop_and_go_setpoints
+from skyquill.errors import InfeasibleError, InputError
+from skyquill.validation import as_float, as_int
+
+FloatArray = NDArray[np.float64]
+Pattern = Literal["spiral", "zigzag", "zigzag-stop"]
+PATTERNS: tuple[Pattern, ...] = ("spiral", "zigzag", "zigzag-stop")
+CONTOUR_MODES: tuple[ContourMode, ...] = ("offset", "homothetic")
+DRIFT_MODES: tuple[DriftMode, ...] = ("step", "lap")
+#: Candidates of :func:`tune_coverage`, preferred first: wide spacing, round corners.
+TUNING_EPSILONS = (1.0, 0.9, 0.8, 0.7)
+TUNING_DELTAS = (1.5, 1.0, 0.6, 0.3, 0.15)
+
+#: Spacing of the speed LP's grid along the path, m (the grid needs several
+#: points per corner feature; see :func:`grid_points`).
+GRID_SPACING_M = 0.05
+#: Bounds on the LP's grid size (LP time grows faster than linearly).
+GRID_POINTS = (300, 2000)
+#: Spacing of the dense samples that coverage is measured on, m.
+COVERAGE_SPACING_M = 0.02
+#: Largest region side accepted, m (beyond it the LP grid would be too coarse).
+MAX_REGION_SIZE_M = 1000.0
+
+
+@dataclass(frozen=True)
+class CoverageOptions:
+    """What to cover with and how.
+
+    Attributes
+    ----------
+    width : float
+        Coverage diameter (swath), m.
+    vmax : float
+        Speed limit, m/s.
+    amax, jmax : float
+        Per-axis acceleration (m/s^2) and jerk (m/s^3) limits.
+    pattern : {"spiral", "zigzag", "zigzag-stop"}
+    contours : {"offset", "homothetic"}
+        Spiral rings: true inward offsets, or the paper's shrink (eq. 1-3).
+    drift : {"step", "lap"}
+        Spiral laps: whole rings joined by a step, or the paper's eq. 4 drift
+        (which needs an extra undrifted outer lap; see
+        :func:`~skyquill.coverage.paths.spiral_control_points`).
+    epsilon : float
+        Density factor in (0, 1]: rings and sweep lines ``epsilon * width``
+        apart (more overlap, fewer gaps at corners, longer path).
+    delta : float
+        Distance of the corner control points from each corner, m (smaller:
+        sharper corners, more coverage, slower).
+    rate : float
+        Setpoint rate, Hz (the control period of §2.2 is ``1 / rate``).
+    altitude : float
+        Flight height written to the setpoints, m.
+    grid : int or None
+        Speed-LP grid points; ``None`` picks them from the path length.
+    """
+
+    width: float = 2.0
+    vmax: float = 3.0
+    amax: float = 5.0
+    jmax: float = 3.0
+    pattern: Pattern = "spiral"
+    contours: ContourMode = "offset"
+    drift: DriftMode = "step"
+    epsilon: float = 1.0
+    delta: float = 0.5
+    rate: float = 50.0
+    altitude: float = 2.0
+    grid: int | None = None
+
+    def __post_init__(self) -> None:
+        for name in ("width", "vmax", "amax", "jmax", "delta", "rate"):
+            as_float(name, getattr(self, name), positive=True)
+        as_float("altitude", self.altitude)
+        if self.pattern not in PATTERNS:
+            raise InputError(f"pattern: got {self.pattern!r}, expected one of {PATTERNS}")
+        if self.contours not in CONTOUR_MODES:
+            raise InputError(f"contours: got {self.contours!r}, expected one of {CONTOUR_MODES}")
+        if self.drift not in DRIFT_MODES:
+            raise InputError(f"drift: got {self.drift!r}, expected one of {DRIFT_MODES}")
+        if not 0.0 < as_float("epsilon", self.epsilon) <= 1.0:
+            raise InputError(f"epsilon: got {self.epsilon!r}, expected a value in (0, 1]")
+        if self.grid is not None:
+            as_int("grid", self.grid, low=3, high=20_000)
+
+
+@dataclass(frozen=True, eq=False)
+class CoveragePlan:
+    """A planned coverage flight.
+
+    Attributes
+    ----------
+    region : shapely.Polygon
+    options : CoverageOptions
+    waypoints : ndarray, shape (K, 2)
+        The control polygon (spline patterns) or the stop points (zigzag-stop), m.
+    path : ndarray, shape (M, 2)
+        The flown path, densely sampled (every ~2 cm), m.
+    setpoints : Setpoints
+        Time-domain samples at ``options.rate`` (2-D: x, y).
+    coverage : float
+        Covered fraction of the region's area.
+    limits : dict
+        Measured maxima and excess (see :func:`limits_report`).
+    planning_time : float
+        Wall time of :func:`plan_coverage`, s.
+    speed_plan : SpeedPlan or None
+        The LP's plan (spline patterns only).
+    """
+
+    region: Polygon
+    options: CoverageOptions
+    waypoints: FloatArray
+    path: FloatArray
+    setpoints: Setpoints
+    coverage: float
+    limits: dict[str, Any]
+    planning_time: float
+    speed_plan: SpeedPlan | None
+
+    @property
+    def duration(self) -> float:
+        """Flight time from rest to rest, s."""
+        return float(self.setpoints.t[-1])
+
+    @property
+    def path_length(self) -> float:
+        """Length of the flown path, m."""
+        return float(np.linalg.norm(np.diff(self.path, axis=0), axis=1).sum())
+
+    def summary(self) -> dict[str, Any]:
+        """What ``summary.json`` holds (JSON-ready)."""
+        lp = self.speed_plan
+        return {
+            "pattern": self.options.pattern,
+            "duration_s": self.duration,
+            "path_length_m": self.path_length,
+            "coverage_fraction": self.coverage,
+            **self.limits,
+            "planning_time_s": self.planning_time,
+            "region_area_m2": float(self.region.area),
+            "options": asdict(self.options),
+            "lp": None
+            if lp is None
+            else {
+                "grid_points": int(lp.u.size),
+                "iterations": lp.iterations,
+                "solve_time_s": lp.solve_time,
+            },
+        }
+
+
+def grid_points(length: float) -> int:
+    """Speed-LP grid size for a path of ``length`` metres (spacing ~5 cm, bounded)."""
+    lo, hi = GRID_POINTS
+    return int(min(max(math.ceil(length / GRID_SPACING_M), lo), hi))
+
+
+def is_convex(region: Polygon) -> bool:
+    """Whether ``region`` equals its convex hull (to round-off)."""
+    return bool(region.convex_hull.area - region.area <= 1e-9 * region.area)
+
+
+def covering_waypoints(region: Polygon, options: CoverageOptions) -> FloatArray:
+    """The pattern's waypoints: a spline's control polygon, or the stop points.
+
+    Concave regions are decomposed into convex parts, covered one after the
+    other along one continuous path.
+    """
+    w, d, eps = options.width, options.delta, options.epsilon
+    if options.pattern == "spiral":
+        if is_convex(region):
+            rings = contours(region, w, options.contours, epsilon=eps)
+            return spiral_control_points(rings, d, drift=options.drift)
+        from skyquill.coverage.decompose import multi_spiral_control_points
+
+        return multi_spiral_control_points(region, eps * w, mode=options.contours, delta=d)
+    # The sweep lines' spacing is the swath; epsilon < 1 packs them closer.
+    if is_convex(region):
+        stops = zigzag(region, eps * w)
+    else:
+        from skyquill.coverage.decompose import multi_zigzag
+
+        stops = multi_zigzag(region, eps * w)
+    return stops if options.pattern == "zigzag-stop" else with_corner_points(stops, d)
+
+
+def covering_path(region: Polygon, options: CoverageOptions) -> tuple[FloatArray, FloatArray]:
+    """The pattern's waypoints ``(K, 2)`` and its flown path densely sampled ``(M, 2)``, m."""
+    waypoints = covering_waypoints(region, options)
+    if options.pattern == "zigzag-stop":
+        return waypoints, _densified(waypoints)
+    return waypoints, _dense(spiral_curve(waypoints))
+
+
+def tune_coverage(
+    region: Polygon, options: CoverageOptions, target: float
+) -> tuple[CoverageOptions, float]:
+    """The widest spacing, then the roundest corners, whose path covers ``target``.
+
+    Tries ``epsilon`` in :data:`TUNING_EPSILONS` and, for each, ``delta`` in
+    :data:`TUNING_DELTAS` (the stop-and-go zigzag has no ``delta``), in that
+    order of preference -- wider spacing shortens the path, rounder corners
+    raise the speed -- and returns the first options whose geometric coverage
+    reaches ``target``, with that coverage. Only geometry is computed (no
+    speed LP), so the search is cheap.
+
+    Raises
+    ------
+    InfeasibleError
+        No candidate reaches ``target``.
+    """
+    goal = as_float("min_coverage", target, positive=True)
+    if goal > 1.0:
+        raise InputError(f"min_coverage: got {goal:g}, expected a fraction in (0, 1]")
+    deltas = (options.delta,) if options.pattern == "zigzag-stop" else TUNING_DELTAS
+    best = 0.0
+    for eps in TUNING_EPSILONS:
+        for delta in deltas:
+            trial = replace(options, epsilon=eps, delta=delta)
+            covered = coverage_fraction(region, covering_path(region, trial)[1], trial.width)
+            if covered >= goal:
+                return trial, covered
+            best = max(best, covered)
+    raise InfeasibleError(
+        f"min_coverage: got {goal:g}, but the best {options.pattern} path covers only "
+        f"{best:.4f} of the region (tried epsilon {TUNING_EPSILONS}, delta {deltas})",
+        ("coverage",),
+    )
+
+
+def plan_coverage(region: Polygon, options: CoverageOptions | None = None) -> CoveragePlan:
+    """Plan a coverage flight of ``region``: path, speed, setpoints, coverage, limits.
+
+    Parameters
+    ----------
+    region
+        The region (shapely Polygon, m), e.g. from
+        :func:`~skyquill.coverage.regions.load_region`.
+    options
+        :class:`CoverageOptions` (defaults: the paper's §4 limits, spiral).
+
+    Raises
+    ------
+    InputError
+        Width not positive or too large for the region, bad options.
+    InfeasibleError
+        The speed LP has no solution.
+    """
+    start = time.perf_counter()
+    opts = options or CoverageOptions()
+    if not isinstance(region, Polygon):
+        raise InputError(f"region: got {type(region).__name__}, expected a shapely Polygon")
+    minx, miny, maxx, maxy = region.bounds
+    if max(maxx - minx, maxy - miny) > MAX_REGION_SIZE_M:
+        raise InputError(
+            f"region: got a region {maxx - minx:.4g} x {maxy - miny:.4g} m, expected at most "
+            f"{MAX_REGION_SIZE_M:g} m across (split it into several missions)"
+        )
+    check_width(region, opts.width)
+    waypoints, path = covering_path(region, opts)
+    period = 1.0 / opts.rate
+    speed_plan: SpeedPlan | None = None
+    if opts.pattern == "zigzag-stop":
+        legs = stop_and_go_legs(waypoints, opts.vmax, opts.amax, opts.jmax)
+        setpoints = stop_and_go_setpoints(legs, period)
+        limits = limits_report(stop_and_go_setpoints(legs, period / 10.0), opts)
+    else:
+        curve = spiral_curve(waypoints)
+        length = float(np.linalg.norm(np.diff(path, axis=0), axis=1).sum())
+        n = opts.grid or grid_points(length)
+        speed_plan = plan_speed(curve, opts.vmax, opts.amax, opts.jmax, n=n, control_period=period)
+        setpoints = speed_plan.setpoints()
+        limits = _lp_limits(speed_plan, opts)
+    coverage = coverage_fraction(region, path, opts.width)
+    return CoveragePlan(
+        region=region,
+        options=opts,
+        waypoints=waypoints,
+        path=path,
+        setpoints=setpoints,
+        coverage=coverage,
+        limits=limits,
+        planning_time=time.perf_counter() - start,
+        speed_plan=speed_plan,
+    )
+
+
+def _dense(curve: Any) -> FloatArray:
+    """``curve`` sampled every ~``COVERAGE_SPACING_M`` (by its control polygon's length)."""
+    rough = np.asarray(curve(np.linspace(0.0, 1.0, 2001)), dtype=np.float64)
+    length = float(np.linalg.norm(np.diff(rough, axis=0), axis=1).sum())
+    m = max(2001, math.ceil(length / COVERAGE_SPACING_M))
+    return np.asarray(curve(np.linspace(0.0, 1.0, m)), dtype=np.float64)
+
+
+def _densified(waypoints: FloatArray) -> FloatArray:
+    """A polyline resampled every ~``COVERAGE_SPACING_M`` (its corners kept)."""
+    line = LineString(waypoints)
+    m = max(2, math.ceil(line.length / COVERAGE_SPACING_M))
+    along = np.unique(np.concatenate([np.linspace(0.0, line.length, m), _vertex_distances(line)]))
+    return np.array([line.interpolate(s).coords[0] for s in along], dtype=np.float64)
+
+
+def _vertex_distances(line: LineString) -> FloatArray:
+    xy = np.asarray(line.coords, dtype=np.float64)
+    return np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(xy, axis=0), axis=1))])
+
+
+def limits_report(setpoints: Setpoints, options: CoverageOptions) -> dict[str, Any]:
+    """Largest speed, per-axis |acceleration| and |jerk| of ``setpoints``, and the excess.
+
+    ``max_excess`` is the largest relative excess over any limit (0 when all hold).
+    """
+    speed = float(np.max(np.linalg.norm(setpoints.v, axis=1)))
+    acc = np.max(np.abs(setpoints.a), axis=0)
+    jerk = np.max(np.abs(setpoints.j), axis=0)
+    return _report(speed, acc, jerk, options)
+
+
+def _lp_limits(plan: SpeedPlan, options: CoverageOptions) -> dict[str, Any]:
+    """The limits report of a speed plan, from finite differences of its positions.
+
+    :meth:`SpeedPlan.verify` differences the setpoints' positions on a grid ten
+    times finer than the control period: a check independent of the chain
+    rule that produced the setpoints' own velocity, acceleration and jerk.
+    """
+    ver = plan.verify()
+    jerk = ver.max_jerk if ver.max_jerk is not None else np.zeros_like(ver.max_acc)
+    return _report(ver.max_speed, ver.max_acc, jerk, options)
+
+
+def _report(
+    speed: float, acc: FloatArray, jerk: FloatArray, options: CoverageOptions
+) -> dict[str, Any]:
+    excess = max(
+        speed / options.vmax - 1.0,
+        float(acc.max()) / options.amax - 1.0,
+        float(jerk.max()) / options.jmax - 1.0,
+        0.0,
+    )
+    return {
+        "max_speed": speed,
+        "max_acc": acc.tolist(),
+        "max_jerk": jerk.tolist(),
+        "max_excess": excess,
+    }
