@@ -220,22 +220,38 @@ def spiral_control_points(
 def _stepped(rings: list[FloatArray], core: BaseGeometry) -> FloatArray:
     """Whole rings joined by a step on each ring's last side, then the core's spine.
 
-    Ring ``i`` is flown from its start round to its last vertex, then back
-    along its last side to the foot of the perpendicular from ring ``i+1``'s
-    start, and across to that start (a ring spacing). After the innermost ring
-    the path steps onto the core's spine and runs along it: the innermost
-    ring's inradius is below one swath (else another ring would fit), so
-    every point it encloses lies within half a swath of the ring or of the
-    spine.
+    Ring ``i`` is flown from its start round to its last vertex and back
+    down its last side to half a ring spacing short of the start (nearer
+    would only re-cover the first side; farther leaves a gap between the
+    start's and the last side's swaths), then across to ring ``i+1``'s
+    start. After the innermost ring the path steps onto the core's spine and
+    runs along it: the innermost ring's inradius is below one spacing (else
+    another ring would fit), so every point it encloses lies within half a
+    spacing of the ring or of the spine.
     """
     spine = _spine(core, rings[-1][0])
     pieces: list[FloatArray] = []
     for i, ring in enumerate(rings):
         target = rings[i + 1][0] if i + 1 < len(rings) else spine[0]
-        foot = _foot(ring[-1], ring[0], target)
-        pieces.append(np.vstack([ring, foot]))
+        pieces.append(np.vstack([ring, _step_point(ring[-1], ring[0], target)]))
     pieces.append(spine)
     return np.vstack(pieces)
+
+
+def _step_point(last: FloatArray, start: FloatArray, target: FloatArray) -> FloatArray:
+    """Where the last side ``last -> start`` leaves for ``target``: half a spacing before ``start``.
+
+    The spacing is ``target``'s distance from the side's line.
+    """
+    side = start - last
+    length = float(np.linalg.norm(side))
+    if length <= 0.0:
+        return start
+    unit = side / length
+    rel = target - start
+    spacing = abs(float(unit[0] * rel[1] - unit[1] * rel[0]))
+    back = min(0.5 * spacing, 0.5 * length)
+    return np.asarray(start - back * unit, dtype=np.float64)
 
 
 def _spine(core: BaseGeometry, near: FloatArray) -> FloatArray:
@@ -247,13 +263,6 @@ def _spine(core: BaseGeometry, near: FloatArray) -> FloatArray:
     if np.linalg.norm(ends[1] - near) < np.linalg.norm(ends[0] - near):
         ends = ends[::-1]
     return np.asarray(ends, dtype=np.float64)
-
-
-def _foot(a: FloatArray, b: FloatArray, p: FloatArray) -> FloatArray:
-    """The point of segment ``a``-``b`` nearest ``p``."""
-    ab = b - a
-    s = float(np.clip(np.dot(p - a, ab) / max(float(np.dot(ab, ab)), 1e-300), 0.0, 1.0))
-    return np.asarray(a + s * ab, dtype=np.float64)
 
 
 def _checked_ring(name: str, ring: object) -> FloatArray:

@@ -96,9 +96,14 @@ def write_trajectory_csv(
     with a fixed heading) and ``pen``.
     """
     table = trajectory_table(traj, rate)
+    return write_table_csv(path, table, None if pen is None else pen(table[:, 0]))
+
+
+def write_table_csv(path: str | Path, table: FloatArray, pen: FloatArray | None = None) -> int:
+    """Write the ``trajectory.csv`` table (N, 13), with ``yaw`` (0) and ``pen`` (N,) if given."""
     columns = list(TRAJECTORY_COLUMNS)
     if pen is not None:
-        table = np.column_stack([table, np.zeros(table.shape[0]), pen(table[:, 0])])
+        table = np.column_stack([table, np.zeros(table.shape[0]), pen])
         columns += ["yaw", "pen"]
     np.savetxt(path, table, delimiter=",", header=",".join(columns), comments="", fmt="%.9g")
     return int(table.shape[0])

@@ -1,0 +1,77 @@
+"""The figure of a coverage plan: region, path and covered area; speed, acceleration, jerk."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+import numpy as np
+from matplotlib.axes import Axes
+from shapely.geometry import LineString, MultiPolygon, Polygon
+
+from skyquill.coverage.plan import CoveragePlan
+
+
+def _fill(ax: Axes, shape: Polygon | MultiPolygon, **style: object) -> None:
+    for part in getattr(shape, "geoms", [shape]):
+        if isinstance(part, Polygon) and not part.is_empty:
+            ax.fill(*part.exterior.xy, **style)  # type: ignore[arg-type]
+            for hole in part.interiors:
+                ax.fill(*hole.xy, color="white")
+
+
+def plot_coverage(plan: CoveragePlan, path: str | Path) -> None:
+    """Save a PNG of ``plan``.
+
+    Left: the region (grey outline), the covered area (light blue), what is
+    left uncovered (red), the waypoints (dots) and the flown path coloured by
+    speed. Right: speed, per-axis |acceleration| and |jerk| against time with
+    their limits dashed.
+
+    Parameters
+    ----------
+    plan
+        A :func:`~skyquill.coverage.plan.plan_coverage` result.
+    path
+        PNG file to write.
+    """
+    opts = plan.options
+    sp = plan.setpoints
+    fig = plt.figure(figsize=(13, 6.5), layout="constrained")
+    grid = fig.add_gridspec(3, 2, width_ratios=(1.1, 1.0))
+    top = fig.add_subplot(grid[:, 0])
+    swept = LineString(plan.path).buffer(0.5 * opts.width)
+    _fill(top, plan.region.intersection(swept), color="#cfe3f7")
+    _fill(top, plan.region.difference(swept), color="#e4572e", alpha=0.8)
+    top.plot(*plan.region.exterior.xy, color="0.3", lw=1.2)
+    speed = np.linalg.norm(sp.v, axis=1)
+    dots = top.scatter(sp.p[:, 0], sp.p[:, 1], c=speed, s=2, cmap="viridis", vmin=0.0)
+    top.plot(plan.waypoints[:, 0], plan.waypoints[:, 1], ".", ms=3, color="0.5")
+    fig.colorbar(dots, ax=top, label="speed (m/s)", shrink=0.7)
+    top.set_aspect("equal")
+    top.set_xlabel("x (m)")
+    top.set_ylabel("y (m)")
+    top.set_title(
+        f"{opts.pattern}: {plan.duration:.1f} s, {plan.path_length:.1f} m, "
+        f"coverage {100 * plan.coverage:.1f} % (red: missed)"
+    )
+    rows = (
+        ("speed (m/s)", speed[:, None], opts.vmax),
+        ("|acc| (m/s²)", np.abs(sp.a), opts.amax),
+        ("|jerk| (m/s³)", np.abs(sp.j), opts.jmax),
+    )
+    for k, (label, values, limit) in enumerate(rows):
+        ax = fig.add_subplot(grid[k, 1])
+        for i in range(values.shape[1]):
+            name = "" if values.shape[1] == 1 else "xyz"[i]
+            ax.plot(sp.t, values[:, i], lw=0.9, label=name or None)
+        ax.axhline(limit, ls="--", color="k", lw=0.8)
+        ax.set_ylabel(label)
+        if values.shape[1] > 1:
+            ax.legend(loc="upper right", fontsize=8)
+    ax.set_xlabel("t (s)")
+    fig.savefig(path, dpi=110)
+    plt.close(fig)

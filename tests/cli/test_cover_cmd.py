@@ -1,0 +1,84 @@
+"""``skyquill cover``: plans a region, writes its three files, refuses bad input with exit 2."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from skyquill.cli.main import app
+from skyquill.io.points import TRAJECTORY_COLUMNS
+
+EXAMPLES = Path(__file__).parents[2] / "examples" / "coverage"
+SUMMARY_KEYS = {
+    "duration_s",
+    "path_length_m",
+    "coverage_fraction",
+    "max_speed",
+    "max_acc",
+    "max_jerk",
+    "max_excess",
+    "planning_time_s",
+    "pattern",
+}
+
+
+@pytest.mark.parametrize("pattern", ["spiral", "zigzag-stop"])
+def test_cover_writes_summary_trajectory_and_plot(tmp_path: Path, pattern: str) -> None:
+    out = tmp_path / "out"
+    args = ["cover", str(EXAMPLES / "square_10m.geojson"), "--out", str(out)]
+    result = CliRunner().invoke(app, [*args, "--pattern", pattern, "--rate", "50"])
+    assert result.exit_code == 0, result.output
+    summary = json.loads((out / "summary.json").read_text())
+    assert set(summary) >= SUMMARY_KEYS
+    assert summary["pattern"] == pattern
+    header = (out / "trajectory.csv").read_text().splitlines()[0].split(",")
+    assert header == [*TRAJECTORY_COLUMNS, "yaw", "pen"]
+    table = np.loadtxt(out / "trajectory.csv", delimiter=",", skiprows=1)
+    assert table.shape[0] == summary["trajectory_rows"]
+    steps = np.diff(table[:, 0])
+    assert np.allclose(steps[:-1], 0.02, atol=1e-6) and 0.0 < steps[-1] <= 0.02 + 1e-6
+    assert table[-1, 0] == pytest.approx(summary["duration_s"], abs=0.02)
+    assert np.all(table[:, -1] == 1.0)
+    assert (out / "plot.png").stat().st_size > 10_000
+
+
+def test_cover_tunes_for_a_coverage_target(tmp_path: Path) -> None:
+    out = tmp_path / "out"
+    result = CliRunner().invoke(
+        app,
+        ["cover", str(EXAMPLES / "square_10m.geojson"), "--out", str(out),
+         "--pattern", "zigzag-stop", "--min-coverage", "0.98"],
+    )  # fmt: skip
+    assert result.exit_code == 0, result.output
+    assert json.loads((out / "summary.json").read_text())["coverage_fraction"] >= 0.98
+
+
+@pytest.mark.parametrize(
+    ("extra", "message"),
+    [
+        (["--width", "0"], "width"),
+        (["--width", "50"], "width"),
+        (["--vmax", "-1"], "vmax"),
+        (["--jmax", "0"], "jmax"),
+        (["--pattern", "snake"], "pattern"),
+        (["--min-coverage", "1.5"], "min_coverage"),
+    ],
+)
+def test_bad_input_exits_2_with_a_message(tmp_path: Path, extra: list[str], message: str) -> None:
+    args = ["cover", str(EXAMPLES / "square_10m.geojson"), "--out", str(tmp_path / "o"), *extra]
+    result = CliRunner().invoke(app, args)
+    assert result.exit_code == 2
+    assert message in result.output
+    assert "Traceback" not in result.output
+
+
+def test_a_self_intersecting_region_is_refused(tmp_path: Path) -> None:
+    bowtie = tmp_path / "bowtie.geojson"
+    bowtie.write_text('{"type": "Polygon", "coordinates": [[[0,0],[10,10],[10,0],[0,10],[0,0]]]}')
+    result = CliRunner().invoke(app, ["cover", str(bowtie), "--out", str(tmp_path / "o")])
+    assert result.exit_code == 2
+    assert "region" in result.output or "bowtie" in result.output
