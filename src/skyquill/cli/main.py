@@ -48,10 +48,15 @@ def user_errors() -> Iterator[None]:
 
 
 # Register the commands (each module adds its own to ``app``).
-from skyquill.cli import export_cmd, fit_cmd, fly_cmd, reproduce_cmd, write_cmd  # noqa: E402
-from skyquill.cli import studio_cmd  # noqa: E402
-from skyquill.cli import paint_cmd  # noqa: E402
-from skyquill.cli import cover_cmd  # noqa: E402
+from skyquill.cli import (  # noqa: E402
+    cover_cmd,
+    export_cmd,
+    fit_cmd,
+    fly_cmd,
+    reproduce_cmd,
+    studio_cmd,
+    write_cmd,
+)
 
 __all__ = [
     "app",
@@ -59,7 +64,6 @@ __all__ = [
     "export_cmd",
     "fit_cmd",
     "fly_cmd",
-    "paint_cmd",
     "reproduce_cmd",
     "studio_cmd",
     "write_cmd",

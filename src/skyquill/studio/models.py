@@ -1,0 +1,197 @@
+"""The studio's JSON: pydantic request and response models, with every size bounded.
+
+Units enter here (DESIGN: units are converted only where input enters): the
+page sends canvas points (any unit, y up) and limits in SI. Every list has a
+maximum length and every number a finite range, so one request can only ask
+for a bounded amount of planning.
+"""
+
+from __future__ import annotations
+
+from typing import Annotated, Literal
+
+from pydantic import BaseModel, ConfigDict, Field, model_validator
+
+#: Strokes in one drawing.
+MAX_STROKES = 200
+#: Points in one stroke.
+MAX_STROKE_POINTS = 5_000
+#: Points over all strokes (a tablet at 120 Hz for ~3 minutes).
+MAX_POINTS = 20_000
+#: Characters of typed text.
+MAX_TEXT = 40
+#: Drones writing at once.
+MAX_DRONES = 8
+#: Largest coordinate magnitude of a drawn point, in the page's units.
+MAX_COORDINATE = 1e6
+
+Coordinate = Annotated[float, Field(ge=-MAX_COORDINATE, le=MAX_COORDINATE)]
+Point = tuple[Coordinate, Coordinate]
+Stroke = Annotated[list[Point], Field(min_length=2, max_length=MAX_STROKE_POINTS)]
+Timestamp = Annotated[float, Field(ge=0.0, le=1e7)]
+StrokeTimes = Annotated[list[Timestamp], Field(max_length=MAX_STROKE_POINTS)]
+
+
+class PlanRequest(BaseModel):
+    """What the page asks to be planned: a drawing or typed text, and the limits.
+
+    Exactly one of ``strokes`` and ``text`` is given.
+    """
+
+    model_config = ConfigDict(
+        extra="forbid",
+        allow_inf_nan=False,
+        json_schema_extra={
+            "examples": [
+                {
+                    "strokes": [[[0, 0], [50, 80], [100, 0]], [[20, 30], [80, 30]]],
+                    "t": [[0.0, 0.2, 0.4], [1.0, 1.3]],
+                    "size_m": 0.5,
+                    "vmax": 1.0,
+                    "amax": 2.0,
+                    "jmax": 10.0,
+                },
+                {"text": "Hi", "drones": 2, "board": "wall"},
+            ]
+        },
+    )
+
+    strokes: Annotated[list[Stroke] | None, Field(max_length=MAX_STROKES)] = Field(
+        default=None,
+        description="Drawn strokes in drawing order: lists of [x, y] points, y up, any unit.",
+    )
+    t: Annotated[list[StrokeTimes] | None, Field(max_length=MAX_STROKES)] = Field(
+        default=None,
+        description="Optional timestamps, s: one list per stroke, one per point, increasing.",
+    )
+    text: Annotated[str | None, Field(min_length=1, max_length=MAX_TEXT)] = Field(
+        default=None, description="Text to write instead of strokes (Latin or Chinese)."
+    )
+    board: Literal["horizontal", "wall"] = Field(
+        default="horizontal", description="A horizontal board (paper 000) or a wall."
+    )
+    size_m: float = Field(
+        default=0.5, ge=0.05, le=5.0, description="Larger side of each drone's writing, m."
+    )
+    vmax: float = Field(default=1.0, gt=0.0, le=20.0, description="Speed limit per axis, m/s.")
+    amax: float = Field(
+        default=2.0, gt=0.0, le=50.0, description="Acceleration limit per axis, m/s^2."
+    )
+    jmax: float = Field(default=10.0, gt=0.0, le=1000.0, description="Jerk limit per axis, m/s^3.")
+    drones: int = Field(
+        default=1, ge=1, le=MAX_DRONES, description="Drones writing at once, boards side by side."
+    )
+    fly: bool = Field(default=True, description="Also fly every drone in closed-loop simulation.")
+
+    @model_validator(mode="after")
+    def _one_input(self) -> PlanRequest:
+        """Exactly one input; timestamps only with strokes; total points bounded."""
+        if (self.strokes is None) == (self.text is None):
+            got = "both" if self.strokes is not None else "neither"
+            raise ValueError(f"got {got} of strokes and text, expected exactly one")
+        if self.t is not None and self.strokes is None:
+            raise ValueError("t: got timestamps without strokes, expected them only with strokes")
+        if self.strokes is not None:
+            total = sum(len(s) for s in self.strokes)
+            if total > MAX_POINTS:
+                raise ValueError(
+                    f"strokes: got {total} points in all, expected at most {MAX_POINTS}"
+                )
+        if self.text is not None and not self.text.strip():
+            raise ValueError(f"text: got {self.text!r}, expected at least one visible character")
+        return self
+
+
+JobState = Literal["queued", "running", "done", "error"]
+
+
+class Limits(BaseModel):
+    """The per-axis limits the plan was asked to respect."""
+
+    vmax: float
+    amax: float
+    jmax: float
+
+
+class LimitCheck(BaseModel):
+    """One limit as the dense verification found it."""
+
+    label: str
+    max_value: float
+    relative_excess: float
+    guaranteed: bool
+
+
+class DronePlan(BaseModel):
+    """One drone's plan, in its board's coordinates: u right, v up, h off the board (m).
+
+    Attributes of the page's overlay: ``source_lo`` and ``source_scale`` map
+    board coordinates back to the units the strokes came in
+    (``source = source_lo + uv / source_scale``), so the path lands on the ink.
+    """
+
+    board_u0: float = Field(description="This board's left edge, m along the row of boards.")
+    source_lo: tuple[float, float]
+    source_scale: float = Field(description="Metres per source unit.")
+    input: list[list[tuple[float, float]]] = Field(description="The strokes on the board, m.")
+    t: list[float] = Field(description="Sample times, s.")
+    path: list[tuple[float, float, float]] = Field(description="Planned tip (u, v, h), m.")
+    pen: list[int] = Field(description="1 where the pen is down at t, else 0.")
+    speed: list[float] = Field(description="Largest |velocity component| at t, m/s.")
+    acc: list[float] = Field(description="Largest |acceleration component| at t, m/s^2.")
+    jerk: list[float] = Field(description="Largest |jerk component| at t, m/s^3.")
+    flight: list[tuple[float, float, float]] = Field(
+        description="Simulated tip (u, v, h), m, at the same times (empty if not flown)."
+    )
+    ink: list[list[tuple[float, float]]] = Field(
+        description="What the simulated brush drew on the board, m (horizontal board only)."
+    )
+    duration_s: float
+    planning_time_s: float
+    deviation_max_m: float
+    checks: list[LimitCheck]
+    flight_rmse_m: float | None = None
+    ink_max_deviation_m: float | None = None
+
+
+class DownloadFile(BaseModel):
+    """A file the page offers for download."""
+
+    name: str
+    url: str
+    description: str
+    size_bytes: int
+
+
+class PlanResult(BaseModel):
+    """Everything the page shows after a plan."""
+
+    source: Literal["strokes", "text"]
+    board: Literal["horizontal", "wall"]
+    size_m: float
+    limits: Limits
+    duration_s: float
+    planning_time_s: float
+    min_separation_m: float | None
+    drones: list[DronePlan]
+    files: list[DownloadFile]
+    notes: list[str]
+
+
+class JobAccepted(BaseModel):
+    """The answer to a plan request: where to poll."""
+
+    job_id: str
+    url: str
+
+
+class JobStatus(BaseModel):
+    """A planning job: its state, progress and, once done, the result."""
+
+    job_id: str
+    state: JobState
+    progress: float = Field(ge=0.0, le=1.0)
+    stage: str
+    message: str = ""
+    elapsed_s: float
+    result: PlanResult | None = None

@@ -1,0 +1,356 @@
+"""One studio plan, start to finish: request -> missions -> simulated flights -> files.
+
+This is the work a job does off the event loop. It is the ``skyquill write``
+pipeline (:mod:`skyquill.cli.write_cmd`) with two differences: the drones are
+planned one after the other in this thread so that progress can be reported
+(and the time limit checked) between them, and the exports are generated in a
+temporary directory and kept in memory, keyed by the job, never at a path that
+came from a request.
+"""
+
+from __future__ import annotations
+
+import io
+import itertools
+import json
+import math
+import tempfile
+import zipfile
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from skyquill.calligraphy.board import Board
+from skyquill.calligraphy.mission import (
+    Mission,
+    WritingOptions,
+    check_separation,
+    plan_writing,
+)
+from skyquill.calligraphy.show import layout
+from skyquill.errors import InfeasibleError, InputError, SolverError
+from skyquill.strokes import Strokes
+from skyquill.studio.models import DownloadFile, DronePlan, LimitCheck, Limits, PlanRequest
+from skyquill.studio.models import PlanResult as PlanResultModel
+from skyquill.validation import FloatArray
+
+#: Smallest distance between two drones at any time, m (``skyquill write``'s default).
+SEPARATION_M = 1.0
+#: Rate of the setpoint CSVs, Hz (``skyquill write``'s default).
+CSV_RATE_HZ = 100.0
+#: Rate of the curves sent to the page, Hz, and the most samples per drone.
+VIEW_RATE_HZ = 50.0
+MAX_VIEW_SAMPLES = 3_000
+#: Most points of one simulated ink polyline sent to the page.
+MAX_INK_POINTS = 600
+#: Decimals of the numbers sent to the page (0.1 mm, 0.1 ms: far below what is drawn).
+DECIMALS = 4
+
+#: Why ``skyquill.cli.main`` is imported before ``write_cmd``: importing ``write_cmd``
+#: first fails (write_cmd -> fit_cmd -> main -> export_cmd -> fit_cmd, half-initialised).
+_CLI_ORDER = "cli.main before cli.write_cmd"
+
+#: ``progress(fraction, stage)``; it may raise to stop the plan (time limit).
+Progress = Callable[[float, str], None]
+
+
+@dataclass(frozen=True)
+class StudioFile:
+    """A generated download, in memory."""
+
+    name: str
+    data: bytes
+    media_type: str
+    description: str
+
+
+@dataclass(frozen=True)
+class PlanOutput:
+    """A finished plan: what the page shows, and the files it offers."""
+
+    result: PlanResultModel
+    files: dict[str, StudioFile]
+
+
+def parts_of(request: PlanRequest) -> list[Strokes]:
+    """What each drone writes: the drawing or the text, shared out in consecutive parts."""
+    import skyquill.cli.main  # noqa: F401  (first: see _CLI_ORDER)
+    from skyquill.cli.write_cmd import is_cjk, split_text
+    from skyquill.strokes import hanzi_text, text_strokes
+
+    if request.text is not None:
+        text = request.text
+        chunks = [text] if request.drones == 1 else split_text(text, request.drones)
+        return [hanzi_text(c) if is_cjk(c) else text_strokes(c) for c in chunks]
+    assert request.strokes is not None  # the model guarantees exactly one input
+    drawing = Strokes(
+        paths=tuple(np.asarray(s, dtype=float) for s in request.strokes),
+        times=None if request.t is None else tuple(np.asarray(t, float) for t in request.t),
+        source="studio drawing",
+    )
+    return split_strokes(drawing, request.drones)
+
+
+def split_strokes(drawing: Strokes, parts: int) -> list[Strokes]:
+    """``drawing`` in ``parts`` consecutive groups of whole strokes (one per drone)."""
+    n = drawing.n_strokes
+    if n < parts:
+        raise InputError(
+            f"drones: got {parts} drones for {n} stroke(s), expected at most one drone per stroke"
+        )
+    bounds = np.linspace(0, n, parts + 1).round().astype(int)
+    out = []
+    for a, b in itertools.pairwise(bounds):
+        times = None if drawing.times is None else drawing.times[a:b]
+        out.append(Strokes(paths=drawing.paths[a:b], times=times, source=drawing.source))
+    return out
+
+
+def run_plan(
+    request: PlanRequest, *, progress: Progress, file_url: Callable[[str], str]
+) -> PlanOutput:
+    """Plan, fly and export what ``request`` asks; report progress between the stages.
+
+    Parameters
+    ----------
+    request
+        The validated request.
+    progress
+        Called with the fraction done (0 to 1) and a stage name; may raise to stop.
+    file_url
+        The URL at which the page will find a generated file, from its name.
+
+    Raises
+    ------
+    InputError, InfeasibleError
+        The request cannot be planned (the message is for the person).
+    """
+    progress(0.02, "reading the input")
+    parts = parts_of(request)
+    options = WritingOptions(
+        size_m=request.size_m, vmax=request.vmax, amax=request.amax, jmax=request.jmax
+    )
+    places = layout(len(parts), options.size_m, SEPARATION_M, kind=request.board)
+    missions: list[Mission] = []
+    for i, (part, (board, home)) in enumerate(zip(parts, places, strict=True)):
+        progress(0.05 + 0.6 * i / len(parts), f"planning drone {i + 1} of {len(parts)}")
+        missions.append(_plan_one(part, board, options, home, i))
+    closest = None
+    if len(missions) > 1:
+        progress(0.65, "checking the separation between drones")
+        closest = check_separation([m.trajectory for m in missions], SEPARATION_M)
+    drones = []
+    for i, (mission, part) in enumerate(zip(missions, parts, strict=True)):
+        progress(0.7 + 0.2 * i / len(parts), f"flying drone {i + 1} of {len(parts)} in simulation")
+        drones.append(_drone_plan(mission, part, places[0][0], fly=request.fly))
+    progress(0.92, "writing the files")
+    files, notes = _exports(missions, [home for _, home in places])
+    result = PlanResultModel(
+        source="text" if request.text is not None else "strokes",
+        board=request.board,
+        size_m=request.size_m,
+        limits=Limits(vmax=request.vmax, amax=request.amax, jmax=request.jmax),
+        duration_s=max(m.trajectory.duration for m in missions),
+        planning_time_s=sum(m.planning_time_s for m in missions),
+        min_separation_m=closest,
+        drones=drones,
+        files=[
+            DownloadFile(
+                name=f.name, url=file_url(f.name), description=f.description, size_bytes=len(f.data)
+            )
+            for f in files.values()
+        ],
+        notes=notes,
+    )
+    return PlanOutput(result, files)
+
+
+def _plan_one(
+    part: Strokes, board: Board, options: WritingOptions, home: FloatArray, i: int
+) -> Mission:
+    """One drone's mission; a solver that gives up is told as limits not met."""
+    try:
+        return plan_writing(part, board, options, home)
+    except SolverError as exc:
+        # Seen with tiny jerk limits: the QP backends hit their iteration limit
+        # instead of proving infeasibility. To the person it is the same answer.
+        raise InfeasibleError(
+            f"limits: could not plan drone {i + 1}'s flight within speed {options.vmax:g} m/s, "
+            f"acceleration {options.amax:g} m/s^2 and jerk {options.jmax:g} m/s^3 ({exc}); "
+            "expected looser limits or a smaller drawing"
+        ) from exc
+
+
+def _round(a: FloatArray) -> Any:
+    """``a`` as nested lists of floats rounded to :data:`DECIMALS` (smaller JSON)."""
+    return np.round(np.asarray(a, dtype=float), DECIMALS).tolist()
+
+
+def _view_times(duration: float) -> FloatArray:
+    n = min(MAX_VIEW_SAMPLES, math.ceil(duration * VIEW_RATE_HZ) + 1)
+    return np.linspace(0.0, duration, max(n, 2))
+
+
+def _drone_plan(mission: Mission, part: Strokes, first_board: Board, *, fly: bool) -> DronePlan:
+    """One drone's curves for the page, in its board's coordinates."""
+    traj, board = mission.trajectory, mission.board
+    t = _view_times(traj.duration)
+    v, a, j = (np.abs(traj.evaluate(t, n)).max(axis=1) for n in (1, 2, 3))
+    lo, hi = part.bounds()
+    check = mission.fit.verification
+    fields: dict[str, Any] = {
+        "board_u0": float(board.origin[0] - first_board.origin[0]),
+        "source_lo": (float(lo[0]), float(lo[1])),
+        "source_scale": mission.options.size_m / float(np.max(hi - lo)),
+        "input": [_round(board.to_board(s)[:, :2]) for s in mission.strokes_world],
+        "t": _round(t),
+        "path": _round(board.to_board(traj.evaluate(t))),
+        "pen": mission.pen(t).astype(int).tolist(),
+        "speed": _round(v),
+        "acc": _round(a),
+        "jerk": _round(j),
+        "flight": [],
+        "ink": [],
+        "duration_s": traj.duration,
+        "planning_time_s": mission.planning_time_s,
+        "deviation_max_m": mission.deviation.max_m,
+        "checks": [LimitCheck.model_validate(c) for c in check.limits_report()],
+    }
+    if fly:
+        fields |= _flight_fields(mission, t)
+    return DronePlan.model_validate(fields)
+
+
+def _sim_board(mission: Mission) -> Any:
+    """The simulated board under a horizontal writing board (as ``skyquill write --fly``)."""
+    import skyquill.cli.main  # noqa: F401  (first: see _CLI_ORDER)
+    from skyquill.cli.write_cmd import PRESS_M
+    from skyquill.sim import Board as SimBoard
+
+    if mission.board.kind != "horizontal":
+        return None  # the simulator's contact model is a horizontal board only
+    corner, size, margin = mission.board.origin, mission.options.size_m, 0.1
+    return SimBoard(
+        height_m=float(corner[2]) + PRESS_M,
+        extent=(
+            corner[0] - margin,
+            corner[0] + size + margin,
+            corner[1] - margin,
+            corner[1] + size + margin,
+        ),
+    )
+
+
+def _flight_fields(mission: Mission, t: FloatArray) -> dict[str, Any]:
+    """The closed-loop flight (RPT) of the vehicle trajectory, as :class:`DronePlan` fields."""
+    from skyquill.sim import Quadrotor, simulate
+
+    board = mission.board
+    flight = simulate(
+        mission.vehicle_trajectory(),
+        Quadrotor(brush_length_m=mission.options.brush_length_m),
+        board=_sim_board(mission),
+    )
+    # The tip hangs the brush length below the vehicle (its swing with tilt is not drawn).
+    tip = np.column_stack([np.interp(t, flight.t, flight.p[:, k]) for k in range(3)])
+    tip = tip - mission.brush_offset
+    ink = [s for s in flight.ink if len(s) >= 2]
+    return {
+        "flight": _round(board.to_board(tip)),
+        "ink": [_round(board.to_board(_decimate(s))[:, :2]) for s in ink],
+        "flight_rmse_m": flight.rmse_m,
+        "ink_max_deviation_m": _ink_deviation(ink, mission.strokes_world),
+    }
+
+
+def _ink_deviation(ink: Sequence[FloatArray], strokes: Sequence[FloatArray]) -> float:
+    """Largest distance from the simulated ink to the nearest input stroke, m."""
+    if not ink:
+        return 0.0
+    from skyquill.geometry import polyline_distance
+
+    points = np.vstack(ink)
+    return float(np.min([polyline_distance(points, s) for s in strokes], axis=0).max())
+
+
+def _decimate(points: FloatArray) -> FloatArray:
+    """At most :data:`MAX_INK_POINTS` of ``points``, the last one kept."""
+    step = max(1, math.ceil(len(points) / MAX_INK_POINTS))
+    return np.vstack([points[::step], points[-1:]])
+
+
+def _exports(
+    missions: Sequence[Mission], homes: Sequence[FloatArray]
+) -> tuple[dict[str, StudioFile], list[str]]:
+    """Setpoint CSV(s), Crazyswarm CSV(s) and the ``.skyc`` show, generated in a temp dir."""
+    from skyquill.io.crazyswarm import write_crazyswarm
+    from skyquill.io.points import write_trajectory_csv
+    from skyquill.io.skyc import write_skyc
+
+    vehicles = [m.vehicle_trajectory() for m in missions]
+    notes: list[str] = []
+    with tempfile.TemporaryDirectory(prefix="skyquill-studio-") as tmp:
+        out = Path(tmp)
+        setpoints: list[Path] = []
+        swarm: list[Path] = []
+        for i, (mission, vehicle) in enumerate(zip(missions, vehicles, strict=True), start=1):
+            csv = out / f"setpoints_{i}.csv"
+            write_trajectory_csv(csv, vehicle, CSV_RATE_HZ, pen=mission.pen)
+            setpoints.append(csv)
+            export = write_crazyswarm(vehicle, out / f"crazyswarm_{i}.csv")
+            swarm.extend(export.files)
+            notes.append(f"drone {i}: {export.message.replace(str(out) + '/', '')}")
+        skyc = write_skyc(
+            vehicles, out / "show.skyc", homes=np.array(homes), title="skyquill studio"
+        )
+        notes.append(skyc.message)
+        files = [
+            _bundle(
+                setpoints,
+                "setpoints",
+                f"setpoints at {CSV_RATE_HZ:g} Hz: t, x, y, z, velocity, acceleration, jerk, "
+                "yaw, pen (SI, z up)",
+            ),
+            _bundle(
+                swarm, "crazyswarm", "Crazyswarm2 polynomial trajectory (uav_trajectories CSV)"
+            ),
+            StudioFile("show.skyc", skyc.path.read_bytes(), "application/zip", "Skybrush show"),
+        ]
+    files.append(_summary(missions))
+    return {f.name: f for f in files}, notes
+
+
+def _bundle(paths: Sequence[Path], stem: str, description: str) -> StudioFile:
+    """One CSV as ``<stem>.csv``, or several in ``<stem>.zip``."""
+    if len(paths) == 1:
+        return StudioFile(f"{stem}.csv", paths[0].read_bytes(), "text/csv", description)
+    buffer = io.BytesIO()
+    with zipfile.ZipFile(buffer, "w", compression=zipfile.ZIP_DEFLATED) as archive:
+        for p in paths:
+            archive.writestr(p.name, p.read_bytes())
+    note = " (one file per drone and upload, in a zip)"
+    return StudioFile(f"{stem}.zip", buffer.getvalue(), "application/zip", description + note)
+
+
+def _summary(missions: Sequence[Mission]) -> StudioFile:
+    """``summary.json``: each drone's verification, deviation and timing."""
+    drones = [
+        {
+            "duration_s": m.trajectory.duration,
+            "planning_time_s": m.planning_time_s,
+            "limits": [
+                {k: (float(v) if isinstance(v, np.floating) else v) for k, v in c.items()}
+                for c in m.fit.verification.limits_report()
+            ],
+            "max_excess": float(m.fit.verification.max_excess),
+            "deviation": m.deviation.as_dict(),
+            "faithful": m.faithful,
+            "time_scale": m.time_scale,
+        }
+        for m in missions
+    ]
+    data = json.dumps({"drones": drones}, indent=2, allow_nan=False).encode()
+    return StudioFile("summary.json", data, "application/json", "verification and timing")
