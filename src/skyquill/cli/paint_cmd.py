@@ -1,0 +1,191 @@
+"""``skyquill paint``: a simulated dot-painting mission on a wall (paper 002).
+
+Writes ``summary.json``, ``painted.csv`` (per dot: reference and painted ``x, z``) and
+``plot.png`` into ``--out``.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+from pathlib import Path
+from typing import TYPE_CHECKING, Annotated
+
+import typer
+
+from skyquill.cli.main import OutDir, app, console, user_errors
+from skyquill.errors import InputError
+
+if TYPE_CHECKING:  # the painting package is imported lazily
+    from rich.progress import Progress
+
+    from skyquill.painting.estimate import UpdateMode
+    from skyquill.painting.mission import MissionResult
+    from skyquill.validation import FloatArray
+
+#: Largest |gamma| accepted, deg: beyond it the drone does not face the wall.
+MAX_GAMMA_DEG = 60.0
+
+
+@app.command()
+def paint(
+    out: OutDir,
+    dots_csv: Annotated[
+        Path | None,
+        typer.Argument(help="Dots CSV with columns x (along the wall) and z (height), m."),
+    ] = None,
+    image: Annotated[
+        Path | None, typer.Option(help="Stipple this PNG/JPEG instead of reading DOTS.csv.")
+    ] = None,
+    dots: Annotated[int, typer.Option(help="Number of dots to stipple from --image.")] = 140,
+    width: Annotated[float, typer.Option(help="Width of the stippled drawing, m.")] = 3.5,
+    gamma: Annotated[float, typer.Option(help="True yaw offset of the placement, deg.")] = 0.0,
+    offset: Annotated[
+        str, typer.Option(help="True placement offset delta x,y,z in the wall frame, m.")
+    ] = "0,-1.1,0",
+    wall_angles: Annotated[
+        str, typer.Option(help="Segment angles left to right, deg, e.g. -10,0,10 (0: flat).")
+    ] = "0",
+    estimator: Annotated[str, typer.Option(help="none, svd or robust.")] = "svd",
+    localization: Annotated[str, typer.Option(help="onboard or truth.")] = "onboard",
+    order: Annotated[str, typer.Option(help="given, paper (right-left, top-bottom), shortest.")] = (
+        "given"
+    ),
+    update: Annotated[
+        str, typer.Option(help="Segmented walls: depth (eq. 15) or normal (fresco).")
+    ] = "depth",
+    false_contacts: Annotated[
+        float, typer.Option(help="Probability of a false contact per approach.")
+    ] = 0.0,
+    missed_contacts: Annotated[
+        float, typer.Option(help="Probability of a missed contact per approach.")
+    ] = 0.0,
+    seed: Annotated[int, typer.Option(help="Seed of the random generator.")] = 0,
+) -> None:
+    """Paint DOTS.csv (or a stippled --image) on a wall; write summary.json, painted.csv, plot."""
+    import numpy as np
+
+    from skyquill.cli.fly_cmd import _vector3
+    from skyquill.io.points import write_json
+    from skyquill.painting.dots import drawing_span
+    from skyquill.painting.mission import MissionConfig, run_mission
+    from skyquill.painting.wall import Placement, Wall, parse_angles
+    from skyquill.viz.painting_plot import plot_mission
+
+    with user_errors():
+        if out.exists() and not out.is_dir():
+            raise InputError(f"--out: got {str(out)!r}, an existing file; expected a directory")
+        if not -MAX_GAMMA_DEG <= gamma <= MAX_GAMMA_DEG:
+            raise InputError(
+                f"--gamma: got {gamma:g}, expected an angle from -{MAX_GAMMA_DEG:g} to "
+                f"{MAX_GAMMA_DEG:g} deg"
+            )
+        delta = _vector3("--offset", offset, "m")
+        if not -20.0 <= delta[1] < 0.0 or np.abs(delta).max() > 20.0:
+            raise InputError(
+                f"--offset: got {offset!r}, expected the drone in front of the wall: "
+                "-20 <= y < 0 m and every component within 20 m"
+            )
+        angles = parse_angles(wall_angles)
+        for option, rate in (
+            ("--false-contacts", false_contacts),
+            ("--missed-contacts", missed_contacts),
+        ):
+            if not 0.0 <= rate < 1.0:
+                raise InputError(f"{option}: got {rate:g}, expected a probability in [0, 1)")
+        with _progress() as bar:
+            points = _dots(dots_csv, image, dots, width, seed, bar)
+            lo, hi = drawing_span(points)
+            wall = Wall.segmented(angles, (lo, hi))
+            task = bar.add_task("painting", total=None)
+            result = run_mission(
+                points,
+                wall=wall,
+                truth=Placement(delta, math.radians(gamma)),
+                estimator=estimator,
+                localization=localization,
+                order=order,
+                update=_update(update),
+                config=MissionConfig(
+                    false_contact_rate=false_contacts, missed_contact_rate=missed_contacts
+                ),
+                rng=np.random.default_rng(seed),
+                progress=lambda done, total: bar.update(task, completed=done, total=total),
+            )
+        out.mkdir(parents=True, exist_ok=True)
+        _write_painted(out / "painted.csv", result)
+        with console.status("plotting"):
+            plot_mission(result, out / "plot.png", (dots_csv or image or Path("")).name)
+        summary = result.summary() | {
+            "source": str(dots_csv or image),
+            "seed": seed,
+            "order": order,
+            "gamma_deg": gamma,
+            "offset_m": [float(v) for v in delta],
+        }
+        write_json(out / "summary.json", summary)
+    console.print(
+        f"[green]done[/] {out}: {result.painted.sum()} of {len(result.reference)} dots, RMSE "
+        f"{100 * result.rmse_m:.2f} cm, max {100 * result.max_error_m:.2f} cm, "
+        f"{result.flight_time_s / 60:.1f} min, {result.landings} landing(s)",
+        highlight=False,
+    )
+
+
+def _progress() -> Progress:
+    """A rich progress bar on stderr (the console the CLI prints to)."""
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn
+
+    return Progress(
+        TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), console=console
+    )
+
+
+def _update(name: str) -> UpdateMode:
+    if name not in ("depth", "normal"):
+        raise InputError(f"--update: got {name!r}, expected 'depth' or 'normal'")
+    return "depth" if name == "depth" else "normal"
+
+
+def _dots(
+    dots_csv: Path | None, image: Path | None, n: int, width: float, seed: int, bar: Progress
+) -> FloatArray:
+    """The dots from the CSV, or stippled from the image (exactly one of them)."""
+    import numpy as np
+
+    from skyquill.painting.dots import load_darkness, read_dots_csv, stipple
+
+    if (dots_csv is None) == (image is None):
+        raise InputError(
+            "DOTS.csv / --image: got "
+            + ("both" if dots_csv is not None else "neither")
+            + ", expected exactly one of them"
+        )
+    if dots_csv is not None:
+        return read_dots_csv(dots_csv)
+    if not (math.isfinite(width) and 0.0 < width <= 20.0):
+        raise InputError(f"--width: got {width:g}, expected a width in (0, 20] m")
+    assert image is not None  # narrowed by the check above
+    darkness = load_darkness(image)
+    task = bar.add_task("stippling", total=None)
+    return stipple(
+        darkness,
+        n,
+        width_m=width,
+        rng=np.random.default_rng(seed),
+        progress=lambda done, total: bar.update(task, completed=done, total=total),
+    )
+
+
+def _write_painted(path: Path, result: MissionResult) -> None:
+    """``dot, order, x_ref, z_ref, x_painted, z_painted, error_m`` (empty when not painted)."""
+    rank = {int(i): k for k, i in enumerate(result.order)}
+    with path.open("w", newline="", encoding="utf-8") as handle:
+        out = csv.writer(handle)
+        out.writerow(["dot", "order", "x_ref", "z_ref", "x_painted", "z_painted", "error_m"])
+        for i, (ref, hit, err) in enumerate(
+            zip(result.reference, result.painted_w, result.errors_m, strict=True)
+        ):
+            done = math.isfinite(err)
+            cells = [f"{hit[0]:.5f}", f"{hit[2]:.5f}", f"{err:.5f}"] if done else ["", "", ""]
+            out.writerow([i, rank[i], f"{ref[0]:.5f}", f"{ref[1]:.5f}", *cells])
