@@ -10,7 +10,6 @@ import pytest
 from typer.testing import CliRunner
 
 from skyquill.cli.main import app
-from skyquill.cli.write_cmd import split_text
 from skyquill.geometry import polyline_distance
 
 runner = CliRunner()
@@ -74,11 +73,6 @@ def test_four_drones_write_yi_ma_dang_xian_and_fly(tmp_path: Path) -> None:
         assert drone["flight"]["saturations"] == {"thrust_max": 0, "thrust_min": 0, "tilt": 0}
     strokes = json.loads((tmp_path / "input_strokes.json").read_text())
     assert strokes["first_stroke_of_drone"][-1] == len(strokes["strokes"]) == summary["strokes"]
-
-
-def test_split_text() -> None:
-    assert split_text("一马当先", 4) == ["一", "马", "当", "先"]
-    assert split_text("one two three", 2) == ["one two", "three"]
 
 
 @pytest.mark.parametrize(

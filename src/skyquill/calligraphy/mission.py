@@ -28,7 +28,7 @@ import itertools
 import math
 import time
 from dataclasses import dataclass, field
-from typing import Literal
+from typing import TYPE_CHECKING, Literal
 
 import numpy as np
 
@@ -42,6 +42,9 @@ from skyquill.optimize.timing import allocate_path_times
 from skyquill.strokes import Strokes, turning_points
 from skyquill.trajectory import SplineTrajectory
 from skyquill.validation import FloatArray, as_array, as_float, as_int
+
+if TYPE_CHECKING:  # the simulator is imported only to fly
+    from skyquill.sim import Board as SimBoard
 
 #: Spacing of the samples that hold lifts and transits near their straight lines, m.
 TRANSIT_SPACING_M = 0.01
@@ -580,3 +583,28 @@ def check_separation(
                     ("separation",),
                 )
     return closest
+
+
+#: How far the simulated board is raised into the brush's planned path, m.
+PRESS_M = 0.002
+#: How far the simulated board reaches beyond the writing on every side, m.
+BOARD_MARGIN_M = 0.1
+
+
+def contact_board(mission: Mission) -> SimBoard | None:
+    """The simulator's board under a horizontal writing board (``None`` for a wall).
+
+    The plan touches the surface; the simulated board sits :data:`PRESS_M`
+    higher so that the brush presses into it and tracking errors do not lift
+    it off. The simulator's contact model is a horizontal slab only.
+    """
+    from skyquill.sim import Board as SimBoard
+
+    if mission.board.kind != "horizontal":
+        return None
+    corner, size, margin = mission.board.origin, mission.options.size_m, BOARD_MARGIN_M
+    return SimBoard(
+        height_m=float(corner[2]) + PRESS_M,
+        extent=(corner[0] - margin, corner[0] + size + margin,
+                corner[1] - margin, corner[1] + size + margin),
+    )  # fmt: skip

@@ -8,8 +8,7 @@ from typing import Annotated, Any
 
 import typer
 
-from skyquill.cli.fit_cmd import _rate
-from skyquill.cli.main import app, console, user_errors
+from skyquill.cli.main import app, console, positive_rate, user_errors
 from skyquill.errors import InputError
 from skyquill.io.points import write_json, write_trajectory_csv
 from skyquill.io.spline_json import read_spline_json
@@ -55,7 +54,7 @@ def export(
     with user_errors():
         if format not in FORMATS:
             raise InputError(f"--format: got {format!r}, expected one of {', '.join(FORMATS)}")
-        rate = _rate(rate)
+        rate = positive_rate(rate)
         trajectories = find_trajectories(directory)
         out.parent.mkdir(parents=True, exist_ok=True)
         summary = _export(trajectories, out, format, rate)

@@ -7,7 +7,7 @@ from typing import Annotated, Any
 
 import typer
 
-from skyquill.cli.main import OutDir, app, console, user_errors
+from skyquill.cli.main import OutDir, app, console, positive_rate, user_errors
 from skyquill.errors import InputError
 from skyquill.io.points import read_points_csv, write_json, write_trajectory_csv
 from skyquill.io.spline_json import write_spline_json
@@ -72,12 +72,6 @@ def run_fit(
     return summary
 
 
-def _rate(rate: float) -> float:
-    if not rate > 0:
-        raise InputError(f"--rate: got {rate:g}, expected a positive number of Hz")
-    return rate
-
-
 @app.command()
 def fit(
     points_csv: Annotated[Path, typer.Argument(help="CSV with columns x,y[,z][,t] in m and s.")],
@@ -129,7 +123,7 @@ def fit(
             raise InputError(f"--timing: got 'given', but {points_csv.name} has no t column")
         if timing in ("path", "segments"):
             times = None
-        run_fit(points, times, options, out, _rate(rate), points_csv.stem)
+        run_fit(points, times, options, out, positive_rate(rate), points_csv.stem)
 
 
 def _hull(name: str) -> Any:

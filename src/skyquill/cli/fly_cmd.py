@@ -7,11 +7,9 @@ from typing import TYPE_CHECKING, Annotated, Literal
 
 import typer
 
-from skyquill.cli.fit_cmd import _rate
-from skyquill.cli.main import OutDir, app, console, user_errors
+from skyquill.cli.main import OutDir, app, console, parse_vector3, positive_rate, user_errors
 from skyquill.errors import InputError
 from skyquill.io.points import write_json
-from skyquill.validation import FloatArray
 
 if TYPE_CHECKING:  # the fly command imports the simulator lazily
     from skyquill.io.trajectory_csv import SampledTrajectory
@@ -56,7 +54,7 @@ def fly(
         if sim not in FLY_SIMS:
             raise InputError(f"--sim: got {sim!r}, expected 'skyquill' or 'rotorpy'")
         loop = _fly_controller(controller, sim)
-        wind_mps = _vector3("--wind", wind, "m/s")
+        wind_mps = parse_vector3("--wind", wind, "m/s")
         if np.abs(wind_mps).max() > MAX_WIND_MPS:
             raise InputError(
                 f"--wind: got {wind!r}, expected components of at most {MAX_WIND_MPS:g} m/s"
@@ -64,7 +62,7 @@ def fly(
         for option, value, most in (("--gust", gust, MAX_WIND_MPS), ("--noise", noise, 1.0)):
             if not 0.0 <= value <= most:
                 raise InputError(f"{option}: got {value:g}, expected a number from 0 to {most:g}")
-        rate = _rate(rate)
+        rate = positive_rate(rate)
         trajectory = read_trajectory_csv(trajectory_csv)
         disturbances = Disturbances(wind_mps=wind_mps, gust_std_mps=gust, position_noise_m=noise)
         with console.status(
@@ -157,22 +155,3 @@ def _fly_once(
         return fly_rotorpy(trajectory, loop, rate_hz=rate)
     except ImportError as exc:
         raise InputError(f"--sim rotorpy: {exc}") from None
-
-
-def _vector3(option: str, text: str, unit: str) -> FloatArray:
-    """Parse ``"x,y,z"`` into a (3,) float array; InputError naming ``option`` otherwise."""
-    import math
-
-    import numpy as np
-
-    parts = [p.strip() for p in text.split(",")]
-    try:
-        values = [float(p) for p in parts]
-    except ValueError:
-        values = []
-    if len(values) != 3 or not all(math.isfinite(v) for v in values):
-        raise InputError(
-            f"{option}: got {text!r}, expected three comma-separated finite numbers in {unit}, "
-            "e.g. 2,0,0"
-        )
-    return np.array(values)

@@ -10,15 +10,18 @@ with status 2; no traceback.
 from __future__ import annotations
 
 import logging
+import math
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Annotated
 
+import numpy as np
 import typer
 from rich.console import Console
 
-from skyquill.errors import SkyquillError
+from skyquill.errors import InputError, SkyquillError
+from skyquill.validation import FloatArray
 
 app = typer.Typer(
     add_completion=False,
@@ -45,6 +48,28 @@ def user_errors() -> Iterator[None]:
     except SkyquillError as exc:
         console.print(f"[bold red]error:[/] {exc}", highlight=False)
         raise typer.Exit(2) from None
+
+
+def positive_rate(rate: float) -> float:
+    """``--rate`` (Hz), checked to be a positive number."""
+    if not rate > 0:
+        raise InputError(f"--rate: got {rate:g}, expected a positive number of Hz")
+    return rate
+
+
+def parse_vector3(option: str, text: str, unit: str) -> FloatArray:
+    """Parse ``"x,y,z"`` into a (3,) float array; InputError naming ``option`` otherwise."""
+    parts = [p.strip() for p in text.split(",")]
+    try:
+        values = [float(p) for p in parts]
+    except ValueError:
+        values = []
+    if len(values) != 3 or not all(math.isfinite(v) for v in values):
+        raise InputError(
+            f"{option}: got {text!r}, expected three comma-separated finite numbers in {unit}, "
+            "e.g. 2,0,0"
+        )
+    return np.array(values)
 
 
 # Register the commands (each module adds its own to ``app``).

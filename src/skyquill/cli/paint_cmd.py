@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING, Annotated
 
 import typer
 
-from skyquill.cli.main import OutDir, app, console, user_errors
+from skyquill.cli.main import OutDir, app, console, parse_vector3, user_errors
 from skyquill.errors import InputError
 
 if TYPE_CHECKING:  # the painting package is imported lazily
@@ -65,7 +65,6 @@ def paint(
     """Paint DOTS.csv (or a stippled --image) on a wall; write summary.json, painted.csv, plot."""
     import numpy as np
 
-    from skyquill.cli.fly_cmd import _vector3
     from skyquill.io.points import write_json
     from skyquill.painting.dots import drawing_span
     from skyquill.painting.mission import MissionConfig, run_mission
@@ -80,7 +79,7 @@ def paint(
                 f"--gamma: got {gamma:g}, expected an angle from -{MAX_GAMMA_DEG:g} to "
                 f"{MAX_GAMMA_DEG:g} deg"
             )
-        delta = _vector3("--offset", offset, "m")
+        delta = parse_vector3("--offset", offset, "m")
         if not -20.0 <= delta[1] < 0.0 or np.abs(delta).max() > 20.0:
             raise InputError(
                 f"--offset: got {offset!r}, expected the drone in front of the wall: "

@@ -2,48 +2,24 @@
 
 from __future__ import annotations
 
-import itertools
 import json
-import unicodedata
 from pathlib import Path
 from typing import Annotated, Any
 
 import numpy as np
 import typer
 
-from skyquill.cli.fit_cmd import _rate
-from skyquill.cli.main import OutDir, app, console, user_errors
+from skyquill.cli.main import OutDir, app, console, positive_rate, user_errors
 from skyquill.errors import InputError
 from skyquill.io.points import write_json, write_trajectory_csv
 from skyquill.io.spline_json import write_spline_json
-
-#: How far the simulated board is raised into the brush's planned path, m.
-PRESS_M = 0.002
-
-
-def is_cjk(text: str) -> bool:
-    """Whether ``text`` holds CJK ideographs (written from hanzi medians, not Hershey)."""
-    return any(unicodedata.name(c, "").startswith("CJK UNIFIED IDEOGRAPH") for c in text)
-
-
-def split_text(text: str, parts: int) -> list[str]:
-    """``text`` in ``parts`` consecutive chunks: characters for hanzi, words otherwise."""
-    units = [c for c in text if not c.isspace()] if is_cjk(text) else text.split()
-    if len(units) < parts:
-        raise InputError(
-            f"--drones: got {parts} drones for {len(units)} character(s)/word(s) in "
-            f"{text!r}, expected at most one drone per character or word"
-        )
-    joiner = "" if is_cjk(text) else " "
-    bounds = np.linspace(0, len(units), parts + 1).round().astype(int)
-    return [joiner.join(units[a:b]) for a, b in itertools.pairwise(bounds)]
 
 
 def load_input(
     text: str | None, strokes: Path | None, svg: Path | None, hanzi: Path | None, font: str
 ) -> Any:
     """The single input as :class:`~skyquill.strokes.Strokes` (imported lazily)."""
-    from skyquill.strokes import hanzi_text, load_stroke_json, load_svg, text_strokes
+    from skyquill.strokes import load_stroke_json, load_svg, typed_strokes
 
     given = [
         name
@@ -60,7 +36,7 @@ def load_input(
     if svg is not None:
         return load_svg(svg)
     assert text is not None
-    return hanzi_text(text, source=hanzi) if is_cjk(text) else text_strokes(text, font)
+    return typed_strokes(text, font, hanzi)
 
 
 @app.command()
@@ -94,10 +70,10 @@ def write(
     """Plan pen-up / pen-down writing flights; write CSVs, input_strokes.json, plot, summary."""
     from skyquill.calligraphy.mission import WritingOptions
     from skyquill.calligraphy.show import plan_show
-    from skyquill.strokes import hanzi_text, text_strokes
+    from skyquill.strokes import split_text, typed_strokes
 
     with user_errors():
-        rate = _rate(rate)
+        rate = positive_rate(rate)
         options = WritingOptions(
             size_m=size,
             vmax=vmax,
@@ -109,10 +85,7 @@ def write(
         if drones != 1:
             if text is None or strokes is not None or svg is not None:
                 raise InputError("--drones: several drones need TEXT to share out, got a file")
-            parts = [
-                hanzi_text(p, source=hanzi) if is_cjk(p) else text_strokes(p, font)
-                for p in split_text(text, drones)
-            ]
+            parts = [typed_strokes(p, font, hanzi) for p in split_text(text, drones)]
         else:
             parts = [load_input(text, strokes, svg, hanzi, font)]
         with console.status(f"planning {len(parts)} writing flight(s)"):
@@ -198,22 +171,11 @@ def _drone_summary(mission: Any, name: str, fly: bool, vehicle: Any) -> dict[str
 
 def _fly(mission: Any, vehicle: Any) -> dict[str, Any]:
     """Fly the vehicle trajectory with RPT over the board; compare the ink with the input."""
+    from skyquill.calligraphy.mission import contact_board
     from skyquill.geometry import polyline_distance
-    from skyquill.sim import Board, Quadrotor, simulate
+    from skyquill.sim import Quadrotor, simulate
 
-    corner = mission.board.origin
-    margin = 0.1
-    # The plan touches the surface; the simulated board sits PRESS_M higher so
-    # that the brush presses into it and tracking errors do not lift it off.
-    board = Board(
-        height_m=float(corner[2]) + PRESS_M,
-        extent=(
-            corner[0] - margin,
-            corner[0] + mission.options.size_m + margin,
-            corner[1] - margin,
-            corner[1] + mission.options.size_m + margin,
-        ),
-    )
+    board = contact_board(mission)
     flight = simulate(
         vehicle, Quadrotor(brush_length_m=mission.options.brush_length_m), board=board
     )

@@ -7,7 +7,8 @@ Loaders return :class:`Strokes` (y up, in the source's units; call
 * :func:`load_svg` -- every path of an SVG drawing;
 * :func:`text_strokes` -- Latin text in a Hershey vector font;
 * :func:`hanzi_strokes`, :func:`hanzi_text` -- Chinese characters from the
-  Make Me a Hanzi stroke medians.
+  Make Me a Hanzi stroke medians;
+* :func:`typed_strokes` -- either, by the script of the text.
 
 :func:`turning_points` keeps the start, end and turning points of a stroke by
 split-and-merge (paper 000, section 4).
@@ -18,6 +19,7 @@ from skyquill.strokes.hershey import hershey_fonts, text_strokes
 from skyquill.strokes.json_io import load_stroke_json
 from skyquill.strokes.model import Strokes
 from skyquill.strokes.svg import load_svg
+from skyquill.strokes.text import is_cjk, split_text, typed_strokes
 from skyquill.strokes.turning import segment_distances, turning_points
 
 __all__ = [
@@ -26,9 +28,12 @@ __all__ = [
     "hanzi_strokes",
     "hanzi_text",
     "hershey_fonts",
+    "is_cjk",
     "load_stroke_json",
     "load_svg",
     "segment_distances",
+    "split_text",
     "text_strokes",
     "turning_points",
+    "typed_strokes",
 ]

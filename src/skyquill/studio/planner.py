@@ -28,6 +28,7 @@ from skyquill.calligraphy.mission import (
     Mission,
     WritingOptions,
     check_separation,
+    contact_board,
     plan_writing,
 )
 from skyquill.calligraphy.show import layout
@@ -48,10 +49,6 @@ MAX_VIEW_SAMPLES = 3_000
 MAX_INK_POINTS = 600
 #: Decimals of the numbers sent to the page (0.1 mm, 0.1 ms: far below what is drawn).
 DECIMALS = 4
-
-#: Why ``skyquill.cli.main`` is imported before ``write_cmd``: importing ``write_cmd``
-#: first fails (write_cmd -> fit_cmd -> main -> export_cmd -> fit_cmd, half-initialised).
-_CLI_ORDER = "cli.main before cli.write_cmd"
 
 #: ``progress(fraction, stage)``; it may raise to stop the plan (time limit).
 Progress = Callable[[float, str], None]
@@ -77,14 +74,12 @@ class PlanOutput:
 
 def parts_of(request: PlanRequest) -> list[Strokes]:
     """What each drone writes: the drawing or the text, shared out in consecutive parts."""
-    import skyquill.cli.main  # noqa: F401  (first: see _CLI_ORDER)
-    from skyquill.cli.write_cmd import is_cjk, split_text
-    from skyquill.strokes import hanzi_text, text_strokes
+    from skyquill.strokes import split_text, typed_strokes
 
     if request.text is not None:
         text = request.text
         chunks = [text] if request.drones == 1 else split_text(text, request.drones)
-        return [hanzi_text(c) if is_cjk(c) else text_strokes(c) for c in chunks]
+        return [typed_strokes(c) for c in chunks]
     assert request.strokes is not None  # the model guarantees exactly one input
     drawing = Strokes(
         paths=tuple(np.asarray(s, dtype=float) for s in request.strokes),
@@ -224,26 +219,6 @@ def _drone_plan(mission: Mission, part: Strokes, first_board: Board, *, fly: boo
     return DronePlan.model_validate(fields)
 
 
-def _sim_board(mission: Mission) -> Any:
-    """The simulated board under a horizontal writing board (as ``skyquill write --fly``)."""
-    import skyquill.cli.main  # noqa: F401  (first: see _CLI_ORDER)
-    from skyquill.cli.write_cmd import PRESS_M
-    from skyquill.sim import Board as SimBoard
-
-    if mission.board.kind != "horizontal":
-        return None  # the simulator's contact model is a horizontal board only
-    corner, size, margin = mission.board.origin, mission.options.size_m, 0.1
-    return SimBoard(
-        height_m=float(corner[2]) + PRESS_M,
-        extent=(
-            corner[0] - margin,
-            corner[0] + size + margin,
-            corner[1] - margin,
-            corner[1] + size + margin,
-        ),
-    )
-
-
 def _flight_fields(mission: Mission, t: FloatArray) -> dict[str, Any]:
     """The closed-loop flight (RPT) of the vehicle trajectory, as :class:`DronePlan` fields."""
     from skyquill.sim import Quadrotor, simulate
@@ -252,7 +227,7 @@ def _flight_fields(mission: Mission, t: FloatArray) -> dict[str, Any]:
     flight = simulate(
         mission.vehicle_trajectory(),
         Quadrotor(brush_length_m=mission.options.brush_length_m),
-        board=_sim_board(mission),
+        board=contact_board(mission),
     )
     # The tip hangs the brush length below the vehicle (its swing with tilt is not drawn).
     tip = np.column_stack([np.interp(t, flight.t, flight.p[:, k]) for k in range(3)])
