@@ -109,3 +109,12 @@ def test_random_polygons_give_a_region_or_an_input_error(points: list[tuple[floa
         assert str(exc)
         return
     assert region.is_valid and region.area > 0
+
+
+def test_a_zero_width_spike_is_refused() -> None:
+    # GEOS calls this ring valid: the spike (2, 0) - (4, 0) has no area.
+    spike = [[4, 0], [2, 0], [4, 1e-300], [1, 3], [-2, 3], [1, -4]]
+    with pytest.raises(InputError, match="zero-width spike"):
+        region_from_vertices(spike)
+    # Repeated vertices are no spike.
+    region_from_vertices([[0, 0], [5, 0], [5, 0], [5, 5], [0, 5]])

@@ -99,7 +99,35 @@ def _checked(polygon: Polygon, name: str) -> Polygon:
         raise InputError(f"{name}: got an invalid polygon ({reason}), expected a simple one")
     if polygon.area <= 0.0:
         raise InputError(f"{name}: got a polygon of zero area, expected a region")
+    _check_spikes(coords[:-1, :2], name)
     return shapely.normalize(polygon)
+
+
+#: Smallest interior angle accepted, rad: below it a vertex is a zero-width spike.
+MIN_CORNER_RAD = 1e-6
+
+
+def _check_spikes(ring: FloatArray, name: str) -> None:
+    """Refuse zero-width spikes: an edge that doubles back onto the previous one.
+
+    GEOS calls such a ring valid (the spike has no area), but a covering path
+    would be sent along a line of no width. Repeated vertices are skipped:
+    they do not change the region.
+    """
+    size = max(1.0, float(np.abs(ring).max()))
+    steps = np.diff(np.vstack([ring, ring[:1]]), axis=0)
+    keep = np.linalg.norm(steps, axis=1) > 1e-12 * size
+    corners, legs = ring[keep], steps[keep]
+    unit = legs / np.linalg.norm(legs, axis=1)[:, None]
+    incoming = np.roll(unit, 1, axis=0)
+    cos_turn = np.einsum("ij,ij->i", incoming, unit)
+    spikes = np.flatnonzero(cos_turn < -np.cos(MIN_CORNER_RAD))
+    if spikes.size:
+        x, y = corners[spikes[0]]
+        raise InputError(
+            f"{name}: got a zero-width spike at vertex ({x:.6g}, {y:.6g}) (the boundary "
+            "doubles back on itself), expected a simple polygon with corners of positive angle"
+        )
 
 
 def check_width(region: Polygon, width: float) -> float:

@@ -106,6 +106,7 @@ import scipy.linalg
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from numpy.typing import NDArray
+from scipy.sparse.csgraph import structural_rank
 
 from skyquill.errors import InfeasibleError, InputError
 from skyquill.limits import DerivativeLimit
@@ -577,6 +578,8 @@ class _Polisher:
     def __call__(self, active: NDArray[np.intp]) -> FloatArray | None:
         """Polished ``x`` (n,), or ``None`` if the KKT matrix is singular (no LICQ)."""
         A = sp.csr_array(sp.vstack([self.A_eq, self.G[active.tolist(), :]], format="csr"))
+        if A.shape[0] > self.n:
+            return None  # more active rows than variables: LICQ fails for certain
         b = np.concatenate([self.b_eq, self.tightened[active]])
         norms = np.sqrt(np.asarray(A.multiply(A).sum(axis=1)).ravel())
         norms[norms == 0.0] = 1.0
@@ -594,6 +597,11 @@ class _Polisher:
                     sol = scipy.linalg.solve(K, rhs, check_finite=False, assume_a="sym")
             else:
                 K_sp = sp.block_array([[self.H2, A.T], [A, None]], format="csc")
+                # SuperLU (scipy 1.17) segfaults on some structurally singular
+                # KKT matrices instead of raising (seen with a 0.01 m/s^3 jerk
+                # limit: rank 6660 of 6704); a maximum matching finds them first.
+                if structural_rank(K_sp) < size:
+                    return None
                 sol = spla.splu(K_sp).solve(rhs)
         except (RuntimeError, np.linalg.LinAlgError, scipy.linalg.LinAlgWarning):
             return None

@@ -1,0 +1,380 @@
+"""Coverage speed-LP benchmark: scipy ``linprog`` vs the hot-started HiGHS model, and toppra.
+
+Run from the repository root::
+
+    .venv/bin/python bench/coverage_lp.py           # full run, about 2-4 minutes
+    .venv/bin/python bench/coverage_lp.py --quick   # smoke test, 3 timed runs
+
+It writes ``bench/results/coverage_lp.json`` (``coverage_lp_quick.json`` with
+``--quick``) and prints one table. BLAS is pinned to one thread
+(``threadpoolctl.threadpool_limits(1)``) for the whole run. Every timing is
+``time.perf_counter`` around one call, 2 warm-up calls first, the garbage
+collector off while timing; medians, p10 and p90 over >= 10 timed runs (3 with
+``--quick``, and 3 after 1 warm-up for the slow ``linprog`` plans). Read
+ratios, not absolute times: the reference machine has 2 noisy cores.
+
+The path is the issue's: the coverage spiral of a 10 m x 10 m square (contours
+2 m apart, ``"offset"``, spiral transition ``delta`` 1.0 and 0.3), limits
+vmax 3 m/s, amax 5 m/s^2, jmax 3 m/s^3 (the paper's), 2,000 grid points.
+Issue targets: "max_excess <= 2 %; one LP solve with 2,000 points <= 100 ms;
+whole 10 m x 10 m plan <= 0.5 s".
+
+Cases (1-2 on the delta 1.0 spiral's 2,000-point grid, both the default
+adaptive grid, which ``plan_speed`` solves, and a uniform one):
+
+1. ``lp_cold``: one jerk-free LP (speed and acceleration rows, jerk rows
+   free), from scratch: ``linprog`` vs a fresh HiGHS model
+   (``_GridLP(...).solve``, model construction included).
+2. ``lp_first_jerk``: the first pseudo-jerk LP, hot-started from the jerk-free
+   optimum (the LP with the most pivots of a plan), highspy only.
+   ``lp_hot``: one pseudo-jerk re-solve after a bound change (the linearisation
+   point moved from the converged ``b`` to ``0.99 b``), hot-started from the
+   previous basis, vs the same LP from scratch with ``linprog``.
+3. ``plan``: the whole ``plan_speed`` with jerk limit: the default (uniform
+   grid, refinement to 2 %, highspy), the opt-in adaptive grid, the default
+   with ``lp_backend="linprog"``, and the previous configuration
+   (``max_excess=None``, ``linprog``); each with its duration and the
+   ``verify()`` excess.
+4. ``toppra``: jerk off (toppra has no jerk limit) and vmax = 100 m/s (toppra's
+   velocity constraint is per axis, ours on the norm; so only the per-axis
+   acceleration limit binds), same 2,001-point uniform grid: duration ratio and
+   solve-time ratio (``TOPPRA(...).compute_trajectory`` vs ``plan_speed``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import platform
+import sys
+import time
+from collections.abc import Callable
+from datetime import UTC, datetime
+from importlib import metadata
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from threadpoolctl import threadpool_info, threadpool_limits
+
+from common import gc_off
+from skyquill.coverage import speed as sp
+from skyquill.coverage.paths import contours, spiral_control_points, spiral_curve
+from skyquill.coverage.regions import region_from_vertices
+
+RESULTS = Path(__file__).resolve().parent / "results" / "coverage_lp.json"
+QUICK_RESULTS = RESULTS.with_name("coverage_lp_quick.json")
+WARMUP = 2
+MIN_RUNS = 10
+VMAX, AMAX, JMAX = 3.0, 5.0, 3.0
+N = 2000
+DELTAS = (1.0, 0.3)
+TARGETS = {"lp_s": 0.100, "plan_s": 0.5, "max_excess": 0.02}
+
+
+def spiral(delta: float) -> Any:
+    """The issue's coverage spiral of the 10 m square."""
+    square = region_from_vertices([[0, 0], [10, 0], [10, 10], [0, 10]])
+    return spiral_curve(spiral_control_points(contours(square, 2.0, "offset"), delta))
+
+
+def measure(fn: Callable[[], Any], runs: int, warmup: int = WARMUP) -> tuple[dict[str, Any], Any]:
+    """``warmup`` untimed calls, then ``runs`` timed calls; median/p10/p90 in seconds."""
+    out = None
+    for _ in range(warmup):
+        out = fn()
+    times = np.empty(runs)
+    with gc_off():
+        for i in range(runs):
+            t0 = time.perf_counter()
+            out = fn()
+            times[i] = time.perf_counter() - t0
+    stats = {
+        "median_s": float(np.median(times)),
+        "p10_s": float(np.percentile(times, 10)),
+        "p90_s": float(np.percentile(times, 90)),
+        "runs": runs,
+        "warmup_runs": warmup,
+    }
+    return stats, out
+
+
+def grid_lp(curve: Any, grid: str) -> tuple[Any, sp._Bounds]:
+    """Rows and bounds of the grid LP with jerk rows, as ``plan_speed`` builds them."""
+    u = np.linspace(0.0, 1.0, N)
+    amax, jmax = np.full(2, AMAX), np.full(2, JMAX)
+    if grid == "adaptive":
+        curve = sp._Reparam(curve, sp._grid_map(curve, N, vmax=VMAX, amax=amax, jmax=jmax))
+    c1, c2, c3 = sp._derivs3(curve, u)
+    ub, vb = sp._speed_bounds(c1, c2, VMAX, chord_error=None, period=0.02)
+    a_acc = sp._acc_matrix(u, (c1, c2), amax)
+    a_jerk = sp._jerk_matrix((c1, c2, c3), jmax, vb)
+    from scipy import sparse
+
+    a = sparse.vstack([a_acc, a_jerk], format="csr")
+    bounds = sp._Bounds(ub, vb, 2, *sp._ones(N))
+    sp._end_caps(bounds.ub, c1, jmax)
+    return a, bounds
+
+
+def lp_cases(curve: Any, runs: int, grid: str) -> list[dict[str, Any]]:
+    """Cases 1 and 2: one cold LP, one hot re-solve (highspy) vs linprog from scratch."""
+    a, bounds = grid_lp(curve, grid)
+    free = bounds.rows(None)
+    entries = []
+    cold: dict[str, dict[str, Any]] = {}
+    for backend in ("linprog", "highspy"):
+
+        def solve_cold(be: str = backend) -> Any:
+            return sp._GridLP(a, backend=be).solve(free, bounds.cols())
+
+        cold[backend], _ = measure(solve_cold, runs)
+    entries.append(_pair(f"lp_cold_{grid}", cold, "one jerk-free LP from scratch, n=2000"))
+    entries.append(first_jerk_lp(a, bounds, runs, grid))
+    # Converge the pseudo-jerk iteration once, then time re-solves after a bound change.
+    lp = sp._GridLP(a, backend="highspy")
+    b, _ = sp._pseudo_jerk(lp, bounds, lp.solve(free, bounds.cols()), stop=(20, 1e-3), log=([], []))
+    rows_a, rows_b = bounds.rows(b), bounds.rows(0.99 * b)
+    flip = [False]
+
+    def hot() -> Any:
+        flip[0] = not flip[0]
+        return lp.solve(rows_a if flip[0] else rows_b, bounds.cols())
+
+    hot_stats, _ = measure(hot, max(runs, 20))
+    ref = sp._GridLP(a, backend="linprog")
+    scratch, _ = measure(lambda: ref.solve(rows_b, bounds.cols()), runs)
+    what = "pseudo-jerk re-solve, n=2000"
+    entries.append(_pair(f"lp_hot_{grid}", {"linprog": scratch, "highspy": hot_stats}, what))
+    return entries
+
+
+def first_jerk_lp(a: Any, bounds: sp._Bounds, runs: int, grid: str) -> dict[str, Any]:
+    """The heaviest single LP: the first pseudo-jerk LP, hot-started from the jerk-free basis."""
+    free = bounds.rows(None)
+    times = []
+    for _ in range(WARMUP + runs):
+        lp = sp._GridLP(a, backend="highspy")
+        b0 = lp.solve(free, bounds.cols())
+        before = lp.time
+        lp.solve(bounds.rows(b0), bounds.cols())
+        times.append(lp.time - before)
+    t = np.asarray(times[WARMUP:])
+    return {
+        "id": f"lp_first_jerk_{grid}",
+        "what": "first pseudo-jerk LP after the jerk-free one (most pivots), highspy, n=2000",
+        "highspy": {
+            "median_s": float(np.median(t)),
+            "p10_s": float(np.percentile(t, 10)),
+            "p90_s": float(np.percentile(t, 90)),
+            "runs": runs,
+        },
+        "meets_target": bool(np.median(t) <= TARGETS["lp_s"]),
+    }
+
+
+def _pair(name: str, stats: dict[str, dict[str, Any]], what: str) -> dict[str, Any]:
+    ratio = stats["linprog"]["median_s"] / stats["highspy"]["median_s"]
+    return {
+        "id": name,
+        "what": what,
+        "linprog": stats["linprog"],
+        "highspy": stats["highspy"],
+        "speedup_linprog_over_highspy": ratio,
+        "meets_target": stats["highspy"]["median_s"] <= TARGETS["lp_s"],
+    }
+
+
+PLAN_VARIANTS: dict[str, dict[str, Any]] = {
+    "default_highspy": {},
+    "adaptive_grid_highspy": {"grid": "adaptive"},
+    "default_linprog": {"lp_backend": "linprog"},
+    "previous_linprog": {"max_excess": None, "lp_backend": "linprog"},
+}
+
+
+def plan_case(curve: Any, delta: float, runs: int) -> list[dict[str, Any]]:
+    """Case 3: whole ``plan_speed`` with jerk limit in three configurations."""
+    entries = []
+    for name, kwargs in PLAN_VARIANTS.items():
+        slow = "linprog" in name  # seconds per call: 1 warm-up, 3 runs
+
+        def run(kw: dict[str, Any] = kwargs) -> sp.SpeedPlan:
+            return sp.plan_speed(curve, VMAX, AMAX, JMAX, n=N, **kw)
+
+        stats, plan = measure(run, 3 if slow else runs, 1 if slow else WARMUP)
+        ver = plan.verify()
+        entries.append(
+            {
+                "id": f"plan_delta{delta:g}_{name}",
+                "kwargs": kwargs,
+                "timing": stats,
+                "duration_s": plan.duration,
+                "max_excess": ver.max_excess,
+                "jerk_excess": ver.jerk_excess,
+                "excess_estimate": plan.excess_estimate,
+                "refinements": plan.refinements,
+                "lp_solves": plan.lp_solves,
+                "lp_time_s": plan.solve_time,
+                "lp_time_per_solve_s": plan.solve_time / max(plan.lp_solves, 1),
+                "meets_target": bool(
+                    stats["median_s"] <= TARGETS["plan_s"]
+                    and ver.max_excess <= TARGETS["max_excess"]
+                ),
+            }
+        )
+    return entries
+
+
+def toppra_case(curve: Any, runs: int) -> dict[str, Any] | None:
+    """Case 4: jerk-off plan vs toppra on the same path and grid."""
+    try:
+        import toppra as ta
+        import toppra.algorithm as algo
+        from toppra import constraint
+        from toppra.interpolator import AbstractGeometricPath
+    except ImportError:
+        return None
+    ta.setup_logging("WARNING")
+
+    class BSplinePath(AbstractGeometricPath):  # type: ignore[misc]
+        """toppra geometric-path adapter around the scipy ``BSpline``."""
+
+        def __call__(self, s: Any, order: int = 0) -> Any:
+            return np.asarray(curve(np.clip(np.asarray(s, dtype=float), 0.0, 1.0), order))
+
+        @property
+        def dof(self) -> int:
+            return 2
+
+        @property
+        def path_interval(self) -> Any:
+            return np.array([0.0, 1.0])
+
+    path = BSplinePath()
+    vlim = np.array([[-100.0, 100.0]] * 2)
+    alim = np.array([[-AMAX, AMAX]] * 2)
+
+    def peer() -> Any:
+        inst = algo.TOPPRA(
+            [
+                constraint.JointVelocityConstraint(vlim),
+                constraint.JointAccelerationConstraint(alim),
+            ],
+            path,
+            gridpoints=np.linspace(0.0, 1.0, N + 1),
+            parametrizer="ParametrizeConstAccel",
+        )
+        return inst.compute_trajectory(0, 0)
+
+    def ours() -> sp.SpeedPlan:
+        return sp.plan_speed(curve, 100.0, AMAX, None, n=N + 1)
+
+    t_peer, traj = measure(peer, runs)
+    t_ours, plan = measure(ours, runs)
+    return {
+        "id": "toppra_jerk_off",
+        "toppra": t_peer,
+        "ours": t_ours,
+        "toppra_duration_s": float(traj.duration),
+        "ours_duration_s": plan.duration,
+        "duration_ratio_ours_over_toppra": plan.duration / float(traj.duration),
+        "time_ratio_toppra_over_ours": t_peer["median_s"] / t_ours["median_s"],
+        "ours_max_excess": plan.verify().max_excess,
+    }
+
+
+def machine_info() -> dict[str, Any]:
+    def version(name: str) -> str | None:
+        try:
+            return metadata.version(name)
+        except metadata.PackageNotFoundError:
+            return None
+
+    return {
+        "platform": platform.platform(),
+        "python": sys.version.split()[0],
+        "cpu_count": os.cpu_count(),
+        "loadavg_at_start": os.getloadavg() if hasattr(os, "getloadavg") else None,
+        **{k: version(k) for k in ("numpy", "scipy", "highspy", "toppra", "skyquill")},
+    }
+
+
+def _jsonable(x: Any) -> Any:
+    if isinstance(x, dict):
+        return {str(k): _jsonable(v) for k, v in x.items()}
+    if isinstance(x, list | tuple):
+        return [_jsonable(v) for v in x]
+    if isinstance(x, np.generic):
+        return x.item()
+    if isinstance(x, float) and not math.isfinite(x):
+        return None
+    return x
+
+
+def print_summary(out: dict[str, Any]) -> None:
+    for e in out["cases"]:
+        if e["id"].startswith("lp_first_jerk"):
+            print(f"{e['id']:<44} highspy {1e3 * e['highspy']['median_s']:8.1f} ms")
+        elif e["id"].startswith("lp_"):
+            print(
+                f"{e['id']:<44} linprog {1e3 * e['linprog']['median_s']:8.1f} ms  highspy "
+                f"{1e3 * e['highspy']['median_s']:8.1f} ms  "
+                f"x{e['speedup_linprog_over_highspy']:.1f}"
+            )
+        elif e["id"].startswith("plan_"):
+            print(
+                f"{e['id']:<44} {1e3 * e['timing']['median_s']:8.1f} ms  duration "
+                f"{e['duration_s']:.3f} s  max_excess {e['max_excess']:.4f}  "
+                f"LPs {e['lp_solves']} ({1e3 * e['lp_time_per_solve_s']:.1f} ms each)"
+            )
+        else:
+            print(
+                f"{e['id']:<44} toppra {1e3 * e['toppra']['median_s']:8.1f} ms  ours "
+                f"{1e3 * e['ours']['median_s']:8.1f} ms  duration ratio "
+                f"{e['duration_ratio_ours_over_toppra']:.5f}  time ratio "
+                f"{e['time_ratio_toppra_over_ours']:.2f}"
+            )
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--quick", action="store_true", help="3 timed runs per measurement")
+    parser.add_argument("--out", type=Path, default=None, help="JSON output path")
+    args = parser.parse_args(argv)
+    runs = 3 if args.quick else MIN_RUNS
+    out_path: Path = args.out or (QUICK_RESULTS if args.quick else RESULTS)
+    wall = time.perf_counter()
+    entries: list[dict[str, Any]] = []
+    with threadpool_limits(limits=1):
+        blas = threadpool_info()
+        for grid in ("adaptive", "uniform"):
+            entries += lp_cases(spiral(1.0), runs, grid)
+        for delta in DELTAS:
+            entries += plan_case(spiral(delta), delta, runs)
+        top = toppra_case(spiral(1.0), runs)
+        if top is not None:
+            entries.append(top)
+    out = {
+        "schema": 1,
+        "generated_utc": datetime.now(UTC).isoformat(timespec="seconds"),
+        "quick": bool(args.quick),
+        "total_wall_s": time.perf_counter() - wall,
+        "machine": machine_info(),
+        "blas_threads_pinned_to": 1,
+        "blas": blas,
+        "problem": {"n": N, "vmax": VMAX, "amax": AMAX, "jmax": JMAX, "deltas": DELTAS},
+        "targets": TARGETS,
+        "cases": entries,
+    }
+    out_path.parent.mkdir(parents=True, exist_ok=True)
+    out_path.write_text(json.dumps(_jsonable(out), indent=2) + "\n")
+    print_summary(out)
+    print(f"wrote {out_path} in {out['total_wall_s']:.1f} s")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
