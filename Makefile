@@ -48,6 +48,9 @@ bench: $(STAMP)
 	$(BIN)/python bench/resegment.py
 	$(BIN)/python bench/calligraphy.py
 	$(BIN)/python bench/paper000_figs.py
+	$(BIN)/python bench/coverage_lp.py
+	$(BIN)/python bench/coverage.py
+	$(BIN)/python bench/painting.py
 
 clean:
 	rm -rf $(VENV) out .pytest_cache .mypy_cache .ruff_cache

@@ -26,6 +26,9 @@ def cover(
     drift: Annotated[str, typer.Option(help="Spiral laps: step or lap (paper eq. 4).")] = "step",
     delta: Annotated[float, typer.Option(help="Corner control-point distance, m.")] = 0.5,
     epsilon: Annotated[float, typer.Option(help="Density: spacing = epsilon * width.")] = 1.0,
+    perimeter: Annotated[
+        bool, typer.Option(help="Zigzags: a lap around the region first.")
+    ] = False,
     min_coverage: Annotated[
         float | None,
         typer.Option(help="Pick epsilon and delta for this coverage fraction (e.g. 0.97)."),
@@ -52,6 +55,7 @@ def cover(
             contours=contours,  # type: ignore[arg-type]
             drift=drift,  # type: ignore[arg-type]
             epsilon=epsilon,
+            perimeter=perimeter,
             delta=delta,
             rate=rate,
             altitude=altitude,

@@ -16,6 +16,7 @@ joined into one path (:mod:`skyquill.coverage.decompose`, the paper's Fig. 5).
 
 from __future__ import annotations
 
+import itertools
 import math
 import time
 from dataclasses import asdict, dataclass, replace
@@ -45,7 +46,7 @@ Pattern = Literal["spiral", "zigzag", "zigzag-stop"]
 PATTERNS: tuple[Pattern, ...] = ("spiral", "zigzag", "zigzag-stop")
 CONTOUR_MODES: tuple[ContourMode, ...] = ("offset", "homothetic")
 DRIFT_MODES: tuple[DriftMode, ...] = ("step", "lap")
-#: Candidates of :func:`tune_coverage`, preferred first: wide spacing, round corners.
+#: Candidates of :func:`tune_coverage`.
 TUNING_EPSILONS = (1.0, 0.9, 0.8, 0.7)
 TUNING_DELTAS = (1.5, 1.0, 0.6, 0.3, 0.15)
 
@@ -82,6 +83,9 @@ class CoverageOptions:
     epsilon : float
         Density factor in (0, 1]: rings and sweep lines ``epsilon * width``
         apart (more overlap, fewer gaps at corners, longer path).
+    perimeter : bool
+        Zigzag patterns: start with a lap around the region (sweeps the
+        slivers that sweep-line ends leave along slanted sides).
     delta : float
         Distance of the corner control points from each corner, m (smaller:
         sharper corners, more coverage, slower).
@@ -101,6 +105,7 @@ class CoverageOptions:
     contours: ContourMode = "offset"
     drift: DriftMode = "step"
     epsilon: float = 1.0
+    perimeter: bool = False
     delta: float = 0.5
     rate: float = 50.0
     altitude: float = 2.0
@@ -164,7 +169,7 @@ class CoveragePlan:
     @property
     def path_length(self) -> float:
         """Length of the flown path, m."""
-        return float(np.linalg.norm(np.diff(self.path, axis=0), axis=1).sum())
+        return _length(self.path)
 
     def summary(self) -> dict[str, Any]:
         """What ``summary.json`` holds (JSON-ready)."""
@@ -215,11 +220,11 @@ def covering_waypoints(region: Polygon, options: CoverageOptions) -> FloatArray:
         return multi_spiral_control_points(region, eps * w, mode=options.contours, delta=d)
     # The sweep lines' spacing is the swath; epsilon < 1 packs them closer.
     if is_convex(region):
-        stops = zigzag(region, eps * w)
+        stops = zigzag(region, eps * w, perimeter=options.perimeter)
     else:
         from skyquill.coverage.decompose import multi_zigzag
 
-        stops = multi_zigzag(region, eps * w)
+        stops = multi_zigzag(region, eps * w, perimeter=options.perimeter)
     return stops if options.pattern == "zigzag-stop" else with_corner_points(stops, d)
 
 
@@ -234,14 +239,15 @@ def covering_path(region: Polygon, options: CoverageOptions) -> tuple[FloatArray
 def tune_coverage(
     region: Polygon, options: CoverageOptions, target: float
 ) -> tuple[CoverageOptions, float]:
-    """The widest spacing, then the roundest corners, whose path covers ``target``.
+    """The options with the shortest path among those that cover ``target``.
 
-    Tries ``epsilon`` in :data:`TUNING_EPSILONS` and, for each, ``delta`` in
-    :data:`TUNING_DELTAS` (the stop-and-go zigzag has no ``delta``), in that
-    order of preference -- wider spacing shortens the path, rounder corners
-    raise the speed -- and returns the first options whose geometric coverage
-    reaches ``target``, with that coverage. Only geometry is computed (no
-    speed LP), so the search is cheap.
+    Tries every ``epsilon`` in :data:`TUNING_EPSILONS`, zigzags without and
+    with a perimeter lap, and every ``delta`` in :data:`TUNING_DELTAS` (the
+    stop-and-go zigzag has no ``delta``), and returns the candidate whose
+    path reaches ``target`` coverage with the shortest length, with its
+    coverage. Length is the proxy for time because only geometry is computed
+    here (no speed LP, so the search is cheap); among paths of one spacing a
+    larger ``delta`` is both shorter and rounder, hence faster.
 
     Raises
     ------
@@ -252,19 +258,28 @@ def tune_coverage(
     if goal > 1.0:
         raise InputError(f"min_coverage: got {goal:g}, expected a fraction in (0, 1]")
     deltas = (options.delta,) if options.pattern == "zigzag-stop" else TUNING_DELTAS
+    laps = (False,) if options.pattern == "spiral" else (False, True)
+    found: list[tuple[float, CoverageOptions, float]] = []
     best = 0.0
-    for eps in TUNING_EPSILONS:
-        for delta in deltas:
-            trial = replace(options, epsilon=eps, delta=delta)
-            covered = coverage_fraction(region, covering_path(region, trial)[1], trial.width)
-            if covered >= goal:
-                return trial, covered
-            best = max(best, covered)
-    raise InfeasibleError(
-        f"min_coverage: got {goal:g}, but the best {options.pattern} path covers only "
-        f"{best:.4f} of the region (tried epsilon {TUNING_EPSILONS}, delta {deltas})",
-        ("coverage",),
-    )
+    for eps, lap, delta in itertools.product(TUNING_EPSILONS, laps, deltas):
+        trial = replace(options, epsilon=eps, perimeter=lap, delta=delta)
+        path = covering_path(region, trial)[1]
+        covered = coverage_fraction(region, path, trial.width)
+        best = max(best, covered)
+        if covered >= goal:
+            found.append((_length(path), trial, covered))
+    if not found:
+        raise InfeasibleError(
+            f"min_coverage: got {goal:g}, but the best {options.pattern} path covers only "
+            f"{best:.4f} of the region (tried epsilon {TUNING_EPSILONS}, delta {deltas})",
+            ("coverage",),
+        )
+    _, chosen, covered = min(found, key=lambda item: item[0])
+    return chosen, covered
+
+
+def _length(path: FloatArray) -> float:
+    return float(np.linalg.norm(np.diff(path, axis=0), axis=1).sum())
 
 
 def plan_coverage(region: Polygon, options: CoverageOptions | None = None) -> CoveragePlan:
@@ -305,8 +320,7 @@ def plan_coverage(region: Polygon, options: CoverageOptions | None = None) -> Co
         limits = limits_report(stop_and_go_setpoints(legs, period / 10.0), opts)
     else:
         curve = spiral_curve(waypoints)
-        length = float(np.linalg.norm(np.diff(path, axis=0), axis=1).sum())
-        n = opts.grid or grid_points(length)
+        n = opts.grid or grid_points(_length(path))
         speed_plan = plan_speed(curve, opts.vmax, opts.amax, opts.jmax, n=n, control_period=period)
         setpoints = speed_plan.setpoints()
         limits = _lp_limits(speed_plan, opts)

@@ -56,6 +56,7 @@ Discretisation choices (the grid LP is otherwise optimistic):
 
 from __future__ import annotations
 
+import logging
 import math
 import time
 from collections.abc import Callable
@@ -94,6 +95,8 @@ _V_FLOOR = 0.05
 _TABLE = 8
 #: Width (in grid cells) of the smoothing of the adaptive grid's density.
 _SMOOTH_CELLS = 10
+
+logger = logging.getLogger(__name__)
 
 __all__ = ["PathCurve", "Setpoints", "SpeedPlan", "Verification", "plan_speed"]
 
@@ -444,19 +447,28 @@ class _GridLP:
 
     def solve(self, r: FloatArray, ub: FloatArray) -> FloatArray:
         """Solve with row bounds ``r`` (``inf`` = free row) and column bounds ``ub``."""
-        if self._highs is None:
-            keep = np.isfinite(r)
-            # Rows normalised to right-hand side 1 (as linprog's presolve/scaling prefer).
-            a_keep = sparse.diags_array(1.0 / r[keep]) @ self.a[keep]
-            a_ub = sparse.vstack([a_keep, -a_keep], format="csr")
-            x, dt = _solve(-np.ones(self.a.shape[1]), a_ub, ub, np.ones(a_ub.shape[0]))
-        else:
-            # Only the changed bounds are passed (most rows keep theirs between iterations).
-            rows = np.flatnonzero(r != self._r).astype(np.int32)
-            cols = np.flatnonzero(ub != self._ub).astype(np.int32)
-            self._r, self._ub = r.copy(), ub.copy()
-            x, dt = _highs_solve(self._highs, (rows, r[rows]), (cols, ub[cols]))
-            x = np.clip(x, 0.0, ub)
+        if self._highs is not None:
+            try:
+                return self._solve_highspy(r, ub)
+            except _HighsStalledError as exc:
+                logger.info("highspy stalled (%s); linprog for the remaining solves", exc)
+                self._highs = None
+        keep = np.isfinite(r)
+        # Rows normalised to right-hand side 1 (as linprog's presolve/scaling prefer).
+        a_keep = sparse.diags_array(1.0 / r[keep]) @ self.a[keep]
+        a_ub = sparse.vstack([a_keep, -a_keep], format="csr")
+        x, dt = _solve(-np.ones(self.a.shape[1]), a_ub, ub, np.ones(a_ub.shape[0]))
+        return self._count(x, dt)
+
+    def _solve_highspy(self, r: FloatArray, ub: FloatArray) -> FloatArray:
+        # Only the changed bounds are passed (most rows keep theirs between iterations).
+        rows = np.flatnonzero(r != self._r).astype(np.int32)
+        cols = np.flatnonzero(ub != self._ub).astype(np.int32)
+        self._r, self._ub = r.copy(), ub.copy()
+        x, dt = _highs_solve(self._highs, (rows, r[rows]), (cols, ub[cols]))
+        return self._count(np.clip(x, 0.0, ub), dt)
+
+    def _count(self, x: FloatArray, dt: float) -> FloatArray:
         self.time += dt
         self.solves += 1
         return x
@@ -491,6 +503,25 @@ def _highs_model(a: Any) -> Any:
     return highs
 
 
+#: Wall-time limit of one hot-started highspy solve, s (the slowest seen takes 0.1 s).
+HOT_SOLVE_LIMIT_S = 2.0
+
+
+class _HighsStalledError(Exception):
+    """A hot-started highspy solve ended neither optimal nor infeasible."""
+
+
+def _run_highs(highs: Any, limit_s: float) -> Any:
+    """Run HiGHS for at most ``limit_s`` more seconds; its model status.
+
+    HiGHS's ``time_limit`` counts the instance's run time over all solves, so
+    the limit is set relative to the time already spent.
+    """
+    highs.setOptionValue("time_limit", float(highs.getRunTime()) + limit_s)
+    highs.run()
+    return highs.getModelStatus()
+
+
 def _highs_solve(
     highs: Any, rows: tuple[Any, FloatArray], cols: tuple[Any, FloatArray]
 ) -> tuple[FloatArray, float]:
@@ -504,9 +535,12 @@ def _highs_solve(
     if idx.size:
         highs.changeColsBounds(idx.size, idx, np.zeros(idx.size), ub)
     t0 = time.perf_counter()
-    highs.run()
+    status = _run_highs(highs, HOT_SOLVE_LIMIT_S)
+    if status not in (_highspy.HighsModelStatus.kOptimal, _highspy.HighsModelStatus.kInfeasible):
+        # A hot start can stall, or end "Unknown", on some smoothed zigzags;
+        # a cold highspy solve stalled too, scipy's HiGHS (presolve on) does not.
+        raise _HighsStalledError(highs.modelStatusToString(status))
     dt = time.perf_counter() - t0
-    status = highs.getModelStatus()
     if status == _highspy.HighsModelStatus.kInfeasible:
         raise InfeasibleError("speed-planning LP is infeasible", ("speed_lp",))
     if status != _highspy.HighsModelStatus.kOptimal:
