@@ -3,8 +3,16 @@
 from __future__ import annotations
 
 import gc
+import math
+import os
+import platform
+import sys
 from collections.abc import Iterator
 from contextlib import contextmanager
+from importlib import metadata
+from typing import Any
+
+import numpy as np
 
 
 @contextmanager
@@ -18,3 +26,40 @@ def gc_off() -> Iterator[None]:
     finally:
         if enabled:
             gc.enable()
+
+
+def jsonable(x: Any) -> Any:
+    """``x`` with numpy scalars as Python numbers and non-finite floats as ``None`` (JSON)."""
+    if isinstance(x, dict):
+        return {str(k): jsonable(v) for k, v in x.items()}
+    if isinstance(x, list | tuple):
+        return [jsonable(v) for v in x]
+    if isinstance(x, np.generic):
+        return x.item()
+    if isinstance(x, float) and not math.isfinite(x):
+        return None
+    return x
+
+
+def _version(name: str) -> str | None:
+    try:
+        return metadata.version(name)
+    except metadata.PackageNotFoundError:
+        return None
+
+
+def machine_info(packages: tuple[str, ...]) -> dict[str, Any]:
+    """Where the numbers were measured: platform, CPUs, load, and ``packages``' versions."""
+    affinity = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else None
+    return {
+        "platform": platform.platform(),
+        "machine": platform.machine(),
+        "processor": platform.processor(),
+        "python": sys.version.split()[0],
+        "python_implementation": platform.python_implementation(),
+        "cpu_count": os.cpu_count(),
+        "cpu_affinity_count": affinity,
+        "loadavg_at_start": os.getloadavg() if hasattr(os, "getloadavg") else None,
+        **{name: _version(name) for name in ("numpy", *packages, "skyquill")},
+        "OPENBLAS_CORETYPE (read only)": os.environ.get("OPENBLAS_CORETYPE"),
+    }

@@ -45,21 +45,16 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
-import os
-import platform
-import sys
 import time
 from collections.abc import Callable
 from datetime import UTC, datetime
-from importlib import metadata
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 from threadpoolctl import threadpool_info, threadpool_limits
 
-from common import gc_off
+from common import gc_off, jsonable, machine_info
 from skyquill.coverage import speed as sp
 from skyquill.coverage.paths import contours, spiral_control_points, spiral_curve
 from skyquill.coverage.regions import region_from_vertices
@@ -286,34 +281,6 @@ def toppra_case(curve: Any, runs: int) -> dict[str, Any] | None:
     }
 
 
-def machine_info() -> dict[str, Any]:
-    def version(name: str) -> str | None:
-        try:
-            return metadata.version(name)
-        except metadata.PackageNotFoundError:
-            return None
-
-    return {
-        "platform": platform.platform(),
-        "python": sys.version.split()[0],
-        "cpu_count": os.cpu_count(),
-        "loadavg_at_start": os.getloadavg() if hasattr(os, "getloadavg") else None,
-        **{k: version(k) for k in ("numpy", "scipy", "highspy", "toppra", "skyquill")},
-    }
-
-
-def _jsonable(x: Any) -> Any:
-    if isinstance(x, dict):
-        return {str(k): _jsonable(v) for k, v in x.items()}
-    if isinstance(x, list | tuple):
-        return [_jsonable(v) for v in x]
-    if isinstance(x, np.generic):
-        return x.item()
-    if isinstance(x, float) and not math.isfinite(x):
-        return None
-    return x
-
-
 def print_summary(out: dict[str, Any]) -> None:
     for e in out["cases"]:
         if e["id"].startswith("lp_first_jerk"):
@@ -362,7 +329,7 @@ def main(argv: list[str] | None = None) -> int:
         "generated_utc": datetime.now(UTC).isoformat(timespec="seconds"),
         "quick": bool(args.quick),
         "total_wall_s": time.perf_counter() - wall,
-        "machine": machine_info(),
+        "machine": machine_info(("scipy", "highspy", "toppra")),
         "blas_threads_pinned_to": 1,
         "blas": blas,
         "problem": {"n": N, "vmax": VMAX, "amax": AMAX, "jmax": JMAX, "deltas": DELTAS},
@@ -370,7 +337,7 @@ def main(argv: list[str] | None = None) -> int:
         "cases": entries,
     }
     out_path.parent.mkdir(parents=True, exist_ok=True)
-    out_path.write_text(json.dumps(_jsonable(out), indent=2) + "\n")
+    out_path.write_text(json.dumps(jsonable(out), indent=2) + "\n")
     print_summary(out)
     print(f"wrote {out_path} in {out['total_wall_s']:.1f} s")
     return 0

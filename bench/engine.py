@@ -57,14 +57,10 @@ import argparse
 import hashlib
 import json
 import math
-import os
-import platform
-import sys
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from datetime import UTC, datetime
-from importlib import metadata
 from pathlib import Path
 from typing import Any
 
@@ -81,7 +77,7 @@ from rich.progress import (
 from rich.table import Table
 from threadpoolctl import threadpool_info, threadpool_limits
 
-from common import gc_off
+from common import gc_off, jsonable, machine_info
 from skyquill.errors import InfeasibleError, SolverError
 from skyquill.limits import DerivativeLimit, vehicle_limits
 from skyquill.optimize import (
@@ -744,33 +740,6 @@ def source_digest() -> dict[str, Any]:
     return {"sha256": h.hexdigest(), "files": len(files)}
 
 
-def machine_info() -> dict[str, Any]:
-    def version(name: str) -> str | None:
-        try:
-            return metadata.version(name)
-        except metadata.PackageNotFoundError:
-            return None
-
-    affinity = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else None
-    return {
-        "platform": platform.platform(),
-        "machine": platform.machine(),
-        "processor": platform.processor(),
-        "python": sys.version.split()[0],
-        "python_implementation": platform.python_implementation(),
-        "cpu_count": os.cpu_count(),
-        "cpu_affinity_count": affinity,
-        "numpy": np.__version__,
-        "scipy": version("scipy"),
-        "clarabel": version("clarabel"),
-        "piqp": version("piqp"),
-        "osqp": version("osqp"),
-        "minsnap_trajectories": version("minsnap-trajectories"),
-        "skyquill": version("skyquill"),
-        "OPENBLAS_CORETYPE (read only)": os.environ.get("OPENBLAS_CORETYPE"),
-    }
-
-
 def _ms(x: float | None) -> str:
     return "-" if x is None else f"{1e3 * x:.2f}"
 
@@ -921,18 +890,6 @@ def print_tables(console: Console, out: dict[str, Any]) -> None:
     console.print(t)
 
 
-def _jsonable(x: Any) -> Any:
-    if isinstance(x, dict):
-        return {str(k): _jsonable(v) for k, v in x.items()}
-    if isinstance(x, list | tuple):
-        return [_jsonable(v) for v in x]
-    if isinstance(x, np.generic):
-        return x.item()
-    if isinstance(x, float) and not math.isfinite(x):
-        return None
-    return x
-
-
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument(
@@ -995,7 +952,7 @@ def main(argv: list[str] | None = None) -> int:
         "generated_utc": datetime.now(UTC).isoformat(timespec="seconds"),
         "quick": quick,
         "total_wall_s": time.perf_counter() - wall,
-        "machine": machine_info(),
+        "machine": machine_info(("scipy", "clarabel", "piqp", "osqp", "minsnap-trajectories")),
         "source_at_start": digest_start,
         "source_at_end": source_digest(),
         "blas_threads_pinned_to": 1,
@@ -1024,7 +981,7 @@ def main(argv: list[str] | None = None) -> int:
         "scaling_linear": scaling["linear"],
     }
     out_path.parent.mkdir(parents=True, exist_ok=True)
-    out_path.write_text(json.dumps(_jsonable(out), indent=2) + "\n")
+    out_path.write_text(json.dumps(jsonable(out), indent=2) + "\n")
     print_tables(console, out)
     if out["source_at_start"] != out["source_at_end"]:
         console.print("[yellow]warning: src/skyquill changed during the run; numbers mix states[/]")

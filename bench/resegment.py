@@ -54,19 +54,16 @@ import argparse
 import itertools
 import json
 import math
-import platform
-import sys
 import time
 from collections.abc import Callable
 from datetime import UTC, datetime
-from importlib import metadata
 from pathlib import Path
 from typing import Any, Literal
 
 import numpy as np
 from threadpoolctl import threadpool_info, threadpool_limits
 
-from common import gc_off
+from common import gc_off, machine_info
 from skyquill.io.points import read_points_csv
 from skyquill.limits import vehicle_limits
 from skyquill.optimize import SmoothingProblem, solve
@@ -262,22 +259,6 @@ def resegment_case(
 
 
 # ------------------------------------------------------------------------- main
-def machine_info() -> dict[str, Any]:
-    """Python, platform and package versions."""
-    versions: dict[str, str | None] = {}
-    for name in ("numpy", "scipy", "piqp", "clarabel", "threadpoolctl"):
-        try:
-            versions[name] = metadata.version(name)
-        except metadata.PackageNotFoundError:
-            versions[name] = None
-    return {
-        "python": sys.version.split()[0],
-        "platform": platform.platform(),
-        "processor": platform.processor(),
-        "packages": versions,
-    }
-
-
 def main(argv: list[str] | None = None) -> int:
     """Run every case and write the JSON."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -317,7 +298,7 @@ def main(argv: list[str] | None = None) -> int:
     out = {
         "generated": datetime.now(UTC).isoformat(timespec="seconds"),
         "quick": args.quick,
-        "machine": machine_info(),
+        "machine": machine_info(("scipy", "piqp", "clarabel", "threadpoolctl")),
         "blas": blas,
         "timing": {
             "clock": "time.perf_counter",

@@ -47,14 +47,10 @@ import argparse
 import gc
 import importlib.util
 import json
-import os
-import platform
 import statistics
-import sys
 import time
 from collections.abc import Callable
 from datetime import UTC, datetime
-from importlib import metadata
 from pathlib import Path
 from typing import Any
 
@@ -71,6 +67,7 @@ from rich.progress import (
 from rich.table import Table
 from threadpoolctl import threadpool_info, threadpool_limits
 
+from common import machine_info
 from skyquill.optimize.fit import fit_points
 from skyquill.sim import Flight, RPTController, simulate
 from skyquill.trajectory import SplineTrajectory, Trajectory
@@ -153,30 +150,6 @@ def rotorpy_available() -> str | None:
     except ImportError as exc:
         return f"skyquill.sim.rotorpy_adapter does not import: {exc}"
     return None
-
-
-def machine_info() -> dict[str, Any]:
-    """Where the numbers were measured."""
-
-    def version(name: str) -> str | None:
-        try:
-            return metadata.version(name)
-        except metadata.PackageNotFoundError:
-            return None
-
-    affinity = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else None
-    return {
-        "platform": platform.platform(),
-        "machine": platform.machine(),
-        "processor": platform.processor(),
-        "python": sys.version.split()[0],
-        "cpu_count": os.cpu_count(),
-        "cpu_affinity_count": affinity,
-        "numpy": np.__version__,
-        "scipy": version("scipy"),
-        "rotorpy": version("rotorpy"),
-        "skyquill": version("skyquill"),
-    }
 
 
 def entry(config: str, times: list[float], flight: Flight, loops: list[float]) -> dict[str, Any]:
@@ -331,7 +304,7 @@ def main(argv: list[str] | None = None) -> None:
         **out,
         "quick": args.quick,
         "total_wall_s": time.perf_counter() - wall,
-        "machine": machine_info(),
+        "machine": machine_info(("scipy", "rotorpy")),
         "blas": blas,
     }
     out_path.parent.mkdir(parents=True, exist_ok=True)
