@@ -122,3 +122,49 @@ def test_random_convex_regions_plan_inside_the_region(region: Polygon, pattern: 
     except InfeasibleError:
         return
     assert covered >= 0.97 and options.epsilon <= 1.0
+
+
+@st.composite
+def star_regions(draw: st.DrawFn) -> np.ndarray:
+    """Random star-shaped (mostly concave) vertex lists: 5-10 vertices, 10-30 m across."""
+    count = draw(st.integers(5, 10))
+    size = draw(st.floats(10.0, 30.0))
+    angles = np.sort(draw(st.lists(st.floats(0.0, 2 * np.pi), min_size=count, max_size=count)))
+    radii = draw(st.lists(st.floats(0.3, 1.0), min_size=count, max_size=count))
+    return np.c_[np.cos(angles), np.sin(angles)] * (0.5 * size * np.asarray(radii))[:, None]
+
+
+@settings(
+    max_examples=6,
+    deadline=None,
+    suppress_health_check=[HealthCheck.too_slow],
+    phases=[Phase.explicit, Phase.generate],
+)
+@given(vertices=star_regions(), pattern=st.sampled_from(["spiral", "zigzag", "zigzag-stop"]))
+def test_random_concave_regions_plan_or_are_refused(vertices: np.ndarray, pattern: str) -> None:
+    try:
+        region = region_from_vertices(vertices)
+        plan = plan_coverage(region, CoverageOptions(pattern=pattern, grid=600))  # type: ignore[arg-type]
+    except (InputError, InfeasibleError) as exc:
+        # Refused by name: a spike, or a turn too tight to time within the limits.
+        assert str(exc).split(":")[0] in ("vertices", "region", "width", f"pattern {pattern!r}")
+        return
+    assert float(shapely.distance(shapely.points(plan.path), region).max()) < 0.05
+    assert np.isfinite(plan.duration) and plan.duration > 0.0
+    assert np.allclose(plan.setpoints.v[[0, -1]], 0.0, atol=1e-9)
+    assert plan.limits["max_excess"] <= 0.02
+
+
+def test_a_concave_spiral_too_tight_to_join_rests_between_its_parts() -> None:
+    # Found by the property test: the join past the reflex corner is too tight to
+    # time as one spline; each part is flown on its own, resting at the joins.
+    region = region_from_vertices(
+        [[2.28, 0.371], [4.033, 2.414], [3.965, 3.76], [-1.502, 0.965], [-3.116, 0.97],
+         [-2.684, -3.428], [2.637, -3.58]]
+    )  # fmt: skip
+    plan = plan_coverage(region, CoverageOptions())
+    assert plan.limits["joins"] == "stop"
+    assert plan.limits["max_excess"] <= 0.02
+    assert plan.coverage >= 0.97
+    assert np.all(np.diff(plan.setpoints.t) > 0.0)
+    assert float(shapely.distance(shapely.points(plan.path), region).max()) < 1e-6

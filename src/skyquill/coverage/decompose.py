@@ -627,20 +627,54 @@ def multi_spiral_control_points(
         On a malformed region, ``width``, ``mode`` or ``delta``.
     """
     polygon = _checked_region(region)
-    w = check_width(polygon, width)
     d = as_float("delta", delta, positive=True)
-    parts = _flown_parts(polygon, w)
-    pieces: list[FloatArray] = []
-    for k, part in enumerate(parts):
-        if k == 0:
-            aim = _portal(polygon, parts, 0, 1) if len(parts) > 1 else None
-            pieces.append(_part_spiral(part, w, mode=mode, delta=d, aim=aim)[::-1])
-            continue
-        spiral = _part_spiral(part, w, mode=mode, delta=d, aim=pieces[-1][-1])
-        route = _join(polygon, parts, k, pieces[-1][-1], spiral[0])
+    spirals, routes, parts = _spirals_and_routes(polygon, width, mode=mode, delta=d)
+    pieces = [spirals[0]]
+    for k, (route, spiral) in enumerate(zip(routes, spirals[1:], strict=True), start=1):
         pieces.append(_packed(route, polygon, parts[k - 1 : k + 1], delta=d))
         pieces.append(spiral)
     return _dedupe(np.vstack(pieces))
+
+
+def multi_spiral_pieces(
+    region: Polygon, width: float, *, mode: ContourMode = "offset", delta: float = 0.5
+) -> tuple[list[FloatArray], list[FloatArray]]:
+    """The parts' spiral control polygons and the join routes between them, unjoined.
+
+    For flights that stop between parts: each spiral is its own spline, each
+    route a polyline flown straight (its corners inside the region). Same
+    parts, order and routes as :func:`multi_spiral_control_points`.
+
+    Returns
+    -------
+    spirals : list of ndarray
+        Control polygons ``(P_k, 2)``, one per part, in flight order (m).
+    routes : list of ndarray
+        Polylines ``(R_k, 2)`` from the end of spiral ``k`` to the start of
+        spiral ``k + 1`` (m).
+    """
+    polygon = _checked_region(region)
+    d = as_float("delta", delta, positive=True)
+    spirals, routes, _ = _spirals_and_routes(polygon, width, mode=mode, delta=d)
+    return spirals, routes
+
+
+def _spirals_and_routes(
+    polygon: Polygon, width: float, *, mode: ContourMode, delta: float
+) -> tuple[list[FloatArray], list[FloatArray], list[Polygon]]:
+    w = check_width(polygon, width)
+    parts = _flown_parts(polygon, w)
+    spirals: list[FloatArray] = []
+    routes: list[FloatArray] = []
+    for k, part in enumerate(parts):
+        if k == 0:
+            aim = _portal(polygon, parts, 0, 1) if len(parts) > 1 else None
+            spirals.append(_part_spiral(part, w, mode=mode, delta=delta, aim=aim)[::-1])
+            continue
+        spiral = _part_spiral(part, w, mode=mode, delta=delta, aim=spirals[-1][-1])
+        routes.append(_join(polygon, parts, k, spirals[-1][-1], spiral[0]))
+        spirals.append(spiral)
+    return spirals, routes, parts
 
 
 def _flown_parts(region: Polygon, width: float) -> list[Polygon]:

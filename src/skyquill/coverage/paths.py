@@ -301,8 +301,18 @@ def _drifted(ring: FloatArray, target: FloatArray) -> FloatArray:
     return ring + frac * (target - ring)
 
 
+#: Turns sharper than this (rad) are reversals: the spline would stop in a cusp there.
+REVERSAL_RAD = np.radians(170.0)
+
+
 def with_corner_points(polygon: FloatArray, delta: float) -> FloatArray:
-    """Insert points at ``min(delta, leg / 2)`` from both ends of every leg."""
+    """Insert points at ``min(delta, leg / 2)`` from both ends of every leg.
+
+    A reversal (the path doubling back, e.g. into a spike or along a spine)
+    is first opened into a U-turn ``delta / 2`` wide (:func:`_opened_reversals`):
+    through a reversal the spline has a cusp, where the speed must vanish.
+    """
+    polygon = _opened_reversals(_dedupe(polygon), 0.25 * delta)
     out = [polygon[:1]]
     for a, b in itertools.pairwise(polygon):
         leg = b - a
@@ -310,6 +320,33 @@ def with_corner_points(polygon: FloatArray, delta: float) -> FloatArray:
         step = min(delta, 0.5 * length) / length
         out.append(np.array([a + step * leg, b - step * leg, b]))
     return _dedupe(np.vstack(out))
+
+
+def _opened_reversals(polygon: FloatArray, half_width: float) -> FloatArray:
+    """Each vertex where the path turns back by more than 170 deg becomes a U-turn.
+
+    The tip ``b`` is replaced by ``b - h e + h n`` and ``b - h e - h n`` (``e``
+    the incoming direction, ``n`` its normal toward the outgoing leg's side,
+    ``h`` the half width): both stay ``h`` short of the tip, so the turn stays
+    inside a region whose spike is at least ``2 h`` wide there.
+    """
+    if len(polygon) < 3:
+        return polygon
+    legs = np.diff(polygon, axis=0)
+    unit = legs / np.linalg.norm(legs, axis=1)[:, None]
+    out = [polygon[:1]]
+    for k in range(1, len(polygon) - 1):
+        e_in, e_out, tip = unit[k - 1], unit[k], polygon[k]
+        if float(np.dot(e_in, e_out)) > np.cos(REVERSAL_RAD):
+            out.append(tip[None, :])
+            continue
+        normal = np.array([-e_in[1], e_in[0]])
+        if float(np.dot(normal, e_out)) < 0.0:
+            normal = -normal
+        back = tip - half_width * e_in
+        out.append(np.array([back - half_width * normal, back + half_width * normal]))
+    out.append(polygon[-1:])
+    return np.vstack(out)
 
 
 def hartley_judd_knots(control_points: FloatArray, degree: int) -> FloatArray:

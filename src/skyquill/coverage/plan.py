@@ -298,7 +298,9 @@ def plan_coverage(region: Polygon, options: CoverageOptions | None = None) -> Co
     InputError
         Width not positive or too large for the region, bad options.
     InfeasibleError
-        The speed LP has no solution.
+        The path cannot be timed within the limits. A concave region's
+        spiral whose joins are too tight to time is flown part by part,
+        resting at each join (``limits["joins"] == "stop"``) before that.
     """
     start = time.perf_counter()
     opts = options or CoverageOptions()
@@ -312,29 +314,141 @@ def plan_coverage(region: Polygon, options: CoverageOptions | None = None) -> Co
         )
     check_width(region, opts.width)
     waypoints, path = covering_path(region, opts)
-    period = 1.0 / opts.rate
-    speed_plan: SpeedPlan | None = None
-    if opts.pattern == "zigzag-stop":
-        legs = stop_and_go_legs(waypoints, opts.vmax, opts.amax, opts.jmax)
-        setpoints = stop_and_go_setpoints(legs, period)
-        limits = limits_report(stop_and_go_setpoints(legs, period / 10.0), opts)
-    else:
-        curve = spiral_curve(waypoints)
-        n = opts.grid or grid_points(_length(path))
-        speed_plan = plan_speed(curve, opts.vmax, opts.amax, opts.jmax, n=n, control_period=period)
-        setpoints = speed_plan.setpoints()
-        limits = _lp_limits(speed_plan, opts)
-    coverage = coverage_fraction(region, path, opts.width)
+    try:
+        timed = _timed_path(waypoints, path, opts)
+        joins = "continuous"
+    except InfeasibleError:
+        if opts.pattern != "spiral" or is_convex(region):
+            raise
+        # A join squeezed past a reflex corner can be too tight to time: fly
+        # each part's spiral rest to rest instead, joined by straight legs.
+        waypoints, path, timed = _stop_between_parts(region, opts)
+        joins = "stop"
+    setpoints, limits, speed_plan = timed
     return CoveragePlan(
         region=region,
         options=opts,
         waypoints=waypoints,
         path=path,
         setpoints=setpoints,
-        coverage=coverage,
-        limits=limits,
+        coverage=coverage_fraction(region, path, opts.width),
+        limits=limits | {"joins": joins},
         planning_time=time.perf_counter() - start,
         speed_plan=speed_plan,
+    )
+
+
+_Timed = tuple[Setpoints, dict[str, Any], SpeedPlan | None]
+
+
+def _timed_path(waypoints: FloatArray, path: FloatArray, opts: CoverageOptions) -> _Timed:
+    """Setpoints, limits report and speed plan (``None`` for stop-and-go) of one path."""
+    period = 1.0 / opts.rate
+    if opts.pattern == "zigzag-stop":
+        legs = stop_and_go_legs(waypoints, opts.vmax, opts.amax, opts.jmax)
+        fine = stop_and_go_setpoints(legs, period / 10.0)
+        return stop_and_go_setpoints(legs, period), limits_report(fine, opts), None
+    speed_plan = _timed(spiral_curve(waypoints), opts, opts.grid or grid_points(_length(path)))
+    return speed_plan.setpoints(), _lp_limits(speed_plan, opts), speed_plan
+
+
+def _stop_between_parts(
+    region: Polygon, opts: CoverageOptions
+) -> tuple[FloatArray, FloatArray, _Timed]:
+    """Each part's spiral timed on its own, the joins flown as stop-and-go legs."""
+    from skyquill.coverage.decompose import multi_spiral_pieces
+
+    spirals, routes = multi_spiral_pieces(
+        region, opts.epsilon * opts.width, mode=opts.contours, delta=opts.delta
+    )
+    stop = replace(opts, pattern="zigzag-stop")
+    pieces: list[tuple[FloatArray, FloatArray, _Timed]] = []
+    for k, spiral in enumerate(spirals):
+        if k > 0 and len(routes[k - 1]) > 1 and _length(routes[k - 1]) > 1e-9:
+            pieces.append(_piece(routes[k - 1], stop, _densified(routes[k - 1])))
+        if len(spiral) > SPLINE_DEGREE:
+            pieces.append(_piece(spiral, opts, _dense(spiral_curve(spiral))))
+        elif _length(spiral) > 1e-9:  # a part narrower than the swath: along its spine
+            pieces.append(_piece(spiral, stop, _densified(spiral)))
+    waypoints = np.vstack([p[0] for p in pieces])
+    path = np.vstack([p[1] for p in pieces])
+    setpoints = _concatenated([p[2][0] for p in pieces], 1.0 / opts.rate)
+    reports = [p[2][1] for p in pieces]
+    limits = {
+        "max_speed": max(r["max_speed"] for r in reports),
+        "max_acc": np.max([r["max_acc"] for r in reports], axis=0).tolist(),
+        "max_jerk": np.max([r["max_jerk"] for r in reports], axis=0).tolist(),
+        "max_excess": max(r["max_excess"] for r in reports),
+    }
+    return waypoints, path, (setpoints, limits, None)
+
+
+def _piece(
+    waypoints: FloatArray, opts: CoverageOptions, path: FloatArray
+) -> tuple[FloatArray, FloatArray, _Timed]:
+    return waypoints, path, _timed_path(waypoints, path, opts)
+
+
+def _concatenated(parts: list[Setpoints], period: float) -> Setpoints:
+    """Rest-to-rest setpoints one after the other (each next one's first sample dropped)."""
+    t, arrays = [parts[0].t], [[p] for p in (parts[0].p, parts[0].v, parts[0].a, parts[0].j)]
+    for part in parts[1:]:
+        t.append(t[-1][-1] + part.t[1:])
+        for store, x in zip(arrays, (part.p, part.v, part.a, part.j), strict=True):
+            store.append(x[1:])
+    p, v, a, j = (np.vstack(x) for x in arrays)
+    travelled = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(p, axis=0), axis=1))])
+    u = travelled / max(float(travelled[-1]), 1e-300)
+    return Setpoints(t=np.concatenate(t), u=u, p=p, v=v, a=a, j=j, period=period)
+
+
+#: Degree of the covering splines (paper 001: 4, so that jerk is differentiable).
+SPLINE_DEGREE = 4
+#: Largest relative excess over a limit a returned plan may have (issue 5: <= 2 %).
+MAX_EXCESS = 0.02
+#: Speed-LP grids tried in turn: (grid points as a multiple of ``n``, grid kind).
+GRID_LADDER: tuple[tuple[int, Literal["uniform", "adaptive"]], ...] = (
+    (1, "uniform"),
+    (1, "adaptive"),
+    (2, "adaptive"),
+)
+
+
+def _timed(curve: Any, options: CoverageOptions, n: int) -> SpeedPlan:
+    """The speed plan on the first grid of :data:`GRID_LADDER` that verifies.
+
+    A turn shorter than a grid cell (a join of a multi-spiral, the hook at a
+    spiral's end) can make the grid LP stop the vehicle between two nodes --
+    infeasible on that grid, not on the path -- or leave excess between the
+    nodes that local tightening cannot remove; a grid denser there
+    (adaptive: half by arc length, half by estimated time) or finer resolves
+    most. What none resolves is refused, never returned over the limits.
+
+    Raises
+    ------
+    InfeasibleError
+        No grid gives a plan within :data:`MAX_EXCESS` of the limits.
+    """
+    period = 1.0 / options.rate
+    seen: list[str] = []
+    for factor, kind in GRID_LADDER:
+        try:
+            plan = plan_speed(
+                curve, options.vmax, options.amax, options.jmax,
+                n=factor * n, control_period=period, grid=kind,
+            )  # fmt: skip
+        except InfeasibleError as exc:
+            seen.append(f"{kind} grid of {factor * n}: {exc}")
+            continue
+        excess = plan.verify().max_excess
+        if excess <= MAX_EXCESS:
+            return plan
+        seen.append(f"{kind} grid of {factor * n}: excess {100 * excess:.1f} %")
+    raise InfeasibleError(
+        f"pattern {options.pattern!r}: could not time the path within the limits ("
+        + "; ".join(seen)
+        + "); a larger --delta rounds its tightest turns",
+        ("speed_lp",),
     )
 
 
