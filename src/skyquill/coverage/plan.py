@@ -36,7 +36,7 @@ from skyquill.coverage.paths import (
     zigzag,
 )
 from skyquill.coverage.regions import check_width, coverage_fraction
-from skyquill.coverage.speed import Setpoints, SpeedPlan, plan_speed
+from skyquill.coverage.speed import Setpoints, SpeedPlan, Verification, plan_speed
 from skyquill.coverage.stopgo import stop_and_go_legs, stop_and_go_setpoints
 from skyquill.errors import InfeasibleError, InputError
 from skyquill.validation import as_float, as_int
@@ -348,8 +348,9 @@ def _timed_path(waypoints: FloatArray, path: FloatArray, opts: CoverageOptions) 
         legs = stop_and_go_legs(waypoints, opts.vmax, opts.amax, opts.jmax)
         fine = stop_and_go_setpoints(legs, period / 10.0)
         return stop_and_go_setpoints(legs, period), limits_report(fine, opts), None
-    speed_plan = _timed(spiral_curve(waypoints), opts, opts.grid or grid_points(_length(path)))
-    return speed_plan.setpoints(), _lp_limits(speed_plan, opts), speed_plan
+    n = opts.grid or grid_points(_length(path))
+    speed_plan, verification = _timed(spiral_curve(waypoints), opts, n)
+    return speed_plan.setpoints(), _lp_limits(verification, opts), speed_plan
 
 
 def _stop_between_parts(
@@ -414,8 +415,8 @@ GRID_LADDER: tuple[tuple[int, Literal["uniform", "adaptive"]], ...] = (
 )
 
 
-def _timed(curve: Any, options: CoverageOptions, n: int) -> SpeedPlan:
-    """The speed plan on the first grid of :data:`GRID_LADDER` that verifies.
+def _timed(curve: Any, options: CoverageOptions, n: int) -> tuple[SpeedPlan, Verification]:
+    """The speed plan on the first grid of :data:`GRID_LADDER` that verifies, and its check.
 
     A turn shorter than a grid cell (a join of a multi-spiral, the hook at a
     spiral's end) can make the grid LP stop the vehicle between two nodes --
@@ -440,14 +441,15 @@ def _timed(curve: Any, options: CoverageOptions, n: int) -> SpeedPlan:
         except InfeasibleError as exc:
             seen.append(f"{kind} grid of {factor * n}: {exc}")
             continue
-        excess = plan.verify().max_excess
+        verification = plan.verify()
+        excess = verification.max_excess
         if excess <= MAX_EXCESS:
-            return plan
+            return plan, verification
         seen.append(f"{kind} grid of {factor * n}: excess {100 * excess:.1f} %")
     raise InfeasibleError(
         f"pattern {options.pattern!r}: could not time the path within the limits ("
         + "; ".join(seen)
-        + "); a larger --delta rounds its tightest turns",
+        + ")",
         ("speed_lp",),
     )
 
@@ -484,14 +486,13 @@ def limits_report(setpoints: Setpoints, options: CoverageOptions) -> dict[str, A
     return _report(speed, acc, jerk, options)
 
 
-def _lp_limits(plan: SpeedPlan, options: CoverageOptions) -> dict[str, Any]:
+def _lp_limits(ver: Verification, options: CoverageOptions) -> dict[str, Any]:
     """The limits report of a speed plan, from finite differences of its positions.
 
     :meth:`SpeedPlan.verify` differences the setpoints' positions on a grid ten
     times finer than the control period: a check independent of the chain
     rule that produced the setpoints' own velocity, acceleration and jerk.
     """
-    ver = plan.verify()
     jerk = ver.max_jerk if ver.max_jerk is not None else np.zeros_like(ver.max_acc)
     return _report(ver.max_speed, ver.max_acc, jerk, options)
 

@@ -56,6 +56,7 @@ Discretisation choices (the grid LP is otherwise optimistic):
 
 from __future__ import annotations
 
+import bisect
 import logging
 import math
 import time
@@ -66,7 +67,7 @@ from typing import Any, Protocol
 import numpy as np
 import numpy.typing as npt
 from scipy import sparse
-from scipy.interpolate import BSpline, make_interp_spline
+from scipy.interpolate import BSpline, PPoly, make_interp_spline
 from scipy.optimize import linprog
 
 from skyquill.errors import InfeasibleError, InputError, SolverError
@@ -311,6 +312,30 @@ class SpeedPlan:
         uddd = (2.0 / 9.0) * w1**2 + (2.0 / 3.0) * w * w2
         return ud, udd, uddd
 
+    def _scalar_derivs(self) -> Callable[[float], tuple[float, float, float]]:
+        """:meth:`_derivs` (jerk-limited case) at one ``u``, in plain floats.
+
+        The walk is sequential, one ``u`` at a time; calling the B-spline on
+        one-element arrays costs ~25 us a call, so the cubic ``w`` is turned
+        into its piecewise polynomial once and evaluated by Horner's rule.
+        """
+        pp = PPoly.from_spline((self._bspline.t, self._bspline.c, self._bspline.k))
+        breaks = pp.x.tolist()
+        coef = pp.c.T.tolist()  # per interval: (c3, c2, c1, c0) of (u - x_i)
+        last = len(coef) - 1
+
+        def at(u: float) -> tuple[float, float, float]:
+            i = min(max(bisect.bisect_right(breaks, u) - 1, 0), last)
+            a3, a2, a1, a0 = coef[i]
+            x = u - breaks[i]
+            w = max(((a3 * x + a2) * x + a1) * x + a0, 0.0)
+            w1 = (3.0 * a3 * x + 2.0 * a2) * x + a1
+            w2 = 6.0 * a3 * x + 2.0 * a2
+            cw = w ** (1.0 / 3.0)
+            return cw * cw, (2.0 / 3.0) * cw * w1, (2.0 / 9.0) * w1 * w1 + (2.0 / 3.0) * w * w2
+
+        return at
+
     def _taylor_walk(self, T: float) -> FloatArray:
         """Recursion ``u_{k+1} = u_k + u_dot T + u_ddot T**2/2 (+ u_dddot T**3/6)``.
 
@@ -321,12 +346,11 @@ class SpeedPlan:
         would reverse within the period.
         """
         max_steps = int(10.0 * self.duration / T) + 1000
+        derivs = self._scalar_derivs()
         us = [0.0]
         uk = 0.0
-        one = np.empty(1)
         for _ in range(max_steps):
-            one[0] = uk
-            d1, d2, d3 = (float(x[0]) for x in self._derivs(one))
+            d1, d2, d3 = derivs(uk)
             if uk > 0.5 and d1 + d2 * T + 0.5 * d3 * T * T <= 0.0:
                 break
             step = d1 * T + 0.5 * d2 * T * T + d3 * T**3 / 6.0
