@@ -14,6 +14,7 @@ from skyquill.coverage.paths import (
     hartley_judd_knots,
     spiral_control_points,
     spiral_curve,
+    with_corner_points,
     zigzag,
 )
 from skyquill.coverage.regions import coverage_fraction, region_from_vertices
@@ -145,3 +146,25 @@ def test_random_convex_regions_give_paths_inside(points: list[tuple[float, float
         return
     assert _outside(region, spiral) <= 1e-9
     assert _outside(region, sweep) <= 1e-9
+
+
+def test_step_drift_is_shorter_than_the_papers_lap_drift_and_stays_inside() -> None:
+    rings = contours(SQUARE, 2.0)
+    paths = {}
+    for drift in ("lap", "step"):
+        curve = spiral_curve(spiral_control_points(rings, 0.3, drift=drift))  # type: ignore[arg-type]
+        paths[drift] = np.asarray(curve(np.linspace(0.0, 1.0, 5000)))
+        assert _outside(SQUARE, paths[drift]) < 1e-9
+    length = {k: float(np.linalg.norm(np.diff(p, axis=0), axis=1).sum()) for k, p in paths.items()}
+    # 46.8 m against 62.6 m: the lap drift needs an extra undrifted outer lap.
+    assert length["step"] < 0.8 * length["lap"]
+    assert coverage_fraction(SQUARE, paths["step"], 2.0) > 0.95
+    with pytest.raises(InputError, match="drift"):
+        spiral_control_points(rings, 0.3, drift="zigzag")  # type: ignore[arg-type]
+
+
+def test_a_reversal_becomes_a_u_turn_not_a_cusp() -> None:
+    there_and_back = np.array([[0.0, 0.0], [5.0, 0.0], [0.0, 0.0]])
+    curve = spiral_curve(with_corner_points(there_and_back, 0.4))
+    speed = np.linalg.norm(curve(np.linspace(0.0, 1.0, 20001), 1), axis=1)
+    assert speed.min() > 0.01 * speed.max()  # a cusp would have |C'| = 0 (here 0.023)
