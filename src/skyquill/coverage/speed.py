@@ -528,7 +528,7 @@ def _highs_model(a: Any) -> Any:
 
 
 #: Wall-time limit of one hot-started highspy solve, s (the slowest seen takes 0.1 s).
-HOT_SOLVE_LIMIT_S = 2.0
+HOT_SOLVE_LIMIT_S = 0.5
 
 
 class _HighsStalledError(Exception):
