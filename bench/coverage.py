@@ -15,8 +15,8 @@ Three parts, all with the paper's limits (per axis) and a 2 m swath:
 2. ``pareto``: every pattern over a grid of the density factor epsilon and the
    corner distance delta; duration against coverage, the non-dominated points
    marked; written to ``bench/results/coverage.png``.
-3. ``shapes``: each pattern tuned to >= 97 % coverage (the cheapest epsilon and
-   delta reaching it) on six regions; which pattern is fastest on each.
+3. ``shapes``: each pattern tuned to >= 97 % coverage (the fastest planned
+   flight reaching it) on seven regions; which pattern is fastest on each.
 
 Plus the end-to-end planning time of the default 10 m square plan (median of
 5). BLAS is pinned to one thread. Run: ``.venv/bin/python bench/coverage.py``.
