@@ -7,12 +7,14 @@ import math
 import os
 import platform
 import sys
-from collections.abc import Iterator
+import time
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from importlib import metadata
 from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 
 
 @contextmanager
@@ -62,4 +64,27 @@ def machine_info(packages: tuple[str, ...]) -> dict[str, Any]:
         "loadavg_at_start": os.getloadavg() if hasattr(os, "getloadavg") else None,
         **{name: _version(name) for name in ("numpy", *packages, "skyquill")},
         "OPENBLAS_CORETYPE (read only)": os.environ.get("OPENBLAS_CORETYPE"),
+    }
+
+
+def time_calls(fn: Callable[[], Any], runs: int) -> tuple[npt.NDArray[np.float64], Any]:
+    """``runs`` timed calls of ``fn`` with the collector off: the times (s) and the last result."""
+    times = np.empty(runs)
+    out = None
+    with gc_off():
+        for i in range(runs):
+            start = time.perf_counter()
+            out = fn()
+            times[i] = time.perf_counter() - start
+    return times, out
+
+
+def time_stats(times: npt.NDArray[np.float64], warmup: int) -> dict[str, Any]:
+    """Median, 10th and 90th percentile (s) of ``times``, with the run counts."""
+    return {
+        "median_s": float(np.median(times)),
+        "p10_s": float(np.percentile(times, 10)),
+        "p90_s": float(np.percentile(times, 90)),
+        "runs": int(times.size),
+        "warmup_runs": warmup,
     }

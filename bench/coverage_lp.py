@@ -54,7 +54,7 @@ from typing import Any
 import numpy as np
 from threadpoolctl import threadpool_info, threadpool_limits
 
-from common import gc_off, jsonable, machine_info
+from common import jsonable, machine_info, time_calls, time_stats
 from skyquill.coverage import speed as sp
 from skyquill.coverage.paths import contours, spiral_control_points, spiral_curve
 from skyquill.coverage.regions import region_from_vertices
@@ -77,23 +77,10 @@ def spiral(delta: float) -> Any:
 
 def measure(fn: Callable[[], Any], runs: int, warmup: int = WARMUP) -> tuple[dict[str, Any], Any]:
     """``warmup`` untimed calls, then ``runs`` timed calls; median/p10/p90 in seconds."""
-    out = None
     for _ in range(warmup):
-        out = fn()
-    times = np.empty(runs)
-    with gc_off():
-        for i in range(runs):
-            t0 = time.perf_counter()
-            out = fn()
-            times[i] = time.perf_counter() - t0
-    stats = {
-        "median_s": float(np.median(times)),
-        "p10_s": float(np.percentile(times, 10)),
-        "p90_s": float(np.percentile(times, 90)),
-        "runs": runs,
-        "warmup_runs": warmup,
-    }
-    return stats, out
+        fn()
+    times, out = time_calls(fn, runs)
+    return time_stats(times, warmup), out
 
 
 def grid_lp(curve: Any, grid: str) -> tuple[Any, sp._Bounds]:

@@ -63,7 +63,7 @@ from typing import Any, Literal
 import numpy as np
 from threadpoolctl import threadpool_info, threadpool_limits
 
-from common import gc_off, machine_info
+from common import machine_info, time_calls, time_stats
 from skyquill.io.points import read_points_csv
 from skyquill.limits import vehicle_limits
 from skyquill.optimize import SmoothingProblem, solve
@@ -99,19 +99,7 @@ def measure(fn: Callable[[], Any], min_runs: int, quick: bool) -> dict[str, Any]
     fn()
     first = time.perf_counter() - start
     runs = 3 if quick else max(min_runs, min(200, int(BUDGET_S / max(first, 1e-6))))
-    times = np.empty(runs)
-    with gc_off():
-        for i in range(runs):
-            start = time.perf_counter()
-            fn()
-            times[i] = time.perf_counter() - start
-    return {
-        "median_s": float(np.median(times)),
-        "p10_s": float(np.percentile(times, 10)),
-        "p90_s": float(np.percentile(times, 90)),
-        "runs": runs,
-        "warmup_runs": WARMUP,
-    }
+    return time_stats(time_calls(fn, runs)[0], WARMUP)
 
 
 # --------------------------------------------------------------------- problems
