@@ -71,6 +71,7 @@ from scipy.interpolate import BSpline, PPoly, make_interp_spline
 from scipy.optimize import linprog
 
 from skyquill.errors import InfeasibleError, InputError, SolverError
+from skyquill.validation import per_axis
 
 try:  # optional fast path: one HiGHS model, hot-started between re-solves
     import highspy as _highspy
@@ -435,17 +436,6 @@ def _eval(curve: PathCurve, u: FloatArray, nu: int) -> FloatArray:
     if not np.all(np.isfinite(out)):
         raise InputError(f"curve(u, nu={nu}) returned non-finite values")
     return out
-
-
-def _limit(name: str, value: float | npt.ArrayLike, d: int) -> FloatArray:
-    arr = np.asarray(value, dtype=np.float64)
-    if arr.ndim == 0:
-        arr = np.full(d, float(arr))
-    if arr.shape != (d,):
-        raise InputError(f"{name} must be a scalar or shape ({d},), got shape {arr.shape}")
-    if not np.all(np.isfinite(arr)) or np.any(arr <= 0.0):
-        raise InputError(f"{name} must be positive and finite, got {arr.tolist()}")
-    return arr
 
 
 class _GridLP:
@@ -1144,8 +1134,8 @@ def plan_speed(
     backend = _validate_refine(max_excess, refine_rounds, lp_backend, grid)
     n = int(n)
     d = _eval(curve, np.array([0.0, 1.0]), 1).shape[1]
-    amax_a = _limit("amax", amax, d)
-    jmax_a = None if jmax is None else _limit("jmax", jmax, d)
+    amax_a = per_axis("amax", amax, d)
+    jmax_a = None if jmax is None else per_axis("jmax", jmax, d)
     umap = None
     path: PathCurve = curve
     if grid == "adaptive":
