@@ -15,7 +15,7 @@ Three parts, all with the paper's limits (per axis) and a 2 m swath:
 2. ``pareto``: every pattern over a grid of the density factor epsilon and the
    corner distance delta; duration against coverage, the non-dominated points
    marked; written to ``bench/results/coverage.png``.
-3. ``shapes``: each pattern tuned to >= 97 % coverage (the fastest planned
+3. ``shapes``: each pattern tuned to >= 97 % coverage (``plan_tuned``: the fastest planned
    flight reaching it) on seven regions; which pattern is fastest on each.
 
 Plus the end-to-end planning time of the default 10 m square plan (median of
@@ -43,7 +43,7 @@ from rich.table import Table
 from shapely.geometry import Polygon
 from threadpoolctl import threadpool_limits
 
-from skyquill.coverage.plan import CoverageOptions, plan_coverage, tune_coverage
+from skyquill.coverage.plan import CoverageOptions, CoveragePlan, plan_coverage, plan_tuned
 from skyquill.coverage.regions import region_from_vertices
 from skyquill.errors import SkyquillError
 
@@ -79,6 +79,12 @@ def _row(region: Polygon, options: CoverageOptions) -> dict[str, Any]:
     except SkyquillError as exc:
         return {"pattern": options.pattern, "epsilon": options.epsilon,
                 "delta": options.delta, "error": str(exc)}  # fmt: skip
+    return _numbers(plan)
+
+
+def _numbers(plan: CoveragePlan) -> dict[str, Any]:
+    """What the results keep of a plan: its options and measured numbers."""
+    options = plan.options
     return {
         "pattern": options.pattern,
         "contours": options.contours,
@@ -134,11 +140,9 @@ def shape_rows() -> list[dict[str, Any]]:
     for (name, region), pattern in track(jobs, description="shapes"):
         base = replace(LIMITS, pattern=pattern)  # type: ignore[arg-type]
         try:
-            options, _ = tune_coverage(region, base, GOAL["coverage"])
+            row = _numbers(plan_tuned(region, base, GOAL["coverage"]))
         except SkyquillError as exc:
             row = {"pattern": pattern, "error": str(exc)}
-        else:
-            row = _row(region, options)
         rows.append({"shape": name, **row})
     for name in SHAPES:
         done = [r for r in rows if r["shape"] == name and "duration_s" in r]

@@ -39,7 +39,7 @@ def cover(
     """Plan a coverage flight of REGION; write summary.json, trajectory.csv and plot.png."""
     import numpy as np
 
-    from skyquill.coverage.plan import CoverageOptions, plan_coverage, tune_coverage
+    from skyquill.coverage.plan import CoverageOptions, plan_coverage, plan_tuned
     from skyquill.coverage.regions import load_region
     from skyquill.io.points import write_table_csv
     from skyquill.viz.coverage_plot import plot_coverage
@@ -61,9 +61,10 @@ def cover(
             altitude=altitude,
         )
         with console.status("planning the coverage flight"):
-            if min_coverage is not None:
-                options, _ = tune_coverage(shape, options, min_coverage)
-            plan = plan_coverage(shape, options)
+            if min_coverage is None:
+                plan = plan_coverage(shape, options)
+            else:
+                plan = plan_tuned(shape, options, min_coverage)
     out.mkdir(parents=True, exist_ok=True)
     sp = plan.setpoints
     n = sp.t.size

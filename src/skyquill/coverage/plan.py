@@ -239,7 +239,16 @@ def covering_path(region: Polygon, options: CoverageOptions) -> tuple[FloatArray
 def tune_coverage(
     region: Polygon, options: CoverageOptions, target: float
 ) -> tuple[CoverageOptions, float]:
-    """The fastest options whose path covers ``target`` of the region.
+    """The fastest options whose path covers ``target`` of the region, and their coverage.
+
+    See :func:`plan_tuned`, which also returns the plan.
+    """
+    plan = plan_tuned(region, options, target)
+    return plan.options, plan.coverage
+
+
+def plan_tuned(region: Polygon, options: CoverageOptions, target: float) -> CoveragePlan:
+    """The fastest plan whose path covers ``target`` of the region.
 
     For every ``epsilon`` in :data:`TUNING_EPSILONS` and, for zigzags, without
     and with a perimeter lap, the roundest corners that still reach
@@ -250,22 +259,17 @@ def tune_coverage(
     length alone misjudges it: a denser spacing with rounder corners can fly
     faster than a wider one with sharp corners.
 
-    Returns
-    -------
-    tuple
-        The options and their coverage fraction.
-
     Raises
     ------
     InfeasibleError
-        No candidate reaches ``target``.
+        No candidate reaches ``target``, or none that does can be timed.
     """
     goal = as_float("min_coverage", target, positive=True)
     if goal > 1.0:
         raise InputError(f"min_coverage: got {goal:g}, expected a fraction in (0, 1]")
     deltas = (options.delta,) if options.pattern == "zigzag-stop" else TUNING_DELTAS
     laps = (False,) if options.pattern == "spiral" else (False, True)
-    candidates: list[tuple[CoverageOptions, float]] = []
+    candidates: list[CoverageOptions] = []
     best = 0.0
     for eps, lap in itertools.product(TUNING_EPSILONS, laps):
         for delta in sorted(deltas, reverse=True):
@@ -273,26 +277,30 @@ def tune_coverage(
             covered = coverage_fraction(region, covering_path(region, trial)[1], trial.width)
             best = max(best, covered)
             if covered >= goal:
-                candidates.append((trial, covered))
+                candidates.append(trial)
                 break
-    timed = [(_flight_time(region, trial), trial, covered) for trial, covered in candidates]
-    timed = [item for item in timed if math.isfinite(item[0])]
-    if not timed:
+    if not candidates:
         raise InfeasibleError(
             f"min_coverage: got {goal:g}, but the best {options.pattern} path covers only "
             f"{best:.4f} of the region (tried epsilon {TUNING_EPSILONS}, delta {deltas})",
             ("coverage",),
         )
-    _, chosen, covered = min(timed, key=lambda item: item[0])
-    return chosen, covered
+    plans = [plan for trial in candidates if (plan := _plan_or_none(region, trial))]
+    if not plans:
+        raise InfeasibleError(
+            f"min_coverage: {len(candidates)} {options.pattern} path(s) cover {goal:g} of the "
+            "region, but none of them could be timed within the limits",
+            ("coverage", "speed_lp"),
+        )
+    return min(plans, key=lambda plan: plan.duration)
 
 
-def _flight_time(region: Polygon, options: CoverageOptions) -> float:
-    """The planned flight time, s, or ``inf`` where the path cannot be timed."""
+def _plan_or_none(region: Polygon, options: CoverageOptions) -> CoveragePlan | None:
+    """The plan, or ``None`` where the path cannot be timed within the limits."""
     try:
-        return plan_coverage(region, options).duration
+        return plan_coverage(region, options)
     except InfeasibleError:
-        return math.inf
+        return None
 
 
 def _length(path: FloatArray) -> float:
