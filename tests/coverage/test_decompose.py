@@ -7,8 +7,8 @@ import itertools
 import numpy as np
 import pytest
 import shapely
+from coverage_strategies import star_shaped
 from hypothesis import HealthCheck, given, settings
-from hypothesis import strategies as st
 from shapely.geometry import LineString, Polygon
 
 from skyquill.coverage.decompose import (
@@ -150,18 +150,8 @@ def test_bad_inputs_are_named() -> None:
         multi_spiral_control_points(L_SHAPE, WIDTH, mode="radial")  # type: ignore[arg-type]
 
 
-@st.composite
-def _star_shaped(draw: st.DrawFn) -> np.ndarray:
-    """Random star-shaped polygons: 5-12 vertices at sorted angles, 8-40 m across."""
-    count = draw(st.integers(5, 12))
-    size = draw(st.floats(8.0, 40.0))
-    angles = np.sort(draw(st.lists(st.floats(0.0, 2 * np.pi), min_size=count, max_size=count)))
-    radii = draw(st.lists(st.floats(0.2, 1.0), min_size=count, max_size=count))
-    return np.c_[np.cos(angles), np.sin(angles)] * (0.5 * size * np.asarray(radii))[:, None]
-
-
 @settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow])
-@given(_star_shaped())
+@given(star_shaped(vertices=(5, 12), size_m=(8.0, 40.0), radius=(0.2, 1.0)))
 def test_random_star_shaped_regions_work_or_are_refused(vertices: np.ndarray) -> None:
     try:
         region = region_from_vertices(vertices)

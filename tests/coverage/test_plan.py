@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import shapely
+from coverage_strategies import star_shaped
 from hypothesis import HealthCheck, Phase, given, settings
 from hypothesis import strategies as st
 from shapely.geometry import MultiPoint, Polygon
@@ -124,23 +125,16 @@ def test_random_convex_regions_plan_inside_the_region(region: Polygon, pattern: 
     assert covered >= 0.97 and options.epsilon <= 1.0
 
 
-@st.composite
-def star_regions(draw: st.DrawFn) -> np.ndarray:
-    """Random star-shaped (mostly concave) vertex lists: 5-10 vertices, 10-30 m across."""
-    count = draw(st.integers(5, 10))
-    size = draw(st.floats(10.0, 30.0))
-    angles = np.sort(draw(st.lists(st.floats(0.0, 2 * np.pi), min_size=count, max_size=count)))
-    radii = draw(st.lists(st.floats(0.3, 1.0), min_size=count, max_size=count))
-    return np.c_[np.cos(angles), np.sin(angles)] * (0.5 * size * np.asarray(radii))[:, None]
-
-
 @settings(
     max_examples=6,
     deadline=None,
     suppress_health_check=[HealthCheck.too_slow],
     phases=[Phase.explicit, Phase.generate],
 )
-@given(vertices=star_regions(), pattern=st.sampled_from(["spiral", "zigzag", "zigzag-stop"]))
+@given(
+    vertices=star_shaped(vertices=(5, 10), size_m=(10.0, 30.0), radius=(0.3, 1.0)),
+    pattern=st.sampled_from(["spiral", "zigzag", "zigzag-stop"]),
+)
 def test_random_concave_regions_plan_or_are_refused(vertices: np.ndarray, pattern: str) -> None:
     try:
         region = region_from_vertices(vertices)
