@@ -579,7 +579,7 @@ def case4(quick: bool, entries: list[dict[str, Any]], advance: Callable[[str], N
         ours_interior = measure(lambda p=interior: solve(p), quick)
         res_interior: FitResult = ours_interior.last
         res: FitResult = ours.last
-        peer_traj = peer.last
+        peer_traj = peer.last.trajectory
         ours_med, peer_med = float(np.median(ours.times_s)), float(np.median(peer.times_s))
         ratio = peer_med / ours_med
         ratio_solve = float(np.median(own_peer)) / float(np.median(own_ours))

@@ -1,7 +1,9 @@
-"""The dense check every returned trajectory carries (DESIGN.md, "verified").
+"""The one dense check of every trajectory kind (DESIGN.md, "verified").
 
-The trajectory is sampled at >= 20 points per knot span and >= 10,000 points
-in all; the largest speed, per-axis acceleration and jerk, the horizontal
+:func:`verify` takes any :class:`~skyquill.trajectory.Trajectory`: the
+B-spline a planner holds, or the file a command wrote, read back. The
+trajectory is sampled at >= 20 points per span between its breakpoints and
+>= 10,000 points in all; the largest speed, per-axis acceleration and jerk, the horizontal
 norms, and the largest relative excess over each limit asked for are
 reported. A limit the method guarantees through the convex hull must show an
 excess of 0 (to 1e-9 relative); the check says for each limit whether it was
@@ -12,12 +14,17 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import asdict, dataclass
-from typing import Any, Protocol
+from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
 
 from skyquill.limits import DerivativeLimit
+from skyquill.trajectory.base import Trajectory, dense_times
 from skyquill.validation import FloatArray
+
+#: Samples evaluated at once: bounds the check's memory on long trajectories
+#: (4 orders x 3 axes x 8 B x this = ~100 MB).
+CHUNK = 1_000_000
 
 
 class Region(Protocol):
@@ -36,13 +43,9 @@ class Region(Protocol):
     def t_end(self) -> float: ...
 
 
-class DenseTrajectory(Protocol):
-    """What the dense check needs of a trajectory."""
-
-    @property
-    def duration(self) -> float: ...
-
-    def evaluate(self, t: FloatArray, order: int = 0) -> FloatArray: ...
+@runtime_checkable
+class FastDense(Protocol):
+    """A trajectory with its own faster dense sampler (the B-spline's sparse design matrices)."""
 
     def dense_times(self) -> FloatArray: ...
 
@@ -126,7 +129,7 @@ class Verification:
 
 
 def verify(
-    traj: DenseTrajectory,
+    traj: Trajectory,
     limits: Sequence[DerivativeLimit] = (),
     corridors: Sequence[Region] = (),
     guaranteed: bool = True,
@@ -136,45 +139,76 @@ def verify(
     Parameters
     ----------
     traj
-        Any trajectory with ``dense_times``.
+        Any trajectory kind.
     limits
         Limits to report on.
     corridors
         Regions with time windows; the largest excursion is reported.
     guaranteed
-        Whether the planner imposed these limits through the convex hull.
+        Whether the planner imposed these limits through the convex hull (an
+        approximate planner, such as the coverage speed LP, passes False).
     """
-    t = traj.dense_times()
     orders = sorted({1, 2, 3} | {lim.order for lim in limits} | ({0} if corridors else set()))
-    derivs = traj.dense_derivatives(orders)
-    checks = []
-    for lim in limits:
-        value, excess = lim.relative_excess(derivs[lim.order])
-        checks.append(LimitCheck(lim.label, lim.order, value, excess, guaranteed))
-    corridor_excess = -np.inf
-    for region in corridors:
-        inside = (t >= region.t_start) & (t <= region.t_end)
-        if np.any(inside):
-            p = derivs[0][inside]
-            corridor_excess = max(corridor_excess, float((p @ region.A.T - region.b).max()))
+    peaks = _Peaks(limits, corridors, traj.dim)
+    if isinstance(traj, FastDense):
+        t = traj.dense_times()
+        peaks.add(t, traj.dense_derivatives(orders))
+    else:
+        t = dense_times(traj.breakpoints)
+        for start in range(0, t.size, CHUNK):
+            chunk = t[start : start + CHUNK]
+            peaks.add(chunk, {n: traj.evaluate(chunk, n) for n in orders})
+    return peaks.result(int(t.size), guaranteed)
 
-    # One (d, N) copy per order: reductions along contiguous rows are ~30x
-    # faster than along axis 0 of an (N, 3) array.
-    by_axis = {n: np.ascontiguousarray(derivs[n].T) for n in (1, 2, 3)}
 
-    def horizontal(x: FloatArray) -> float:
-        return float(np.sqrt((x[0] ** 2 + x[1] ** 2).max())) if x.shape[0] >= 2 else 0.0
+class _Peaks:
+    """Running maxima over chunks of dense samples."""
 
-    peaks = {n: np.abs(x).max(axis=1) for n, x in by_axis.items()}
-    return Verification(
-        n_samples=int(t.size),
-        max_speed=float(np.sqrt((by_axis[1] ** 2).sum(axis=0).max())),
-        max_velocity=tuple(float(x) for x in peaks[1]),
-        max_acc=tuple(float(x) for x in peaks[2]),
-        max_jerk=tuple(float(x) for x in peaks[3]),
-        max_horizontal_acc=horizontal(by_axis[2]),
-        max_horizontal_jerk=horizontal(by_axis[3]),
-        checks=tuple(checks),
-        corridor_excess_m=float(corridor_excess) if corridors else 0.0,
-        max_excess=max((c.relative_excess for c in checks), default=0.0),
-    )
+    def __init__(self, limits: Sequence[DerivativeLimit], corridors: Sequence[Region], dim: int):
+        self.limits, self.corridors = tuple(limits), tuple(corridors)
+        self.limit_values = [0.0] * len(self.limits)
+        self.limit_excess = [0.0] * len(self.limits)
+        self.speed = 0.0
+        self.axis = {n: np.zeros(dim) for n in (1, 2, 3)}
+        self.horizontal = {2: 0.0, 3: 0.0}
+        self.corridor = -np.inf
+
+    def add(self, t: FloatArray, derivs: dict[int, FloatArray]) -> None:
+        for i, lim in enumerate(self.limits):
+            value, excess = lim.relative_excess(derivs[lim.order])
+            self.limit_values[i] = max(self.limit_values[i], value)
+            self.limit_excess[i] = max(self.limit_excess[i], excess)
+        for region in self.corridors:
+            inside = (t >= region.t_start) & (t <= region.t_end)
+            if np.any(inside):
+                excursion = float((derivs[0][inside] @ region.A.T - region.b).max())
+                self.corridor = max(self.corridor, excursion)
+        # One (d, N) copy per order: reductions along contiguous rows are ~30x
+        # faster than along axis 0 of an (N, 3) array.
+        by_axis = {n: np.ascontiguousarray(derivs[n].T) for n in (1, 2, 3)}
+        self.speed = max(self.speed, float(np.sqrt((by_axis[1] ** 2).sum(axis=0).max())))
+        for n, x in by_axis.items():
+            self.axis[n] = np.maximum(self.axis[n], np.abs(x).max(axis=1))
+            if n in self.horizontal and x.shape[0] >= 2:
+                peak = float(np.sqrt((x[0] ** 2 + x[1] ** 2).max()))
+                self.horizontal[n] = max(self.horizontal[n], peak)
+
+    def result(self, n_samples: int, guaranteed: bool) -> Verification:
+        checks = tuple(
+            LimitCheck(lim.label, lim.order, value, excess, guaranteed)
+            for lim, value, excess in zip(
+                self.limits, self.limit_values, self.limit_excess, strict=True
+            )
+        )
+        return Verification(
+            n_samples=n_samples,
+            max_speed=self.speed,
+            max_velocity=tuple(float(x) for x in self.axis[1]),
+            max_acc=tuple(float(x) for x in self.axis[2]),
+            max_jerk=tuple(float(x) for x in self.axis[3]),
+            max_horizontal_acc=self.horizontal[2],
+            max_horizontal_jerk=self.horizontal[3],
+            checks=checks,
+            corridor_excess_m=float(self.corridor) if self.corridors else 0.0,
+            max_excess=max((c.relative_excess for c in checks), default=0.0),
+        )

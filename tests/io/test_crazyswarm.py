@@ -17,12 +17,11 @@ from skyquill.io.crazyswarm import (
     COLUMNS,
     HEADER,
     MAX_PIECES,
-    PolynomialTrajectory,
     crazyswarm_pieces,
     read_crazyswarm,
     write_crazyswarm,
 )
-from skyquill.trajectory import SplineTrajectory, Trajectory
+from skyquill.trajectory import PiecewisePolynomial, SplineTrajectory, Trajectory
 
 
 def spline(degree: int, dim: int, n_ctrl: int = 20, seed: int = 0) -> SplineTrajectory:
@@ -218,13 +217,13 @@ def test_read_accepts_crazyswarm_capitalised_header_and_blank_lines(tmp_path: Pa
 
 
 def test_polynomial_trajectory_validates() -> None:
-    traj = PolynomialTrajectory(np.array([0.0, 1.0]), np.zeros((1, 8, 3)), np.zeros((1, 8)))
+    traj = PiecewisePolynomial(np.array([0.0, 1.0]), np.zeros((1, 8, 3)), np.zeros((1, 8)))
     with pytest.raises(InputError, match=r"t: got times in \[0, 2\] s, expected within \[0, 1\]"):
         traj.evaluate(np.array([0.0, 2.0]))
     with pytest.raises(InputError, match="breaks: got breaks\\[0\\] = 1, expected 0"):
-        PolynomialTrajectory(np.array([1.0, 2.0]), np.zeros((1, 8, 3)), np.zeros((1, 8)))
+        PiecewisePolynomial(np.array([1.0, 2.0]), np.zeros((1, 8, 3)), np.zeros((1, 8)))
     with pytest.raises(InputError, match="coeffs: got an array of shape"):
-        PolynomialTrajectory(np.array([0.0, 1.0]), np.zeros((2, 8, 3)), np.zeros((1, 8)))
+        PiecewisePolynomial(np.array([0.0, 1.0]), np.zeros((2, 8, 3)), np.zeros((1, 8)))
     assert traj.sample(10.0).p.shape == (11, 3)
 
 

@@ -14,12 +14,11 @@ from skyquill.io.points import TRAJECTORY_COLUMNS, trajectory_table, write_traje
 from skyquill.io.trajectory_csv import (
     FLIGHT_COLUMNS,
     REQUIRED_COLUMNS,
-    SampledTrajectory,
     read_trajectory_csv,
     write_flight_csv,
 )
 from skyquill.sim import simulate
-from skyquill.trajectory import SplineTrajectory, Trajectory
+from skyquill.trajectory import SampledTrajectory, SplineTrajectory, Trajectory
 
 HEADER = ",".join(TRAJECTORY_COLUMNS)
 

@@ -10,7 +10,8 @@ import pytest
 from numpy.polynomial.legendre import leggauss
 from numpy.typing import NDArray
 
-from skyquill.reproduce.peers import PolynomialTrajectory, minsnap_interpolate
+from skyquill.reproduce.peers import PeerFit, minsnap_interpolate
+from skyquill.trajectory import PiecewisePolynomial
 
 ms = pytest.importorskip("minsnap_trajectories")
 
@@ -28,12 +29,13 @@ def _problem(
 @pytest.mark.parametrize("t0", [0.0, 1.5, -0.75])
 def test_passes_through_waypoints(dim: int, t0: float) -> None:
     waypoints, times = _problem(dim=dim, t0=t0, seed=dim)
-    traj = minsnap_interpolate(waypoints, times)
+    fit = minsnap_interpolate(waypoints, times)
+    traj, times = fit.trajectory, times - fit.start_time
     assert traj.degree == 7
     assert traj.coeffs.shape == (len(times) - 1, 8, dim)
     np.testing.assert_array_equal(traj.breaks, times)
     assert traj.duration == pytest.approx(times[-1] - times[0])
-    assert traj.solve_time_s >= 0.0
+    assert fit.solve_time_s >= 0.0
     np.testing.assert_allclose(traj.evaluate(times), waypoints, rtol=0, atol=1e-8)
     # Both one-sided limits at interior waypoints, too.
     eps = 1e-12
@@ -43,9 +45,10 @@ def test_passes_through_waypoints(dim: int, t0: float) -> None:
 
 def test_agrees_with_peer_evaluation() -> None:
     waypoints, times = _problem(dim=3, n_wp=7, t0=1.5, seed=7)
-    traj = minsnap_interpolate(waypoints, times)
+    fit = minsnap_interpolate(waypoints, times)
+    traj, times = fit.trajectory, times - fit.start_time
 
-    # Independent peer solve, at the absolute times, with the same problem settings.
+    # Independent peer solve, on the trajectory's clock, with the same problem settings.
     zero = np.zeros(3)
     refs = [
         ms.Waypoint(time=float(t), position=p, velocity=zero, acceleration=zero, jerk=zero)
@@ -67,7 +70,8 @@ def test_agrees_with_peer_evaluation() -> None:
 @pytest.mark.parametrize("dim", [1, 3])
 def test_rest_at_both_ends(dim: int) -> None:
     waypoints, times = _problem(dim=dim, seed=11)
-    traj = minsnap_interpolate(waypoints, times)
+    fit = minsnap_interpolate(waypoints, times)
+    traj, times = fit.trajectory, times - fit.start_time
     ends = times[[0, -1]]
     for order in (1, 2, 3):
         np.testing.assert_allclose(traj.evaluate(ends, order=order), 0.0, rtol=0, atol=1e-8)
@@ -75,7 +79,8 @@ def test_rest_at_both_ends(dim: int) -> None:
 
 def test_snap_integral_matches_quadrature() -> None:
     waypoints, times = _problem(dim=3, n_wp=5, t0=0.4, seed=3)
-    traj = minsnap_interpolate(waypoints, times)
+    fit = minsnap_interpolate(waypoints, times)
+    traj, times = fit.trajectory, times - fit.start_time
     exact = traj.squared_derivative_integral(4)
 
     nodes, weights = leggauss(8)
@@ -93,10 +98,12 @@ def test_snap_integral_matches_quadrature() -> None:
 
 @pytest.mark.parametrize(("t0", "t1", "x0", "x1"), [(0.0, 1.0, 0.0, 1.0), (0.5, 3.0, -0.3, 2.2)])
 def test_two_point_line_is_smoothstep(t0: float, t1: float, x0: float, x1: float) -> None:
-    traj = minsnap_interpolate(np.array([[x0], [x1]]), np.array([t0, t1]))
+    fit = minsnap_interpolate(np.array([[x0], [x1]]), np.array([t0, t1]))
+    traj = fit.trajectory
+    assert fit.start_time == t0
     T = t1 - t0
-    t = np.linspace(t0, t1, 101)
-    s = (t - t0) / T
+    t = np.linspace(0.0, T, 101)
+    s = t / T
     closed = x0 + (x1 - x0) * (35 * s**4 - 84 * s**5 + 70 * s**6 - 20 * s**7)
     np.testing.assert_allclose(traj.evaluate(t)[:, 0], closed, rtol=0, atol=1e-9)
     # Coefficients themselves: (x1 - x0) * [0, 0, 0, 0, 35, -84, 70, -20] / T**j.
@@ -110,13 +117,12 @@ def test_two_point_line_is_smoothstep(t0: float, t1: float, x0: float, x1: float
 
 def test_evaluate_rejects_out_of_range_and_handles_high_orders() -> None:
     waypoints, times = _problem(dim=2, n_wp=3, t0=1.0, seed=5)
-    traj = minsnap_interpolate(waypoints, times)
+    fit = minsnap_interpolate(waypoints, times)
+    traj, times = fit.trajectory, times - fit.start_time
     with pytest.raises(ValueError):
         traj.evaluate(np.array([times[0] - 1e-6]))
     with pytest.raises(ValueError):
         traj.evaluate(np.array([times[-1] + 1e-6]))
-    with pytest.raises(ValueError):
-        traj.evaluate(np.array([0.0]))  # absolute times: 0 is before breaks[0] = 1
     with pytest.raises(ValueError):
         traj.evaluate(times, order=-1)
     np.testing.assert_array_equal(traj.evaluate(times, order=8), 0.0)
@@ -148,10 +154,9 @@ def test_missing_peer_raises_import_error(monkeypatch: pytest.MonkeyPatch) -> No
 
 
 def test_dataclass_is_frozen_and_read_only() -> None:
-    traj = PolynomialTrajectory(
-        breaks=np.array([0.0, 1.0]), coeffs=np.ones((1, 8, 1)), solve_time_s=0.0
-    )
+    traj = PiecewisePolynomial(breaks=np.array([0.0, 1.0]), coeffs=np.ones((1, 8, 1)))
+    fit = PeerFit(traj, 0.0, 0.0)
     with pytest.raises(AttributeError):
-        traj.solve_time_s = 1.0  # type: ignore[misc]
+        fit.solve_time_s = 1.0  # type: ignore[misc]
     with pytest.raises(ValueError):
         traj.coeffs[0, 0, 0] = 2.0

@@ -12,7 +12,7 @@ from skyquill.errors import InputError
 from skyquill.io.points import write_json
 
 if TYPE_CHECKING:  # the fly command imports the simulator lazily
-    from skyquill.io.trajectory_csv import SampledTrajectory
+    from skyquill.trajectory import SampledTrajectory
     from skyquill.sim import Disturbances, Flight, OuterLoop
 
 FLY_CONTROLLERS = ("rpt", "pid-ff", "pid", "se3")

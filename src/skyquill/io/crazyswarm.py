@@ -32,13 +32,11 @@ from pathlib import Path
 from typing import Literal
 
 import numpy as np
-from numpy.typing import NDArray
 
 from skyquill.errors import InputError
 from skyquill.io.points import parse_cell
-from skyquill.polynomial import horner
-from skyquill.trajectory import Samples, SplineTrajectory, evaluation_times, sample
-from skyquill.validation import FloatArray, as_array, as_float, as_int, strictly_increasing
+from skyquill.trajectory import PiecewisePolynomial, SplineTrajectory
+from skyquill.validation import FloatArray, as_float, as_int
 
 #: Pieces the Crazyflie can hold at once: 4096 B of trajectory memory / 132 B a piece.
 MAX_PIECES = 31
@@ -204,95 +202,6 @@ def write_crazyswarm(
     )
 
 
-@dataclass(frozen=True)
-class PolynomialTrajectory:
-    """Piecewise polynomial trajectory, as flown from a Crazyswarm CSV.
-
-    Implements the :class:`~skyquill.trajectory.Trajectory` protocol in the
-    z-up world frame (metres, seconds); yaw is separate (:meth:`evaluate_yaw`).
-
-    Parameters
-    ----------
-    breaks
-        Piece boundaries, shape (P + 1,), s; starts at 0, strictly increasing.
-    coeffs
-        Power-basis coefficients of x, y, z, shape (P, K, 3), lowest order
-        first, in local time ``tau = t - breaks[i]``: ``p(t) = sum_j
-        coeffs[i, j] tau^j`` (m / s^j). K is 8 for a Crazyswarm file.
-    yaw_coeffs
-        Yaw coefficients, shape (P, K), rad / s^j.
-    """
-
-    breaks: FloatArray
-    coeffs: FloatArray
-    yaw_coeffs: FloatArray
-
-    def __post_init__(self) -> None:
-        breaks = as_array("breaks", self.breaks, ndim=1)
-        if breaks.size < 2:
-            raise InputError(f"breaks: got {breaks.size} value(s), expected at least 2 (one piece)")
-        if breaks[0] != 0.0:
-            raise InputError(f"breaks: got breaks[0] = {breaks[0]:g}, expected 0")
-        strictly_increasing("breaks", breaks)
-        n = breaks.size - 1
-        coeffs = as_array("coeffs", self.coeffs, shape=(n, None, 3))
-        if coeffs.shape[1] < 1:
-            raise InputError("coeffs: got 0 coefficients per piece, expected at least 1")
-        yaw = as_array("yaw_coeffs", self.yaw_coeffs, shape=(n, coeffs.shape[1]))
-        for name, arr in (("breaks", breaks), ("coeffs", coeffs), ("yaw_coeffs", yaw)):
-            arr.setflags(write=False)
-            object.__setattr__(self, name, arr)
-
-    @property
-    def duration(self) -> float:
-        """Total length, s."""
-        return float(self.breaks[-1])
-
-    @property
-    def dim(self) -> int:
-        """Number of axes (3)."""
-        return 3
-
-    @property
-    def n_pieces(self) -> int:
-        """Number of polynomial pieces ``P``."""
-        return int(self.breaks.size - 1)
-
-    def _locate(self, t: FloatArray) -> tuple[FloatArray, NDArray[np.intp]]:
-        times = evaluation_times(t, self.duration)
-        # A break belongs to the piece on its right; the end to the last piece.
-        idx = np.clip(np.searchsorted(self.breaks, times, side="right") - 1, 0, self.n_pieces - 1)
-        return times - self.breaks[idx], idx
-
-    def evaluate(self, t: FloatArray, order: int = 0) -> FloatArray:
-        """The ``order``-th time derivative of position.
-
-        Parameters
-        ----------
-        t
-            Times, shape (N,), each in ``[0, duration]`` s.
-        order
-            0 (position, m) and up (m/s^order); exact polynomial derivatives.
-
-        Returns
-        -------
-        numpy.ndarray, shape (N, 3)
-        """
-        order = as_int("order", order, low=0)
-        tau, idx = self._locate(t)
-        return horner(self.coeffs[idx], tau, order).reshape(tau.size, 3)
-
-    def evaluate_yaw(self, t: FloatArray, order: int = 0) -> FloatArray:
-        """The ``order``-th time derivative of yaw, shape (N,), rad / s^order."""
-        order = as_int("order", order, low=0)
-        tau, idx = self._locate(t)
-        return horner(self.yaw_coeffs[idx], tau, order).reshape(tau.size)
-
-    def sample(self, rate: float) -> Samples:
-        """Samples at ``rate`` Hz (position to jerk), including both ends."""
-        return sample(self, rate)
-
-
 def _read_table(path: Path) -> FloatArray:
     name = str(path)
     try:
@@ -337,7 +246,7 @@ def _read_table(path: Path) -> FloatArray:
     return np.array(rows, dtype=float)
 
 
-def read_crazyswarm(path: str | Path | Sequence[str | Path]) -> PolynomialTrajectory:
+def read_crazyswarm(path: str | Path | Sequence[str | Path]) -> PiecewisePolynomial:
     """Read one Crazyswarm CSV, or several uploads flown back to back.
 
     Parameters
@@ -348,9 +257,9 @@ def read_crazyswarm(path: str | Path | Sequence[str | Path]) -> PolynomialTrajec
 
     Returns
     -------
-    PolynomialTrajectory
+    PiecewisePolynomial
         3 axes in the z-up world frame (Crazyswarm's frame; nothing converted),
-        metres, time from 0; yaw via :meth:`PolynomialTrajectory.evaluate_yaw`.
+        metres, time from 0; yaw via :meth:`PiecewisePolynomial.evaluate_yaw`.
 
     Raises
     ------
@@ -372,4 +281,4 @@ def read_crazyswarm(path: str | Path | Sequence[str | Path]) -> PolynomialTrajec
             "strictly increasing time (durations too large or too small relative to the total)"
         )
     poly = table[:, 1:].reshape(n, 4, N_COEFFS).transpose(0, 2, 1)  # (P, 8, 4)
-    return PolynomialTrajectory(breaks, poly[:, :, :3].copy(), poly[:, :, 3].copy())
+    return PiecewisePolynomial(breaks, poly[:, :, :3].copy(), poly[:, :, 3].copy())

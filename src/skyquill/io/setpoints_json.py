@@ -24,7 +24,7 @@ import numpy as np
 
 from skyquill.errors import InputError
 from skyquill.io.points import TRAJECTORY_COLUMNS, trajectory_table, write_json
-from skyquill.io.trajectory_csv import MIN_STEP_S, SampledTrajectory
+from skyquill.trajectory.sampled import MIN_STEP_S, SampledTrajectory
 from skyquill.trajectory import Trajectory
 from skyquill.validation import as_float
 

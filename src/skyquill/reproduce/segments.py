@@ -25,7 +25,7 @@ Measured for each, on 20,001 uniform-time samples: the average and the
 largest distance to the polyline (:func:`polyline_distance`), and the snap
 cost ``∫||d^4 p/dt^4||^2 dt`` in m^2/s^7, computed exactly by polynomial
 algebra on the pieces (the peer's
-:meth:`~skyquill.reproduce.peers.PolynomialTrajectory.squared_derivative_integral`;
+:meth:`~skyquill.trajectory.PiecewisePolynomial.squared_derivative_integral`;
 for the B-spline after its exact conversion to pieces, cross-checked against
 the optimiser's own smoothness term).
 
@@ -94,8 +94,8 @@ from skyquill.io.points import read_points_csv, write_json
 from skyquill.optimize import Boundary, PointDeviation, SmoothingProblem, solve
 from skyquill.optimize.problem import Deviation
 from skyquill.optimize.timing import allocate_segment_times, segment_chain_terms
-from skyquill.reproduce.peers import PolynomialTrajectory, minsnap_interpolate
-from skyquill.trajectory import SplineTrajectory
+from skyquill.reproduce.peers import minsnap_interpolate
+from skyquill.trajectory import PiecewisePolynomial, SplineTrajectory
 from skyquill.validation import FloatArray, as_array, as_float, as_int
 
 __all__ = [
@@ -121,7 +121,7 @@ _WEIGHT_SWEEP = (10.0, 100.0, 1e3, 1e4, 1e5)
 _KAPPA_SWEEP = (0.1, 0.25, 0.4)
 
 
-def snap_cost(traj: PolynomialTrajectory | SplineTrajectory) -> float:
+def snap_cost(traj: PiecewisePolynomial | SplineTrajectory) -> float:
     """Exact ``∫_0^T ||d^4 p / dt^4||^2 dt`` in m^2/s^7.
 
     A B-spline is first converted exactly to its polynomial pieces
@@ -130,7 +130,7 @@ def snap_cost(traj: PolynomialTrajectory | SplineTrajectory) -> float:
     """
     if isinstance(traj, SplineTrajectory):
         breaks, coeffs = traj.to_piecewise_polynomial()
-        traj = PolynomialTrajectory(breaks=breaks, coeffs=coeffs, solve_time_s=0.0)
+        traj = PiecewisePolynomial(breaks, coeffs)
     return traj.squared_derivative_integral(4)
 
 
@@ -197,14 +197,12 @@ def fit_segment_chain(
 
 
 def _metrics(
-    traj: PolynomialTrajectory | SplineTrajectory,
+    traj: PiecewisePolynomial | SplineTrajectory,
     waypoints: FloatArray,
     duration: float,
     n_samples: int,
 ) -> dict[str, Any]:
     t = np.linspace(0.0, duration, n_samples)
-    if isinstance(traj, PolynomialTrajectory):
-        t = t + float(traj.breaks[0])
     dist = polyline_distance(traj.evaluate(t), waypoints)
     speed = np.linalg.norm(traj.evaluate(t, 1), axis=1)
     acc = np.linalg.norm(traj.evaluate(t, 2), axis=1)
@@ -248,7 +246,7 @@ def _sensitivity(
         by_kappa.append(
             {
                 "kappa": k,
-                "method_2": _metrics(peer, waypoints, duration, n_samples),
+                "method_2": _metrics(peer.trajectory, waypoints, duration, n_samples),
                 "method_3": _metrics(traj, waypoints, duration, n_samples),
             }
         )
@@ -312,13 +310,13 @@ def run_segment_study(
     methods: dict[str, dict[str, Any]] = {
         "method_1": {
             "description": "min-snap interpolation of the waypoints (peer, degree 7)",
-            **_metrics(m1, waypoints, duration, n),
+            **_metrics(m1.trajectory, waypoints, duration, n),
             "solve_time_s": m1.solve_time_s,
         },
         "method_2": {
             "description": "min-snap interpolation with the intermediate points of §3.5 "
             "(peer, degree 7)",
-            **_metrics(m2, waypoints, duration, n),
+            **_metrics(m2.trajectory, waypoints, duration, n),
             "solve_time_s": m2.solve_time_s,
         },
         "method_3": {
@@ -335,9 +333,9 @@ def run_segment_study(
     methods["method_3"]["snap_cost_check_rel_diff"] = abs(snap3 - smooth3) / max(snap3, 1e-300)
 
     t_dense = np.linspace(0.0, duration, 4001)
-    labels: dict[str, PolynomialTrajectory | SplineTrajectory] = {
-        "Method 1: min-snap through waypoints": m1,
-        "Method 2: min-snap with intermediate points": m2,
+    labels: dict[str, PiecewisePolynomial | SplineTrajectory] = {
+        "Method 1: min-snap through waypoints": m1.trajectory,
+        "Method 2: min-snap with intermediate points": m2.trajectory,
         "Method 3: line-segment fit (ours)": traj3,
     }
     positions = {name: tr.evaluate(t_dense) for name, tr in labels.items()}

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import numpy.polynomial.polynomial as npoly
 
-from skyquill.polynomial import horner
+from skyquill.trajectory.horner import horner
 
 
 def test_horner_matches_numpy_for_every_derivative() -> None:

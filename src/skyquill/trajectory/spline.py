@@ -1,9 +1,4 @@
-"""Trajectories: the object every pipeline stage speaks.
-
-:class:`Trajectory` is the protocol (duration, evaluate, sample);
-:class:`SplineTrajectory` is the clamped uniform B-spline the engine returns.
-Positions are in the z-up world frame, metres; time in seconds from 0.
-"""
+"""The clamped uniform B-spline the engine returns (paper 003 eq. 4-5)."""
 
 from __future__ import annotations
 
@@ -11,95 +6,24 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cached_property
-from typing import Protocol, runtime_checkable
+from typing import TYPE_CHECKING
 
 import numpy as np
 from scipy.interpolate import BSpline
 
-from skyquill.errors import InputError
 from skyquill.limits import DerivativeLimit
 from skyquill.spline import ClampedUniformBasis, basis_for, uniform_design
+from skyquill.trajectory.base import (
+    DENSE_MIN_TOTAL,
+    DENSE_PER_SPAN,
+    Samples,
+    evaluation_times,
+    sample,
+)
 from skyquill.validation import FloatArray, as_array, as_float, as_int
-from skyquill.verify import Region, Verification, verify
 
-#: DESIGN.md: at least 20 samples per knot span and never fewer than 10,000.
-DENSE_PER_SPAN = 20
-DENSE_MIN_TOTAL = 10_000
-
-
-@dataclass(frozen=True)
-class Samples:
-    """A trajectory sampled at fixed times.
-
-    Attributes
-    ----------
-    t
-        Times, shape (N,), s.
-    p, v, a, j
-        Position (m), velocity (m/s), acceleration (m/s^2), jerk (m/s^3),
-        each shape (N, d).
-    """
-
-    t: FloatArray
-    p: FloatArray
-    v: FloatArray
-    a: FloatArray
-    j: FloatArray
-
-
-@runtime_checkable
-class Trajectory(Protocol):
-    """What every stage needs of a trajectory."""
-
-    @property
-    def duration(self) -> float:
-        """Length in seconds; the trajectory is defined on ``[0, duration]``."""
-        ...
-
-    @property
-    def dim(self) -> int:
-        """Number of axes ``d``."""
-        ...
-
-    def evaluate(self, t: FloatArray, order: int = 0) -> FloatArray:
-        """The ``order``-th time derivative at times ``t`` (N,); returns (N, d)."""
-        ...
-
-    def sample(self, rate: float) -> Samples:
-        """Samples at ``rate`` Hz from 0 to ``duration`` inclusive."""
-        ...
-
-
-def evaluation_times(t: object, duration: float) -> FloatArray:
-    """Times ``t`` (N,) checked to lie in ``[0, duration]`` (to round-off), clipped there.
-
-    The check every trajectory's ``evaluate`` shares; :class:`InputError` otherwise.
-    """
-    times = as_array("t", t, ndim=1)
-    tol = 1e-9 * max(1.0, duration)
-    if times.size and (times.min() < -tol or times.max() > duration + tol):
-        raise InputError(
-            f"t: got times in [{times.min():g}, {times.max():g}] s, expected within "
-            f"[0, {duration:g}] s"
-        )
-    return np.clip(times, 0.0, duration)  # only round-off reaches the clip
-
-
-def sample_times(duration: float, rate: float) -> FloatArray:
-    """``0, 1/rate, ...`` up to and including ``duration``; shape (N,)."""
-    rate = as_float("rate", rate, positive=True)
-    n = int(np.floor(duration * rate + 1e-9)) + 1
-    t = np.arange(n) / rate
-    if duration - t[-1] > 1e-9:
-        t = np.append(t, duration)
-    return np.minimum(t, duration)
-
-
-def sample(traj: Trajectory, rate: float) -> Samples:
-    """Sample any :class:`Trajectory` (position to jerk) at ``rate`` Hz."""
-    t = sample_times(traj.duration, rate)
-    p, v, a, j = (traj.evaluate(t, n) for n in range(4))
-    return Samples(t, p, v, a, j)
+if TYPE_CHECKING:
+    from skyquill.verify import Region, Verification
 
 
 @dataclass(frozen=True)
@@ -147,6 +71,11 @@ class SplineTrajectory:
     def knot_times(self) -> FloatArray:
         """Distinct knot times (breakpoints), shape (L + 1,), s."""
         return np.arange(self.basis.n_spans + 1) / self.alpha
+
+    @property
+    def breakpoints(self) -> FloatArray:
+        """The knot times: where its polynomial pieces meet, shape (L + 1,), s."""
+        return self.knot_times
 
     @cached_property
     def _splines(self) -> tuple[BSpline, ...]:
@@ -203,6 +132,8 @@ class SplineTrajectory:
         self, limits: Sequence[DerivativeLimit] = (), corridors: Sequence[Region] = ()
     ) -> Verification:
         """The dense check (DESIGN.md) of this trajectory against ``limits`` and ``corridors``."""
+        from skyquill.verify import verify  # the verifier imports the trajectory kinds
+
         return verify(self, limits, corridors)
 
     def derivative_control_points(self, order: int) -> FloatArray:

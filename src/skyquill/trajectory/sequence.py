@@ -1,0 +1,120 @@
+"""Trajectories flown one after another, at rest where they meet.
+
+Stop-and-go legs, a coverage flown part by part, a mission split into
+uploads with a hover between them: each piece starts and ends at rest, so the
+sequence is as smooth as its pieces (velocity and acceleration are 0 at
+every join, checked at construction).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from skyquill.errors import InputError
+from skyquill.trajectory.base import Samples, Trajectory, evaluation_times, sample
+from skyquill.validation import FloatArray, as_int
+
+#: Largest position gap between consecutive pieces, m.
+JOIN_TOLERANCE_M = 1e-6
+#: Largest speed (m/s) and acceleration (m/s^2) at a join that still counts as rest.
+REST_TOLERANCE = 1e-6
+
+
+@dataclass(frozen=True)
+class RestToRestSequence:
+    """``pieces`` flown back to back.
+
+    Parameters
+    ----------
+    pieces
+        At least one trajectory, all with the same number of axes; each next
+        one starts where the previous one ends, and both are at rest there.
+    """
+
+    pieces: tuple[Trajectory, ...]
+
+    def __post_init__(self) -> None:
+        pieces = tuple(self.pieces)
+        if not pieces:
+            raise InputError("pieces: got none, expected at least one trajectory")
+        dims = {p.dim for p in pieces}
+        if len(dims) > 1:
+            raise InputError(f"pieces: got axes {sorted(dims)}, expected one number of axes")
+        for i in range(1, len(pieces)):
+            _check_join(i, pieces[i - 1], pieces[i])
+        object.__setattr__(self, "pieces", pieces)
+
+    @property
+    def starts(self) -> FloatArray:
+        """Start time of each piece and the end, shape (n + 1,), s."""
+        return np.concatenate([[0.0], np.cumsum([p.duration for p in self.pieces])])
+
+    @property
+    def duration(self) -> float:
+        """Total length, s."""
+        return float(self.starts[-1])
+
+    @property
+    def dim(self) -> int:
+        """Number of axes."""
+        return self.pieces[0].dim
+
+    @property
+    def breakpoints(self) -> FloatArray:
+        """Every piece's breakpoints on the sequence's clock, shape (L + 1,), s."""
+        starts = self.starts
+        shifted = [s + p.breakpoints[:-1] for s, p in zip(starts, self.pieces, strict=False)]
+        return np.concatenate([*shifted, [starts[-1]]])
+
+    def piece_at(self, t: FloatArray) -> NDArray[np.intp]:
+        """Index of the piece flown at each time ``t`` (N,); a join belongs to the later piece."""
+        times = evaluation_times(t, self.duration)
+        last = len(self.pieces) - 1
+        return np.clip(np.searchsorted(self.starts, times, side="right") - 1, 0, last)
+
+    def evaluate(self, t: FloatArray, order: int = 0) -> FloatArray:
+        """The ``order``-th time derivative at times ``t`` (N,); returns (N, d)."""
+        as_int("order", order, low=0)
+        times = evaluation_times(t, self.duration)
+        which = self.piece_at(times)
+        out = np.empty((times.size, self.dim))
+        starts = self.starts
+        for k in np.unique(which):
+            mask = which == k
+            piece = self.pieces[k]
+            local = np.clip(times[mask] - starts[k], 0.0, piece.duration)
+            out[mask] = piece.evaluate(local, order)
+        return out
+
+    def sample(self, rate: float) -> Samples:
+        """Samples at ``rate`` Hz (position to jerk), including both ends."""
+        return sample(self, rate)
+
+
+def concatenate(pieces: Sequence[Trajectory]) -> Trajectory:
+    """One trajectory for ``pieces`` flown back to back (the piece itself when there is one)."""
+    return pieces[0] if len(pieces) == 1 else RestToRestSequence(tuple(pieces))
+
+
+def _check_join(i: int, before: Trajectory, after: Trajectory) -> None:
+    end = np.array([before.duration])
+    start = np.array([0.0])
+    gap = float(np.linalg.norm(before.evaluate(end)[0] - after.evaluate(start)[0]))
+    if gap > JOIN_TOLERANCE_M:
+        raise InputError(
+            f"pieces[{i}]: got a start {gap:.3g} m from where pieces[{i - 1}] ends, "
+            f"expected at most {JOIN_TOLERANCE_M:g} m"
+        )
+    for order, name in ((1, "speed"), (2, "acceleration")):
+        for which, traj, at in ((i - 1, before, end), (i, after, start)):
+            value = float(np.linalg.norm(traj.evaluate(at, order)[0]))
+            if value > REST_TOLERANCE:
+                raise InputError(
+                    f"pieces[{which}]: got {name} {value:.3g} at the join with the "
+                    f"{'next' if which == i - 1 else 'previous'} piece, expected rest "
+                    f"(at most {REST_TOLERANCE:g})"
+                )
