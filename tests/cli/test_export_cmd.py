@@ -92,8 +92,9 @@ def test_bad_input(tmp_path: Path, fitted: Path) -> None:
 
 def test_crazyswarm_round_trip_flies_in_the_simulator(fitted: Path, tmp_path: Path) -> None:
     """Import the (split) Crazyswarm upload and fly it: the same trajectory, the same limits."""
-    from skyquill.io.crazyswarm import read_crazyswarm
     from skyquill.io.spline_json import read_spline_json
+
+    from skyquill.io.crazyswarm import read_crazyswarm
     from skyquill.sim import simulate
 
     runner.invoke(

@@ -10,11 +10,11 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from skyquill.errors import InputError
+from skyquill.io.atomic import write_json
 from skyquill.io.points import (
     TRAJECTORY_COLUMNS,
     read_points_csv,
     trajectory_table,
-    write_json,
     write_trajectory_csv,
 )
 from skyquill.trajectory import SplineTrajectory

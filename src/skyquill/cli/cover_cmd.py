@@ -8,7 +8,7 @@ from typing import Annotated
 import typer
 
 from skyquill.cli.main import OutDir, app, console, user_errors
-from skyquill.io.points import write_json
+from skyquill.io.atomic import write_json
 
 
 @app.command()

@@ -10,7 +10,8 @@ import typer
 
 from skyquill.cli.main import app, console, positive_rate, user_errors
 from skyquill.errors import InputError
-from skyquill.io.points import write_json, write_trajectory_csv
+from skyquill.io.atomic import write_json
+from skyquill.io.points import write_trajectory_csv
 from skyquill.io.spline_json import read_spline_json
 from skyquill.trajectory import SplineTrajectory
 

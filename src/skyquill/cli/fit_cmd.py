@@ -9,13 +9,14 @@ import typer
 
 from skyquill.cli.main import OutDir, app, console, positive_rate, user_errors
 from skyquill.errors import InputError
-from skyquill.io.points import read_points_csv, write_json, write_trajectory_csv
-from skyquill.io.spline_json import write_spline_json
+from skyquill.io.plan_dir import write_plan
+from skyquill.io.points import read_points_csv
+from skyquill.io.trajectory_json import PlannedTrajectory
 from skyquill.optimize.fit import FitOptions, PointFit, fit_points
 from skyquill.validation import FloatArray
 
 
-def fit_summary(fit: PointFit, rows: int, rate: float) -> dict[str, Any]:
+def fit_summary(fit: PointFit, rate: float) -> dict[str, Any]:
     """The ``summary.json`` of a fit (SI units)."""
     r, check = fit.result, fit.result.verification
     return {
@@ -37,7 +38,6 @@ def fit_summary(fit: PointFit, rows: int, rate: float) -> dict[str, Any]:
         "n_control_points": int(r.trajectory.control_points.shape[0]),
         "n_points": int(fit.points.shape[0]),
         "rate_hz": rate,
-        "trajectory_rows": rows,
         "limits": check.limits_report(),
         "dense_samples": check.n_samples,
     }
@@ -51,18 +51,20 @@ def run_fit(
     rate: float,
     title: str,
 ) -> dict[str, Any]:
-    """Fit, then write ``trajectory.csv``, ``plot.png`` and ``summary.json`` into ``out``."""
+    """Fit, then write the plan directory ``out`` (trajectory, plot, summary)."""
     from skyquill.viz.fit_plot import plot_fit
 
-    out.mkdir(parents=True, exist_ok=True)
     with console.status(f"fitting {points.shape[0]} points ({title})"):
         fit = fit_points(points, times, options)
-    rows = write_trajectory_csv(out / "trajectory.csv", fit.result.trajectory, rate)
-    write_spline_json(out / "trajectory.json", fit.result.trajectory)
-    with console.status("plotting"):
-        plot_fit(fit, out / "plot.png", title)
-    summary = fit_summary(fit, rows, rate)
-    write_json(out / "summary.json", summary)
+    with console.status("writing and checking the plan"):
+        summary = write_plan(
+            out,
+            [PlannedTrajectory(fit.result.trajectory.in_3d(), limits=fit.limits)],
+            rate=rate,
+            guaranteed=True,
+            summary=fit_summary(fit, rate),
+            plot=lambda path: plot_fit(fit, path, title),
+        )
     console.print(
         f"[green]done[/] {out}: duration {summary['duration_s']:.2f} s, solve "
         f"{1e3 * summary['solve_time_s']:.1f} ms, max excess {summary['max_excess']:.1e}, "

@@ -9,11 +9,11 @@ import typer
 
 from skyquill.cli.main import OutDir, app, console, parse_vector3, positive_rate, user_errors
 from skyquill.errors import InputError
-from skyquill.io.points import write_json
+from skyquill.io.atomic import write_json
 
 if TYPE_CHECKING:  # the fly command imports the simulator lazily
-    from skyquill.trajectory import SampledTrajectory
     from skyquill.sim import Disturbances, Flight, OuterLoop
+    from skyquill.trajectory import SampledTrajectory
 
 FLY_CONTROLLERS = ("rpt", "pid-ff", "pid", "se3")
 FLY_SIMS = ("skyquill", "rotorpy")

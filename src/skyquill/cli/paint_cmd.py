@@ -65,7 +65,7 @@ def paint(
     """Paint DOTS.csv (or a stippled --image) on a wall; write summary.json, painted.csv, plot."""
     import numpy as np
 
-    from skyquill.io.points import write_json
+    from skyquill.io.atomic import write_json
     from skyquill.painting.dots import drawing_span
     from skyquill.painting.mission import MissionConfig, run_mission
     from skyquill.painting.wall import Placement, Wall, parse_angles

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import Annotated, Any
 
@@ -11,8 +10,9 @@ import typer
 
 from skyquill.cli.main import OutDir, app, console, positive_rate, user_errors
 from skyquill.errors import InputError
-from skyquill.io.points import write_json, write_trajectory_csv
-from skyquill.io.spline_json import write_spline_json
+from skyquill.io.atomic import write_json
+from skyquill.io.plan_dir import trajectory_names, write_plan
+from skyquill.io.trajectory_json import PlannedTrajectory
 
 
 def load_input(
@@ -114,22 +114,18 @@ def _board_kind(name: str, fly: bool) -> Any:
 
 
 def write_outputs(show: Any, out: Path, rate: float, fly: bool) -> dict[str, Any]:
-    """Trajectory CSVs, ``input_strokes.json``, ``plot.png`` and ``summary.json``."""
+    """The plan directory: trajectories, ``input_strokes.json``, ``plot.png``, ``summary.json``."""
     from skyquill.viz.writing_plot import plot_missions
 
-    out.mkdir(parents=True, exist_ok=True)
     missions = list(show.missions)
+    names = trajectory_names(len(missions))
     per_drone = []
+    planned = []
     strokes_json: list[Any] = []
-    for i, mission in enumerate(missions):
-        name = "trajectory.csv" if len(missions) == 1 else f"trajectory_{i}.csv"
+    for mission, (name, _) in zip(missions, names, strict=True):
         vehicle = mission.vehicle_trajectory()
-        write_trajectory_csv(out / name, vehicle, rate, pen=mission.pen)
-        write_spline_json(
-            out / name.replace(".csv", ".json"),
-            vehicle,
-            pen_windows_s=[list(w) for w in mission.pen_windows],
-        )
+        limits = mission.fit.problem.limits
+        planned.append(PlannedTrajectory(vehicle, tuple(mission.pen_windows), limits))
         strokes_json.append([(s + mission.brush_offset).tolist() for s in mission.strokes_world])
         per_drone.append(_drone_summary(mission, name, fly, vehicle))
     firsts = np.cumsum([0] + [len(s) for s in strokes_json]).tolist()
@@ -139,12 +135,17 @@ def write_outputs(show: Any, out: Path, rate: float, fly: bool) -> dict[str, Any
         # Drone i wrote strokes[first[i]:first[i + 1]] (its trajectory_<i>.csv).
         "first_stroke_of_drone": firsts,
     }
-    (out / "input_strokes.json").write_text(json.dumps(payload) + "\n", encoding="utf-8")
-    plot_missions(missions, out / "plot.png", "skyquill write")
+    out.mkdir(parents=True, exist_ok=True)
+    write_json(out / "input_strokes.json", payload, indent=None)
     closest = show.min_separation_m if len(missions) > 1 else None
-    summary = _merge(per_drone) | {"min_separation_m": closest, "drones": per_drone}
-    write_json(out / "summary.json", summary)
-    return summary
+    return write_plan(
+        out,
+        planned,
+        rate=rate,
+        guaranteed=True,
+        summary=_merge(per_drone) | {"min_separation_m": closest, "drones": per_drone},
+        plot=lambda path: plot_missions(missions, path, "skyquill write"),
+    )
 
 
 def _drone_summary(mission: Any, name: str, fly: bool, vehicle: Any) -> dict[str, Any]:

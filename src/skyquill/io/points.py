@@ -8,11 +8,9 @@ trajectories are written with ``z = 0``.
 from __future__ import annotations
 
 import csv
-import json
 import math
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
@@ -107,8 +105,3 @@ def write_table_csv(path: str | Path, table: FloatArray, pen: FloatArray | None 
         columns += ["yaw", "pen"]
     np.savetxt(path, table, delimiter=",", header=",".join(columns), comments="", fmt="%.9g")
     return int(table.shape[0])
-
-
-def write_json(path: str | Path, data: dict[str, Any]) -> None:
-    """Write ``data`` as indented JSON (NaN is refused: it is not JSON)."""
-    Path(path).write_text(json.dumps(data, indent=2, allow_nan=False) + "\n", encoding="utf-8")

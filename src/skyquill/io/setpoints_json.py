@@ -23,9 +23,10 @@ from typing import Any
 import numpy as np
 
 from skyquill.errors import InputError
-from skyquill.io.points import TRAJECTORY_COLUMNS, trajectory_table, write_json
-from skyquill.trajectory.sampled import MIN_STEP_S, SampledTrajectory
+from skyquill.io.atomic import write_json
+from skyquill.io.points import TRAJECTORY_COLUMNS, trajectory_table
 from skyquill.trajectory import Trajectory
+from skyquill.trajectory.sampled import MIN_STEP_S, SampledTrajectory
 from skyquill.validation import as_float
 
 #: The frame string every file carries.

@@ -46,7 +46,7 @@ from typing import Any
 import numpy as np
 
 from skyquill.errors import InputError
-from skyquill.trajectory import SplineTrajectory
+from skyquill.trajectory import PiecewisePolynomial, SplineTrajectory
 from skyquill.validation import FloatArray, as_array, as_float
 
 #: Longest Bézier segment Skybrush accepts, s.
@@ -385,3 +385,47 @@ def validate_show(show: Any) -> None:
         settings = _obj(f"{where}.settings", _obj(where, drone).get("settings"))
         _vec3(f"{where}.settings.home", settings.get("home"))
         _check_trajectory(f"{where}.settings.trajectory", settings.get("trajectory"))
+
+
+def show_trajectories(show: dict[str, Any]) -> list[PiecewisePolynomial]:
+    """The drones' trajectories of a validated ``show.json`` (Skybrush's own reading).
+
+    Each segment ending at keyframe ``i`` is a Bézier curve from keyframe
+    ``i - 1`` to ``i`` through its inner control points (none: a straight
+    line; one: quadratic; two: cubic), in show time from the first keyframe.
+
+    Returns
+    -------
+    list of PiecewisePolynomial
+        One per drone, its clock starting at its first keyframe, z-up, m.
+    """
+    out = []
+    for drone in show["swarm"]["drones"]:
+        points = drone["settings"]["trajectory"]["points"]
+        times = np.array([float(p[0]) for p in points])
+        pieces = []
+        for prev, point in zip(points[:-1], points[1:], strict=True):
+            ctrl = np.array([prev[1], *point[2], point[1]], dtype=float)
+            pieces.append(_bezier_power(ctrl, float(point[0]) - float(prev[0])))
+        if not pieces:  # a drone that only hovers: one still piece
+            pieces.append(np.array([points[0][1]], dtype=float))
+            times = np.array([0.0, 1e-3]) + times[0]
+        width = max(p.shape[0] for p in pieces)
+        coeffs = np.zeros((len(pieces), width, 3))
+        for i, piece in enumerate(pieces):
+            coeffs[i, : piece.shape[0]] = piece
+        out.append(PiecewisePolynomial(times - times[0], coeffs))
+    return out
+
+
+def _bezier_power(ctrl: FloatArray, duration: float) -> FloatArray:
+    """Power-basis coefficients in local time (lowest first) of a Bézier curve, shape (n+1, 3)."""
+    n = ctrl.shape[0] - 1
+    # B(s) = sum_j s^j sum_i (-1)^(j-i) C(n, j) C(j, i) P_i, and s = tau / duration.
+    coeffs = np.zeros_like(ctrl)
+    for j in range(n + 1):
+        for i in range(j + 1):
+            sign = (-1) ** (j - i)
+            coeffs[j] += sign * math.comb(n, j) * math.comb(j, i) * ctrl[i]
+        coeffs[j] /= duration**j
+    return coeffs

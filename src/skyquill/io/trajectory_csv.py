@@ -47,6 +47,7 @@ FLIGHT_COLUMNS = (
     "tilt",
 )
 
+
 def read_trajectory_csv(path: str | Path) -> SampledTrajectory:
     """Read a ``trajectory.csv`` (as written by ``skyquill fit``) into a trajectory.
 

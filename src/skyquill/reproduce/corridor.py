@@ -120,8 +120,8 @@ import numpy as np
 
 from skyquill.errors import InfeasibleError, InputError
 from skyquill.geometry import polyline_distance
+from skyquill.io.atomic import write_json
 from skyquill.io.corridor import BoxCorridor, load_box_corridor
-from skyquill.io.points import write_json
 from skyquill.limits import BoxLimit, CylinderLimit, DerivativeLimit
 from skyquill.optimize import Boundary, Corridor, FitResult, SmoothingProblem, solve
 from skyquill.optimize.timing import allocate_segment_times, segment_chain_terms

@@ -90,7 +90,8 @@ from typing import Any
 import numpy as np
 
 from skyquill.geometry import polyline_distance
-from skyquill.io.points import read_points_csv, write_json
+from skyquill.io.atomic import write_json
+from skyquill.io.points import read_points_csv
 from skyquill.optimize import Boundary, PointDeviation, SmoothingProblem, solve
 from skyquill.optimize.problem import Deviation
 from skyquill.optimize.timing import allocate_segment_times, segment_chain_terms

@@ -57,9 +57,11 @@ def _encode_spline(traj: SplineTrajectory) -> dict[str, Any]:
 
 
 def _decode_spline(data: dict[str, Any], depth: int) -> Trajectory:
-    return SplineTrajectory(
-        _array(data, "control_points"), data.get("degree"), data.get("duration_s")
-    )  # type: ignore[arg-type]
+    ctrl = _array(data, "control_points")
+    # SplineTrajectory validates degree and duration, naming them.
+    degree: Any = data.get("degree")
+    duration: Any = data.get("duration_s")
+    return SplineTrajectory(ctrl, degree, duration)
 
 
 def _encode_polynomial(traj: PiecewisePolynomial) -> dict[str, Any]:
@@ -94,15 +96,11 @@ def _decode_retimed(data: dict[str, Any], depth: int) -> Trajectory:
     degree = curve.get("degree")
     if not isinstance(degree, int) or not 1 <= degree <= 7:
         raise InputError(f"trajectory 'retimed', curve degree: got {degree!r}, expected 1 to 7")
-    if (
-        knots.ndim != 1
-        or coefficients.ndim != 2
-        or knots.size != coefficients.shape[0] + degree + 1
-    ):
+    n_coef = coefficients.shape[0] if coefficients.ndim == 2 else -1
+    if knots.ndim != 1 or knots.size != n_coef + degree + 1 or np.any(np.diff(knots) < 0):
         raise InputError(
-            f"trajectory 'retimed', curve: got {knots.size} knots for "
-            f"{n_coef} coefficients (rows) of degree "
-            f"{degree}, expected coefficients + degree + 1 knots"
+            f"trajectory 'retimed', curve: got {knots.size} knots for {n_coef} coefficient rows "
+            f"of degree {degree}, expected rows + degree + 1 non-decreasing knots"
         )
     spline = BSpline(knots, coefficients, degree)
     poly = _decode_polynomial({"kind": "retimed timing", **timing}, depth)

@@ -57,6 +57,14 @@ class SplineTrajectory:
         """Number of axes ``d``."""
         return int(self.control_points.shape[1])
 
+    def in_3d(self, z: float = 0.0) -> SplineTrajectory:
+        """This spline with 3 axes: a 2-D one at height ``z`` (exact: partition of unity)."""
+        if self.dim == 3:
+            return self
+        ctrl = self.control_points
+        lifted = np.column_stack([ctrl, np.full((ctrl.shape[0], 3 - self.dim), z)])
+        return SplineTrajectory(lifted, self.degree, self.duration)
+
     @cached_property
     def basis(self) -> ClampedUniformBasis:
         """The basis in the normalised parameter ``s`` (shared cache)."""

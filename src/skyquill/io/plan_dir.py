@@ -1,0 +1,200 @@
+"""The plan directory: what every planning command writes and ``fly``/``export`` read.
+
+One writer for ``fit``, ``write``, ``cover`` and ``paint``:
+
+* ``trajectory.csv`` (``trajectory_<i>.csv`` for several drones): samples in
+  the shared columns :data:`~skyquill.io.points.TRAJECTORY_COLUMNS` plus
+  ``yaw`` and ``pen``;
+* ``trajectory.json`` (``trajectory_<i>.json``): the exact trajectory, naming
+  its kind (:mod:`skyquill.io.trajectory_json`);
+* ``summary.json``: the command's own fields plus ``plan``: the files per drone
+  and the dense check of each trajectory *as read back from the file written*
+  (what is verified is what is delivered), and the largest difference between
+  the CSV's samples and the exact trajectory;
+* ``plot.png`` when the command draws one.
+
+Every file is written atomically (:mod:`skyquill.io.atomic`).
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from skyquill.errors import InputError
+from skyquill.io.atomic import atomic_path, write_json
+from skyquill.io.points import write_table_csv
+from skyquill.io.trajectory_csv import read_trajectory_csv
+from skyquill.io.trajectory_json import (
+    PlannedTrajectory,
+    read_trajectory_json,
+    write_trajectory_json,
+)
+from skyquill.trajectory import SampledTrajectory, Trajectory, sample
+from skyquill.verify import verify
+
+PLAN_FORMAT = "skyquill-plan"
+
+
+def trajectory_names(count: int) -> list[tuple[str, str]]:
+    """``(csv, json)`` file names for ``count`` drones."""
+    if count == 1:
+        return [("trajectory.csv", "trajectory.json")]
+    return [(f"trajectory_{i}.csv", f"trajectory_{i}.json") for i in range(count)]
+
+
+def write_plan(
+    out: Path,
+    planned: Sequence[PlannedTrajectory],
+    *,
+    rate: float,
+    guaranteed: bool,
+    summary: dict[str, Any],
+    plot: Callable[[Path], None] | None = None,
+) -> dict[str, Any]:
+    """Write the plan directory ``out`` and return the ``summary.json`` written.
+
+    Parameters
+    ----------
+    out
+        The directory; created if missing.
+    planned
+        One trajectory per drone, each 3-D (z-up world frame), with the limits
+        it was planned for: they are checked densely on what was written.
+    rate
+        Sample rate of the CSV files, Hz.
+    guaranteed
+        Whether the planner guarantees them (hull constraints) or only
+        approximates them (the coverage speed LP).
+    summary
+        The command's own summary fields.
+    plot
+        Draws ``plot.png`` to the path it is given.
+    """
+    if not planned:
+        raise InputError("planned: got no trajectory, expected at least one")
+    for i, p in enumerate(planned):
+        if p.trajectory.dim != 3:
+            raise InputError(f"planned[{i}]: got {p.trajectory.dim} axes, expected 3 (x, y, z)")
+    out.mkdir(parents=True, exist_ok=True)
+    drones = [
+        _write_drone(out, names, p, rate, guaranteed)
+        for names, p in zip(trajectory_names(len(planned)), planned, strict=True)
+    ]
+    if plot is not None:
+        with atomic_path(out / "plot.png") as tmp:
+            plot(tmp)
+    full = summary | {
+        "plan": {
+            "format": PLAN_FORMAT,
+            "version": 1,
+            "rate_hz": rate,
+            "limits_guaranteed": guaranteed,
+            "max_excess": max(d["verification"]["max_excess"] for d in drones),
+            "drones": drones,
+        }
+    }
+    write_json(out / "summary.json", full)
+    return full
+
+
+def _write_drone(
+    out: Path,
+    names: tuple[str, str],
+    planned: PlannedTrajectory,
+    rate: float,
+    guaranteed: bool,
+) -> dict[str, Any]:
+    csv_name, json_name = names
+    write_trajectory_json(out / json_name, planned)
+    s = sample(planned.trajectory, rate)
+    table = np.column_stack([s.t, s.p, s.v, s.a, s.j])
+    with atomic_path(out / csv_name) as tmp:
+        rows = write_table_csv(tmp, table, pen=planned.pen(s.t))
+    back = read_trajectory_json(out / json_name)
+    exact = back.trajectory
+    written = read_trajectory_csv(out / csv_name)
+    check = verify(exact, back.limits, guaranteed=guaranteed)
+    return {
+        "csv": csv_name,
+        "json": json_name,
+        "kind": _kind(exact),
+        "duration_s": exact.duration,
+        "rows": rows,
+        "verification": {
+            "n_samples": check.n_samples,
+            "max_speed": check.max_speed,
+            "max_acc": list(check.max_acc),
+            "max_jerk": list(check.max_jerk),
+            "max_excess": check.max_excess,
+            "limits": check.limits_report(),
+            "csv_max_difference_m": _csv_difference(written, exact),
+        },
+    }
+
+
+def _kind(traj: Trajectory) -> str:
+    from skyquill.trajectory.codec import encode
+
+    return str(encode(traj)["kind"])
+
+
+def _csv_difference(written: SampledTrajectory, exact: Trajectory) -> float:
+    """Largest distance between the CSV's positions and the exact trajectory at its times, m."""
+    t = np.clip(written.t - written.t0, 0.0, exact.duration)
+    return float(np.linalg.norm(written.p - exact.evaluate(t), axis=1).max())
+
+
+def read_plan(path: Path) -> list[tuple[str, PlannedTrajectory]]:
+    """The trajectories of a plan directory or of one file, named, in drone order.
+
+    Parameters
+    ----------
+    path
+        A plan directory (its ``summary.json`` names the files; a directory
+        without one is searched for ``trajectory.json`` or
+        ``trajectory_<i>.json``), a ``trajectory.json`` or a ``trajectory.csv``.
+    """
+    if path.is_file():
+        if path.suffix.lower() == ".csv":
+            return [(path.stem, PlannedTrajectory(read_trajectory_csv(path)))]
+        return [(path.stem, read_trajectory_json(path))]
+    if not path.is_dir():
+        raise InputError(f"plan: got {str(path)!r}, expected a plan directory or a trajectory file")
+    files = _listed(path) or _found(path)
+    if not files:
+        raise InputError(
+            f"plan: got {str(path)!r} without trajectory.json or trajectory_<i>.json, expected "
+            "the output directory of fit, write, cover or paint"
+        )
+    return [(f.stem, read_trajectory_json(f)) for f in files]
+
+
+def _listed(directory: Path) -> list[Path]:
+    """The JSON files ``summary.json`` names (the plan the directory holds now)."""
+    summary = directory / "summary.json"
+    if not summary.is_file():
+        return []
+    try:
+        plan = json.loads(summary.read_text(encoding="utf-8")).get("plan")
+    except (json.JSONDecodeError, UnicodeDecodeError, AttributeError, RecursionError):
+        raise InputError(f"{summary}: got a damaged summary, expected skyquill's JSON") from None
+    if not isinstance(plan, dict) or plan.get("format") != PLAN_FORMAT:
+        return []
+    names = [d.get("json") for d in plan.get("drones", []) if isinstance(d, dict)]
+    files = [n for n in names if isinstance(n, str) and Path(n).name == n and n.endswith(".json")]
+    if not files or len(files) != len(names):
+        raise InputError(f"{summary}: got drone entries without file names, expected them")
+    return [directory / n for n in files]
+
+
+def _found(directory: Path) -> list[Path]:
+    single = directory / "trajectory.json"
+    if single.is_file():
+        return [single]
+    numbered = [p for p in directory.glob("trajectory_*.json") if p.stem[11:].isdigit()]
+    return sorted(numbered, key=lambda p: int(p.stem[11:]))

@@ -1,0 +1,158 @@
+"""``trajectory.json``: the exact trajectory of a plan, whatever its kind, for exporters.
+
+``trajectory.csv`` is sampled; exporters that can be exact (Crazyswarm
+polynomials, Bézier shows) and the verification of what was written need the
+trajectory itself::
+
+    {"format": "skyquill-trajectory", "version": 2,
+     "frame": "world, z up, m, s",
+     "trajectory": {"kind": "bspline" | "polynomial" | "retimed" | "sequence" | "sampled", ...},
+     "pen_windows_s": [[t0, t1], ...],
+     "limits": [{"type": "BoxLimit" | "CylinderLimit" | ..., <its fields>}, ...]}
+
+(:mod:`skyquill.trajectory.codec` gives each kind's fields.) Version 1 files,
+``{"format": "skyquill-bspline", "degree", "duration_s", "control_points"}``,
+are still read.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from skyquill.errors import InputError
+from skyquill.io.atomic import write_text
+from skyquill.limits import BoxLimit, CylinderLimit, DerivativeLimit
+from skyquill.trajectory import Trajectory
+from skyquill.trajectory.codec import decode, encode
+from skyquill.validation import as_array
+
+FORMAT = "skyquill-trajectory"
+VERSION = 2
+LEGACY_FORMAT = "skyquill-bspline"
+#: Largest file read, bytes: a 10 ha coverage flight is ~20 MB.
+MAX_BYTES = 500_000_000
+
+
+@dataclass(frozen=True)
+class PlannedTrajectory:
+    """A trajectory and when its pen (brush, spray, light) is down.
+
+    Attributes
+    ----------
+    trajectory
+        Any trajectory kind, z-up world frame.
+    pen_windows_s
+        ``(start, end)`` times in s when the pen is down, in order; empty when
+        the task has no pen.
+    limits
+        The limits it was planned for (an exporter that must refit it keeps
+        them).
+    """
+
+    trajectory: Trajectory
+    pen_windows_s: tuple[tuple[float, float], ...] = ()
+    limits: tuple[DerivativeLimit, ...] = ()
+
+    def pen(self, t: Any) -> Any:
+        """1.0 where the pen is down at times ``t`` (N,), else 0.0."""
+        times = np.asarray(t, dtype=float)
+        down = np.zeros(times.size)
+        for start, end in self.pen_windows_s:
+            down[(times >= start) & (times <= end)] = 1.0
+        return down
+
+
+def write_trajectory_json(path: str | Path, planned: PlannedTrajectory) -> None:
+    """Write ``planned`` to ``path`` atomically."""
+    data = {
+        "format": FORMAT,
+        "version": VERSION,
+        "frame": "world, z up, m, s",
+        "trajectory": encode(planned.trajectory),
+        "pen_windows_s": [list(w) for w in planned.pen_windows_s],
+        "limits": [_encode_limit(lim) for lim in planned.limits],
+    }
+    write_text(path, json.dumps(data, allow_nan=False) + "\n")
+
+
+def read_trajectory_json(path: str | Path) -> PlannedTrajectory:
+    """Read a ``trajectory.json`` (either version).
+
+    Raises
+    ------
+    InputError
+        Naming the file and what is wrong: missing, too large, not UTF-8 JSON,
+        nested too deep, another format, or a malformed trajectory.
+    """
+    file = Path(path)
+    if not file.is_file():
+        raise InputError(f"trajectory file: got {str(file)!r}, expected an existing JSON file")
+    size = file.stat().st_size
+    if size > MAX_BYTES:
+        raise InputError(f"{file.name}: got {size:,} bytes, expected at most {MAX_BYTES:,}")
+    try:
+        data = json.loads(file.read_bytes().decode("utf-8"))
+    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+        raise InputError(f"{file.name}: got invalid JSON ({exc}), expected {FORMAT}") from None
+    except RecursionError:
+        raise InputError(f"{file.name}: got JSON nested too deeply, expected {FORMAT}") from None
+    try:
+        return _planned(data)
+    except InputError as exc:
+        raise InputError(f"{file.name}: {exc}") from None
+
+
+def _planned(data: object) -> PlannedTrajectory:
+    if not isinstance(data, dict):
+        raise InputError(f"got a JSON {type(data).__name__}, expected an object")
+    if data.get("format") == LEGACY_FORMAT:
+        return PlannedTrajectory(decode({"kind": "bspline", **data}), _windows(data))
+    if data.get("format") != FORMAT:
+        raise InputError(f"got format {data.get('format')!r}, expected {FORMAT!r}")
+    limits = data.get("limits", [])
+    if not isinstance(limits, list):
+        raise InputError(f"limits: got a JSON {type(limits).__name__}, expected a list")
+    return PlannedTrajectory(
+        decode(data.get("trajectory")),
+        _windows(data),
+        tuple(_decode_limit(item) for item in limits),
+    )
+
+
+#: The limit shapes ``trajectory.json`` stores, by class name.
+LIMIT_TYPES: dict[str, type] = {cls.__name__: cls for cls in (BoxLimit, CylinderLimit)}
+
+
+def _encode_limit(limit: DerivativeLimit) -> dict[str, Any]:
+    fields = {f.name: getattr(limit, f.name) for f in dataclasses.fields(limit) if f.init}
+    plain = {k: v.tolist() if isinstance(v, np.ndarray) else v for k, v in fields.items()}
+    return {"type": type(limit).__name__, **plain}
+
+
+def _decode_limit(data: object) -> DerivativeLimit:
+    if not isinstance(data, dict) or data.get("type") not in LIMIT_TYPES:
+        got = data.get("type") if isinstance(data, dict) else type(data).__name__
+        raise InputError(f"limits: got {got!r}, expected one of {sorted(LIMIT_TYPES)}")
+    cls = LIMIT_TYPES[data["type"]]
+    names = {f.name for f in dataclasses.fields(cls) if f.init}
+    try:
+        limit: DerivativeLimit = cls(**{k: v for k, v in data.items() if k in names})
+    except TypeError:
+        raise InputError(f"limits: got fields {sorted(data)}, expected {sorted(names)}") from None
+    return limit
+
+
+def _windows(data: dict[str, Any]) -> tuple[tuple[float, float], ...]:
+    raw = data.get("pen_windows_s", [])
+    if isinstance(raw, list) and not raw:
+        return ()
+    windows = as_array("pen_windows_s", raw, shape=(None, 2))
+    if np.any(windows[:, 1] < windows[:, 0]) or np.any(windows[1:, 0] < windows[:-1, 1]):
+        raise InputError("pen_windows_s: got overlapping or reversed windows, expected in order")
+    return tuple((float(a), float(b)) for a, b in windows)
