@@ -182,9 +182,10 @@ def write(tmp_path: Path, text: str) -> Path:
 @pytest.mark.parametrize(
     ("text", "match"),
     [
-        ("", r"empty file, expected the header 'duration,x\^0"),
-        ("t,x,y\n" + row(), r"line 1: got header 't,x,y', expected the header 'duration,x\^0"),
-        (HEADER + "\n", "no pieces after the header"),
+        ("", r"bad.csv: got an empty file, expected a header line with columns duration,x\^0"),
+        ("t,x,y\n" + row(), r"bad.csv: got columns \['t', 'x', 'y'\], expected columns dura"),
+        (HEADER + ",note\n" + row() + ",1", "bad.csv: got unknown column.s. 'note', expected only"),
+        (HEADER + "\n", r"bad.csv: got 0 data row\(s\), expected at least 1"),
         (HEADER + "\n" + row() + "\n0.5,1,2\n", "line 3: got 3 columns, expected 33"),
         (HEADER + "\n" + row(cell="abc"), "line 2, column x\\^0: got 'abc', expected a number"),
         (HEADER + "\n" + row(cell="nan"), "line 2, column x\\^0: got 'nan', expected a finite"),
@@ -200,7 +201,7 @@ def test_read_rejects_bad_files(tmp_path: Path, text: str, match: str) -> None:
 
 
 def test_read_rejects_missing_file_and_empty_list(tmp_path: Path) -> None:
-    with pytest.raises(InputError, match=r"nope\.csv: no such file"):
+    with pytest.raises(InputError, match=r"crazyswarm file: got '.*nope\.csv', expected an exis"):
         read_crazyswarm(tmp_path / "nope.csv")
     with pytest.raises(InputError, match="path: got an empty sequence"):
         read_crazyswarm([])

@@ -36,7 +36,7 @@ def test_csv_extra_columns_and_order(tmp_path: Path) -> None:
         ("x,y\n0,1\n", r"d.csv: got columns \['x', 'y'\], expected columns x,z .* missing z"),
         ("x,z\n0,nan\n", r"d.csv line 2, column z: got 'nan', expected a finite number"),
         ("x,z\n0,1\nq,1\n", r"d.csv line 3, column x: got 'q', expected a number"),
-        ("x,z\n0\n", r"d.csv line 2, column z: got '', expected a number"),
+        ("x,z\n0\n", r"d.csv line 2: got 1 columns, expected 2"),
     ],
 )
 def test_csv_errors(tmp_path: Path, text: str, match: str) -> None:

@@ -24,7 +24,6 @@ split into several consecutive uploads, and :class:`CrazyswarmExport` says so.
 
 from __future__ import annotations
 
-import csv
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -34,7 +33,7 @@ from typing import Literal
 import numpy as np
 
 from skyquill.errors import InputError
-from skyquill.io.points import parse_cell
+from skyquill.io.table import read_table
 from skyquill.trajectory import PiecewisePolynomial, SplineTrajectory
 from skyquill.validation import FloatArray, as_float, as_int
 
@@ -203,47 +202,16 @@ def write_crazyswarm(
 
 
 def _read_table(path: Path) -> FloatArray:
-    name = str(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise InputError(f"{name}: no such file, expected a Crazyswarm CSV") from None
-    except IsADirectoryError:
-        raise InputError(f"{name}: is a directory, expected a Crazyswarm CSV file") from None
-    except UnicodeDecodeError:
-        raise InputError(f"{name}: not UTF-8 text, expected a Crazyswarm CSV") from None
-    except OSError as exc:
-        raise InputError(f"{name}: cannot be read ({exc.strerror})") from None
-    reader = csv.reader(text.splitlines())
-    try:
-        header = next(reader, None)
-        if header is None:
-            raise InputError(f"{name}: empty file, expected the header {HEADER!r}")
-        if [c.strip().lower() for c in header] != list(COLUMNS):
-            shown = ",".join(header)
-            shown = shown if len(shown) <= 80 else shown[:77] + "..."
-            raise InputError(f"{name} line 1: got header {shown!r}, expected the header {HEADER!r}")
-        rows: list[list[float]] = []
-        for row in reader:
-            line = reader.line_num
-            if not any(cell.strip() for cell in row):
-                continue  # blank line
-            if len(row) != len(COLUMNS):
-                raise InputError(
-                    f"{name} line {line}: got {len(row)} columns, expected {len(COLUMNS)}"
-                )
-            values = [parse_cell(name, line, col, row, i) for i, col in enumerate(COLUMNS)]
-            if values[0] <= 0.0:
-                raise InputError(
-                    f"{name} line {line}, column duration: got {values[0]:g}, "
-                    "expected a duration > 0 s"
-                )
-            rows.append(values)
-    except csv.Error as exc:
-        raise InputError(f"{name} line {reader.line_num}: malformed CSV ({exc})") from None
-    if not rows:
-        raise InputError(f"{name}: no pieces after the header, expected at least one row")
-    return np.array(rows, dtype=float)
+    """The pieces of one file, shape (P, 33), columns :data:`COLUMNS`; durations > 0."""
+    table = read_table(path, required=COLUMNS, unknown="refuse", min_rows=1, name="crazyswarm file")
+    durations = table.column("duration")
+    if np.any(durations <= 0.0):
+        r = int(np.argmax(durations <= 0.0))
+        raise InputError(
+            f"{table.name} line {table.lines[r]}, column duration: got {durations[r]:g}, "
+            "expected a duration > 0 s"
+        )
+    return table.data
 
 
 def read_crazyswarm(path: str | Path | Sequence[str | Path]) -> PiecewisePolynomial:
@@ -264,10 +232,12 @@ def read_crazyswarm(path: str | Path | Sequence[str | Path]) -> PiecewisePolynom
     Raises
     ------
     InputError
-        Missing or unreadable file, wrong header (the message gives the
-        expected one), a line with the wrong number of columns, a non-numeric,
-        NaN or infinite cell, a duration <= 0 (each naming file and line), or
-        piece durations that do not add up to increasing times.
+        Whatever :func:`~skyquill.io.table.read_table` refuses (missing or
+        unreadable file, a missing, repeated or unknown column -- the header
+        must hold exactly :data:`COLUMNS`, in any order and case --, a line
+        with the wrong number of columns, a non-numeric, NaN or infinite cell,
+        no rows), a duration <= 0 (naming file and line), or piece durations
+        that do not add up to increasing times.
     """
     paths = [Path(path)] if isinstance(path, str | Path) else [Path(p) for p in path]
     if not paths:

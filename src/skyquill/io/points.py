@@ -7,14 +7,12 @@ trajectories are written with ``z = 0``.
 
 from __future__ import annotations
 
-import csv
-import math
 from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
 
-from skyquill.errors import InputError
+from skyquill.io.table import read_table
 from skyquill.trajectory import Samples, Trajectory, sample
 from skyquill.validation import FloatArray
 
@@ -24,51 +22,23 @@ TRAJECTORY_COLUMNS = ("t", "x", "y", "z", "vx", "vy", "vz", "ax", "ay", "az", "j
 def read_points_csv(path: str | Path) -> tuple[FloatArray, FloatArray | None]:
     """Read ``x,y`` or ``x,y,z`` with an optional ``t`` column.
 
+    Parameters
+    ----------
+    path
+        CSV file read by :func:`~skyquill.io.table.read_table` (UTF-8, header names in
+        any order and case, other columns ignored), at least 2 rows.
+
     Returns
     -------
     points : numpy.ndarray, shape (N, 2) or (N, 3), m
     times : numpy.ndarray, shape (N,), s, or None when there is no ``t`` column
     """
-    file = Path(path)
-    if not file.is_file():
-        raise InputError(f"points file: got {str(file)!r}, expected an existing CSV file")
-    with file.open(newline="", encoding="utf-8") as handle:
-        reader = csv.reader(handle)
-        header = [h.strip().lower() for h in next(reader, [])]
-        rows = [row for row in reader if row and any(cell.strip() for cell in row)]
-    missing = [c for c in ("x", "y") if c not in header]
-    if missing:
-        raise InputError(
-            f"{file.name}: got columns {header}, expected columns x,y (optionally z and t); "
-            f"missing {','.join(missing)}"
-        )
-    columns = [c for c in ("x", "y", "z", "t") if c in header]
-    index = [header.index(c) for c in columns]
-    data = np.empty((len(rows), len(columns)))
-    for r, row in enumerate(rows):
-        for c, (name, i) in enumerate(zip(columns, index, strict=True)):
-            data[r, c] = parse_cell(file.name, r + 2, name, row, i)
-    if data.shape[0] < 2:
-        raise InputError(f"{file.name}: got {data.shape[0]} data row(s), expected at least 2")
-    has_t = columns[-1] == "t"
-    points = data[:, : len(columns) - has_t]
-    return points, (data[:, -1] if has_t else None)
-
-
-def parse_cell(name: str, line: int, column: str, row: list[str], i: int) -> float:
-    """Cell ``i`` of a CSV ``row`` as a finite float; InputError naming file, line, column."""
-    text = row[i].strip() if i < len(row) else ""
-    try:
-        value = float(text)
-    except ValueError:
-        raise InputError(
-            f"{name} line {line}, column {column}: got {text!r}, expected a number"
-        ) from None
-    if not math.isfinite(value):
-        raise InputError(
-            f"{name} line {line}, column {column}: got {text!r}, expected a finite number"
-        )
-    return value
+    table = read_table(
+        path, required=("x", "y"), optional=("z", "t"), min_rows=2, name="points file"
+    )
+    axes = ["x", "y"] + (["z"] if table.has("z") else [])
+    times = table.column("t") if table.has("t") else None
+    return table.select(axes), times
 
 
 def trajectory_table(traj: Trajectory, rate: float) -> FloatArray:

@@ -35,6 +35,7 @@ reported in :class:`SkycExport`.
 
 from __future__ import annotations
 
+import itertools
 import json
 import math
 import zipfile
@@ -404,7 +405,7 @@ def show_trajectories(show: dict[str, Any]) -> list[PiecewisePolynomial]:
         points = drone["settings"]["trajectory"]["points"]
         times = np.array([float(p[0]) for p in points])
         pieces = []
-        for prev, point in zip(points[:-1], points[1:], strict=True):
+        for prev, point in itertools.pairwise(points):
             ctrl = np.array([prev[1], *point[2], point[1]], dtype=float)
             pieces.append(_bezier_power(ctrl, float(point[0]) - float(prev[0])))
         if not pieces:  # a drone that only hovers: one still piece

@@ -10,13 +10,12 @@ writes the time series of a :class:`~skyquill.sim.Flight`.
 
 from __future__ import annotations
 
-import csv
 from pathlib import Path
 
 import numpy as np
 
 from skyquill.errors import InputError
-from skyquill.io.points import parse_cell
+from skyquill.io.table import Table, read_table
 from skyquill.sim.result import Flight
 from skyquill.trajectory.sampled import MAX_VALUE, MIN_STEP_S, SampledTrajectory
 from skyquill.validation import FloatArray
@@ -67,90 +66,53 @@ def read_trajectory_csv(path: str | Path) -> SampledTrajectory:
     Raises
     ------
     InputError
-        Naming the file, and the column or line, when the file is missing or
-        unreadable, a required column is missing, there are fewer than 2 rows,
-        a cell is not a finite number of magnitude at most 1e6, or the times
-        are not strictly increasing.
+        Naming the file, and the column or line, for everything
+        :func:`~skyquill.io.table.read_table` refuses (missing or unreadable
+        file, missing or repeated column, ragged row, a cell that is not a
+        finite number, fewer than 2 rows), a magnitude above 1e6 (1e7 for
+        ``t``), only some of ``jx,jy,jz``, or times not strictly increasing.
     """
-    file = Path(path)
-    if not file.is_file():
-        raise InputError(f"trajectory file: got {str(file)!r}, expected an existing CSV file")
-    name = file.name
-    header, rows = _read_rows(file)
-    _check_header(name, header)
-    has_jerk = any(c in header for c in JERK_COLUMNS)
-    if has_jerk and not all(c in header for c in JERK_COLUMNS):
-        present = [c for c in JERK_COLUMNS if c in header]
+    table = read_table(
+        path,
+        required=REQUIRED_COLUMNS,
+        optional=JERK_COLUMNS,
+        min_rows=2,
+        name="trajectory file",
+    )
+    present = [c for c in JERK_COLUMNS if table.has(c)]
+    if present and len(present) < len(JERK_COLUMNS):
         raise InputError(
-            f"{name}: got jerk column(s) {','.join(present)}, expected all of jx,jy,jz or none"
+            f"{table.name}: got jerk column(s) {','.join(present)}, expected all of jx,jy,jz "
+            "or none"
         )
-    columns = REQUIRED_COLUMNS + (JERK_COLUMNS if has_jerk else ())
-    index = [header.index(c) for c in columns]
-    data = np.empty((len(rows), len(columns)))
-    for r, (line, row) in enumerate(rows):
-        for c, (column, i) in enumerate(zip(columns, index, strict=True)):
-            data[r, c] = _cell(name, line, column, row, i)
-    if data.shape[0] < 2:
-        raise InputError(f"{name}: got {data.shape[0]} data row(s), expected at least 2")
-    t = data[:, 0]
+    _check_magnitudes(table)
+    t = table.column("t")
     steps = np.diff(t)
     if np.any(steps < MIN_STEP_S):
         k = int(np.argmax(steps < MIN_STEP_S))
         raise InputError(
-            f"{name} line {rows[k + 1][0]}, column t: got {t[k + 1]:.9g} after {t[k]:.9g}, "
-            f"expected strictly increasing times (at least {MIN_STEP_S:g} s apart)"
+            f"{table.name} line {table.lines[k + 1]}, column t: got {t[k + 1]:.9g} after "
+            f"{t[k]:.9g}, expected strictly increasing times (at least {MIN_STEP_S:g} s apart)"
         )
     return SampledTrajectory(
         t=t,
-        p=data[:, 1:4],
-        v=data[:, 4:7],
-        a=data[:, 7:10],
-        j=data[:, 10:13] if has_jerk else None,
+        p=table.select(REQUIRED_COLUMNS[1:4]),
+        v=table.select(REQUIRED_COLUMNS[4:7]),
+        a=table.select(REQUIRED_COLUMNS[7:10]),
+        j=table.select(JERK_COLUMNS) if present else None,
     )
 
 
-def _read_rows(file: Path) -> tuple[list[str], list[tuple[int, list[str]]]]:
-    """Header (stripped, lower case) and the non-blank rows with their line numbers."""
-    try:
-        with file.open(newline="", encoding="utf-8") as handle:
-            reader = csv.reader(handle)
-            header = [h.strip().lower() for h in next(reader, [])]
-            rows = [(reader.line_num, row) for row in reader if row and any(c.strip() for c in row)]
-    except UnicodeDecodeError as exc:
+def _check_magnitudes(table: Table) -> None:
+    """Times within 1e7 s, other values within :data:`MAX_VALUE`: SI units, no overflow."""
+    limits = np.array([1e7 if c == "t" else MAX_VALUE for c in table.columns])
+    over = np.abs(table.data) > limits
+    if np.any(over):
+        r, c = np.argwhere(over)[0]
         raise InputError(
-            f"{file.name}: got bytes that are not UTF-8 (byte {exc.start}), expected a text CSV"
-        ) from None
-    except csv.Error as exc:
-        raise InputError(f"{file.name}: got malformed CSV ({exc}), expected a text CSV") from None
-    return header, rows
-
-
-def _check_header(name: str, header: list[str]) -> None:
-    missing = [c for c in REQUIRED_COLUMNS if c not in header]
-    if missing:
-        raise InputError(
-            f"{name}: got columns {header}, expected at least {','.join(REQUIRED_COLUMNS)} "
-            f"(optionally jx,jy,jz); missing {','.join(missing)}"
+            f"{table.name} line {table.lines[r]}, column {table.columns[c]}: got "
+            f"{table.data[r, c]:.9g}, expected a magnitude of at most {limits[c]:g} (SI units)"
         )
-    repeated = sorted(
-        {c for c in header if c in REQUIRED_COLUMNS + JERK_COLUMNS and header.count(c) > 1}
-    )
-    if repeated:
-        raise InputError(
-            f"{name}: got column(s) {','.join(repeated)} more than once, expected each once"
-        )
-
-
-def _cell(name: str, line: int, column: str, row: list[str], i: int) -> float:
-    value = parse_cell(name, line, column, row, i)
-    text = row[i].strip()
-    limit = 1e7 if column == "t" else MAX_VALUE
-    if abs(value) > limit:
-        raise InputError(
-            f"{name} line {line}, column {column}: got {text!r}, expected a magnitude of at "
-            f"most {limit:g} (SI units)"
-        )
-    return value
 
 
 def flight_table(flight: Flight) -> FloatArray:

@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from skyquill.errors import InputError
-from skyquill.io.points import parse_cell
+from skyquill.io.table import read_table
 from skyquill.validation import FloatArray, as_array, as_int
 
 #: Longest side the picture is resampled to before stippling, px: enough for a few thousand
@@ -33,35 +33,15 @@ MAX_DOTS = 10_000
 def read_dots_csv(path: str | Path) -> FloatArray:
     """Read a dots CSV with columns ``x`` and ``z`` (m, wall frame; other columns ignored).
 
+    The file is read by :func:`~skyquill.io.table.read_table` (its refusals apply), at
+    most :data:`MAX_DOTS` rows.
+
     Returns
     -------
     numpy.ndarray, shape (N, 2), m
     """
-    file = Path(path)
-    if not file.is_file():
-        raise InputError(f"dots file: got {str(file)!r}, expected an existing CSV file")
-    try:
-        with file.open(newline="", encoding="utf-8") as handle:
-            reader = csv.reader(handle)
-            header = [h.strip().lower() for h in next(reader, [])]
-            rows = [row for row in reader if row and any(cell.strip() for cell in row)]
-    except (UnicodeDecodeError, csv.Error) as exc:
-        raise InputError(f"{file.name}: got unreadable text ({exc}), expected a CSV file") from None
-    missing = [c for c in ("x", "z") if c not in header]
-    if missing:
-        raise InputError(
-            f"{file.name}: got columns {header}, expected columns x,z (m, wall frame); "
-            f"missing {','.join(missing)}"
-        )
-    ix, iz = header.index("x"), header.index("z")
-    dots = np.array(
-        [
-            [parse_cell(file.name, r + 2, "x", row, ix), parse_cell(file.name, r + 2, "z", row, iz)]
-            for r, row in enumerate(rows)
-        ],
-        dtype=float,
-    ).reshape(-1, 2)
-    return check_dots(f"{file.name}", dots)
+    table = read_table(path, required=("x", "z"), max_rows=MAX_DOTS, name="dots file")
+    return check_dots(table.name, table.select(("x", "z")))
 
 
 def check_dots(name: str, dots: object) -> FloatArray:

@@ -1,0 +1,299 @@
+"""Read a numeric CSV table: one reader, one set of refusals, for every CSV skyquill takes.
+
+The first non-blank line is the header (names stripped and lower-cased, so ``" X "`` is
+``x``); every later non-blank line is a row with one cell per header column. The caller
+names the columns it needs (``required``), the ones it takes when present (``optional``)
+and whether other columns are ignored or refused; only those columns are parsed, as
+finite floats. Text is UTF-8, with or without the byte-order mark spreadsheets write.
+
+Everything else is an :class:`~skyquill.errors.InputError` naming the file (and the line
+and column where there is one): a missing file, bytes that are not UTF-8 (UTF-16, binary),
+an empty file, a repeated or missing column, an unknown column when refused, a row with
+the wrong number of cells, a cell that is not a finite number, or a file too large: more
+than :data:`MAX_BYTES` bytes (refused before reading), a line longer than
+:data:`MAX_LINE_CHARS` or more than :data:`MAX_ROWS` rows (refused as soon as the first
+character or row too many is read, so a huge file is never read whole).
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+from array import array
+from collections.abc import Iterator, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Literal, TextIO
+
+import numpy as np
+from numpy.typing import NDArray
+
+from skyquill.errors import InputError
+from skyquill.validation import FloatArray
+
+#: Most data rows one CSV may hold: 1,000,000 rows is 2.8 h of a 100 Hz trajectory and
+#: ~100 MB of text; a larger file is refused before it is read whole.
+MAX_ROWS = 1_000_000
+
+#: Largest file accepted, bytes (512 MiB): checked before anything is read.
+MAX_BYTES = 512 * 2**20
+#: Longest line accepted, characters: a file without line breaks is refused after this
+#: many characters instead of being read whole into one line.
+MAX_LINE_CHARS = 100_000
+
+#: What to do with columns that are neither required nor optional.
+Unknown = Literal["ignore", "refuse"]
+
+
+@dataclass(frozen=True)
+class Table:
+    """The numeric columns of a CSV file.
+
+    Attributes
+    ----------
+    name
+        The file's name, for messages (``"points.csv"``).
+    columns
+        The columns read, in the caller's order: every required column, then the optional
+        ones the file has.
+    data
+        Values, shape (N, len(columns)), finite floats in the file's units; read-only.
+    lines
+        Line number in the file of each row, shape (N,) (1 is the header's line when the
+        file starts with it), for messages about a row.
+    """
+
+    name: str
+    columns: tuple[str, ...]
+    data: FloatArray
+    lines: NDArray[np.int64]
+
+    @property
+    def n_rows(self) -> int:
+        """Number of data rows N."""
+        return int(self.data.shape[0])
+
+    def has(self, column: str) -> bool:
+        """Whether ``column`` was read (a required one, or an optional one present)."""
+        return column in self.columns
+
+    def column(self, column: str) -> FloatArray:
+        """The values of ``column``, shape (N,); InputError if it was not read."""
+        return self.select([column])[:, 0]
+
+    def select(self, columns: Sequence[str]) -> FloatArray:
+        """The values of ``columns`` in that order, shape (N, len(columns))."""
+        absent = [c for c in columns if c not in self.columns]
+        if absent:
+            raise InputError(
+                f"{self.name}: got no column(s) {','.join(absent)}, expected one of "
+                f"{','.join(self.columns)}"
+            )
+        return self.data[:, [self.columns.index(c) for c in columns]]
+
+
+def read_table(
+    path: str | Path,
+    *,
+    required: Sequence[str],
+    optional: Sequence[str] = (),
+    unknown: Unknown = "ignore",
+    min_rows: int = 0,
+    max_rows: int = MAX_ROWS,
+    name: str = "csv file",
+) -> Table:
+    """Read the numeric columns ``required`` (+ ``optional``) of the CSV file ``path``.
+
+    Parameters
+    ----------
+    path
+        The CSV file (UTF-8, an optional byte-order mark, ``,`` separated, a header line).
+    required
+        Lower-case column names the file must have.
+    optional
+        Lower-case column names read when the file has them.
+    unknown
+        ``"ignore"``: other columns are skipped (and may hold anything);
+        ``"refuse"``: another column is an error.
+    min_rows
+        Fewest data rows accepted.
+    max_rows
+        Most data rows accepted (default :data:`MAX_ROWS`).
+    name
+        What the file is to the caller (``"points file"``), for the message when it does
+        not exist; other messages name the file itself.
+
+    Returns
+    -------
+    Table
+        The columns read, shape (N, k), and each row's line number.
+
+    Raises
+    ------
+    InputError
+        See the module docstring; the message names the file and says what came and what
+        was expected.
+    """
+    file = Path(path)
+    if not file.is_file():
+        raise InputError(f"{name}: got {str(file)!r}, expected an existing CSV file")
+    wanted = _Wanted(tuple(required), tuple(optional), unknown)
+    try:
+        size = file.stat().st_size
+        if size > MAX_BYTES:
+            raise InputError(
+                f"{file.name}: got {size} bytes, expected at most {MAX_BYTES} "
+                f"({MAX_BYTES >> 20} MiB)"
+            )
+        with file.open(newline="", encoding="utf-8-sig") as handle:
+            return _parse(file.name, _lines(file.name, handle), wanted, min_rows, max_rows)
+    except UnicodeDecodeError as exc:
+        raise InputError(
+            f"{file.name}: got bytes that are not UTF-8 ({_describe_bytes(exc)}), "
+            "expected UTF-8 text (save the CSV as 'CSV UTF-8')"
+        ) from None
+    except OSError as exc:
+        raise InputError(
+            f"{file.name}: got a file that cannot be read ({exc.strerror}), expected a CSV file"
+        ) from None
+
+
+@dataclass(frozen=True)
+class _Wanted:
+    required: tuple[str, ...]
+    optional: tuple[str, ...]
+    unknown: Unknown
+
+    def describe(self) -> str:
+        """The expected columns, in words."""
+        text = f"columns {','.join(self.required)}"
+        notes = []
+        if self.optional:
+            notes.append(f"optionally {','.join(self.optional)}")
+        if self.unknown == "ignore":
+            notes.append("other columns ignored")
+        return text + (f" ({'; '.join(notes)})" if notes else "")
+
+
+def _parse(name: str, text: Iterator[str], wanted: _Wanted, min_rows: int, max_rows: int) -> Table:
+    """Header, then the rows; stops at the first refusal."""
+    reader = csv.reader(text)
+    values: array[float] = array("d")
+    lines: array[int] = array("q")
+    try:
+        rows = _non_blank(name, reader)
+        header = next(rows, None)
+        if header is None:
+            raise InputError(
+                f"{name}: got an empty file, expected a header line with {wanted.describe()}"
+            )
+        header = [h.strip().lower() for h in header]
+        columns = _check_header(name, header, wanted)
+        index = [(c, header.index(c)) for c in columns]
+        for row in rows:
+            line = reader.line_num
+            _check_row(f"{name} line {line}", len(row), len(header), len(lines), max_rows)
+            values.extend(parse_cell(name, line, c, row, i) for c, i in index)
+            lines.append(line)
+    except csv.Error as exc:
+        raise InputError(
+            f"{name} line {reader.line_num}: got malformed CSV ({exc}), expected a CSV table"
+        ) from None
+    if len(lines) < min_rows:
+        raise InputError(f"{name}: got {len(lines)} data row(s), expected at least {min_rows}")
+    return Table(name, columns, _frozen(values, (len(lines), len(columns))), _frozen(lines))
+
+
+def _check_row(where: str, cells: int, columns: int, rows_before: int, max_rows: int) -> None:
+    """Refuse a row beyond ``max_rows`` or with another number of cells than the header."""
+    if rows_before == max_rows:
+        raise InputError(
+            f"{where}: got more than {max_rows} data rows, expected at most {max_rows}"
+        )
+    if cells != columns:
+        raise InputError(
+            f"{where}: got {cells} columns, expected {columns} (one per header column)"
+        )
+
+
+def _frozen(values: array[Any], shape: tuple[int, ...] | None = None) -> Any:
+    """A read-only NumPy copy of ``values`` (float or int64), reshaped to ``shape``."""
+    out = np.array(values)
+    if shape is not None:
+        out = out.reshape(shape)
+    out.setflags(write=False)
+    return out
+
+
+def _lines(name: str, handle: TextIO) -> Iterator[str]:
+    """The lines of ``handle``, each read with a length limit (:data:`MAX_LINE_CHARS`)."""
+    while line := handle.readline(MAX_LINE_CHARS + 1):
+        if len(line) > MAX_LINE_CHARS:
+            raise InputError(
+                f"{name}: got a line longer than {MAX_LINE_CHARS} characters, expected CSV "
+                "lines (is this a CSV file?)"
+            )
+        yield line
+
+
+def _non_blank(name: str, reader: Iterator[list[str]]) -> Iterator[list[str]]:
+    """The rows with at least one non-blank cell; a NUL character is refused."""
+    for row in reader:
+        if any("\x00" in cell for cell in row):
+            raise InputError(
+                f"{name}: got a NUL character (binary data or UTF-16 text), expected UTF-8 text"
+            )
+        if any(cell.strip() for cell in row):
+            yield row
+
+
+def _check_header(name: str, header: list[str], wanted: _Wanted) -> tuple[str, ...]:
+    """The columns to read, in the caller's order; InputError for a header that will not do."""
+    repeated = sorted({c for c in header if header.count(c) > 1})
+    if repeated:
+        raise InputError(
+            f"{name}: got column(s) {','.join(repeated)} more than once, expected each column once"
+        )
+    missing = [c for c in wanted.required if c not in header]
+    if missing:
+        raise InputError(
+            f"{name}: got columns {header}, expected {wanted.describe()}; "
+            f"missing {','.join(missing)}"
+        )
+    known = wanted.required + wanted.optional
+    extra = [c for c in header if c not in known]
+    if extra and wanted.unknown == "refuse":
+        raise InputError(
+            f"{name}: got unknown column(s) {','.join(map(repr, extra))}, expected only "
+            f"{','.join(known)}"
+        )
+    return wanted.required + tuple(c for c in wanted.optional if c in header)
+
+
+def parse_cell(name: str, line: int, column: str, row: Sequence[str], i: int) -> float:
+    """Cell ``i`` of a CSV ``row`` as a finite float; InputError naming file, line, column."""
+    text = row[i].strip() if i < len(row) else ""
+    try:
+        value = float(text)
+    except ValueError:
+        raise InputError(
+            f"{name} line {line}, column {column}: got {_shorten(text)!r}, expected a number"
+        ) from None
+    if not math.isfinite(value):
+        raise InputError(
+            f"{name} line {line}, column {column}: got {_shorten(text)!r}, expected a finite number"
+        )
+    return value
+
+
+def _shorten(text: str, limit: int = 40) -> str:
+    return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+def _describe_bytes(exc: UnicodeDecodeError) -> str:
+    """What the undecodable bytes look like: a UTF-16 byte-order mark, or where they are."""
+    head = exc.object[:2]
+    if head in (b"\xff\xfe", b"\xfe\xff"):
+        return "a UTF-16 byte-order mark"
+    bad = exc.object[exc.start : exc.start + 4].hex(" ")
+    return f"byte(s) {bad} where text was expected"
