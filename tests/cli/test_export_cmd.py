@@ -84,7 +84,7 @@ def test_bad_input(tmp_path: Path, fitted: Path) -> None:
     broken = tmp_path / "nan"
     broken.mkdir()
     data = json.loads((fitted / "trajectory.json").read_text())
-    data["control_points"][3][0] = float("nan")
+    data["trajectory"]["control_points"][3][0] = float("nan")
     (broken / "trajectory.json").write_text(json.dumps(data))
     result = runner.invoke(app, ["export", str(broken), "--out", str(tmp_path / "x.csv")])
     assert result.exit_code == 2 and "NaN" in " ".join(result.output.split())
@@ -92,9 +92,8 @@ def test_bad_input(tmp_path: Path, fitted: Path) -> None:
 
 def test_crazyswarm_round_trip_flies_in_the_simulator(fitted: Path, tmp_path: Path) -> None:
     """Import the (split) Crazyswarm upload and fly it: the same trajectory, the same limits."""
-    from skyquill.io.spline_json import read_spline_json
-
     from skyquill.io.crazyswarm import read_crazyswarm
+    from skyquill.io.trajectory_json import read_trajectory_json
     from skyquill.sim import simulate
 
     runner.invoke(
@@ -102,7 +101,7 @@ def test_crazyswarm_round_trip_flies_in_the_simulator(fitted: Path, tmp_path: Pa
     )
     files = json.loads((tmp_path / "cf.summary.json").read_text())["files"]
     imported = read_crazyswarm([Path(f) for f in files])
-    original = read_spline_json(fitted / "trajectory.json")
+    original = read_trajectory_json(fitted / "trajectory.json").trajectory
     t = np.linspace(0.0, original.duration, 3000)
     for order in range(4):
         assert np.allclose(

@@ -148,7 +148,7 @@ def test_bad_files_exit_2_with_one_message(tmp_path: Path) -> None:
     bad.write_text("t,x,y,z\n0,0,0,0\n1,1,1,1\n", encoding="utf-8")
     for path, message in (
         (bad, "points.csv: got columns ['t', 'x', 'y', 'z'], expected columns t,x,y,z,vx"),
-        (tmp_path / "absent.csv", "trajectory file: got"),
+        (tmp_path / "absent.csv", "plan: got"),
     ):
         result = runner.invoke(app, ["fly", str(path), "--out", str(tmp_path / "o")])
         assert result.exit_code == 2

@@ -1,19 +1,20 @@
-"""``skyquill fly``: fly a trajectory.csv in closed loop, write flight.csv, plot, summary."""
+"""``skyquill fly``: fly a plan in closed loop, write flight.csv, plot, summary."""
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated, Literal
+from typing import TYPE_CHECKING, Annotated, Any, Literal
 
 import typer
 
 from skyquill.cli.main import OutDir, app, console, parse_vector3, positive_rate, user_errors
 from skyquill.errors import InputError
-from skyquill.io.atomic import write_json
+from skyquill.io.atomic import atomic_path, write_json
 
 if TYPE_CHECKING:  # the fly command imports the simulator lazily
     from skyquill.sim import Disturbances, Flight, OuterLoop
-    from skyquill.trajectory import SampledTrajectory
+    from skyquill.trajectory import Trajectory
 
 FLY_CONTROLLERS = ("rpt", "pid-ff", "pid", "se3")
 FLY_SIMS = ("skyquill", "rotorpy")
@@ -23,10 +24,12 @@ MAX_WIND_MPS = 100.0
 
 @app.command()
 def fly(
-    trajectory_csv: Annotated[
+    plan: Annotated[
         Path,
         typer.Argument(
-            help="trajectory.csv as `fit` writes it: t,x,y,z,vx,vy,vz,ax,ay,az[,jx,jy,jz], SI."
+            metavar="PLAN",
+            help="A plan directory (fit, write, cover, paint), its trajectory.json, or a "
+            "trajectory.csv (t,x,y,z,vx,vy,vz,ax,ay,az[,jx,jy,jz], SI).",
         ),
     ],
     out: OutDir,
@@ -42,13 +45,11 @@ def fly(
     seed: Annotated[int, typer.Option(help="Seed of the random generator (gusts, noise).")] = 0,
     rate: Annotated[float, typer.Option(help="Control and integration rate, Hz.")] = 500.0,
 ) -> None:
-    """Fly TRAJECTORY_CSV in closed loop; write summary.json, flight.csv and plot.png."""
+    """Fly every trajectory of PLAN in closed loop; write summary.json, flight.csv, plot.png."""
     import numpy as np
 
-    from skyquill.errors import SolverError
-    from skyquill.io.trajectory_csv import read_trajectory_csv, write_flight_csv
+    from skyquill.io.plan_dir import read_plan
     from skyquill.sim import Disturbances
-    from skyquill.viz.flight_plot import plot_flight
 
     with user_errors():
         if sim not in FLY_SIMS:
@@ -63,33 +64,18 @@ def fly(
             if not 0.0 <= value <= most:
                 raise InputError(f"{option}: got {value:g}, expected a number from 0 to {most:g}")
         rate = positive_rate(rate)
-        trajectory = read_trajectory_csv(trajectory_csv)
+        plans = read_plan(plan)
         disturbances = Disturbances(wind_mps=wind_mps, gust_std_mps=gust, position_noise_m=noise)
-        with console.status(
-            f"flying {trajectory.duration:.1f} s of {trajectory_csv.name} with "
-            f"{controller} on {sim} at {rate:g} Hz"
-        ):
-            flight = _fly_once(trajectory, loop, sim, disturbances, seed, rate)
-        if not (np.all(np.isfinite(flight.p)) and np.all(np.isfinite(flight.v))):
-            raise SolverError(
-                f"{sim}: the flight diverged (non-finite state), nothing written; "
-                "lower the disturbances"
-            )
-        out.mkdir(parents=True, exist_ok=True)
-        rows = write_flight_csv(out / "flight.csv", flight)
-        with console.status("plotting"):
-            plot_flight(flight, out / "plot.png", trajectory_csv.name)
-        summary = flight.summary()
-        summary |= {
-            "realtime_factor": summary["sim_time_s"] / max(flight.wall_time_s, 1e-12),
-            "trajectory": str(trajectory_csv),
-            "duration_s": trajectory.duration,
+        setup = _Setup(loop, sim, disturbances, seed, rate)
+        flights = [_fly_drone(name, p.trajectory, setup, out, len(plans) > 1) for name, p in plans]
+        summary = _worst(flights) | {
+            "plan": str(plan),
             "rate_hz": rate,
             "wind_mps": [float(w) for w in wind_mps],
             "gust_std_mps": gust,
             "position_noise_m": noise,
             "seed": seed,
-            "flight_rows": rows,
+            "drones": flights,
         }
         write_json(out / "summary.json", summary)
     console.print(
@@ -97,6 +83,59 @@ def fly(
         f"{1e3 * summary['max_error_m']:.2f} mm, {summary['realtime_factor']:.0f}x real time",
         highlight=False,
     )
+
+
+@dataclass(frozen=True)
+class _Setup:
+    loop: OuterLoop | Literal["se3"]
+    sim: str
+    disturbances: Disturbances
+    seed: int
+    rate: float
+
+
+def _fly_drone(
+    name: str, trajectory: Trajectory, setup: _Setup, out: Path, several: bool
+) -> dict[str, Any]:
+    """Fly one trajectory; write its flight CSV and plot; its summary entry."""
+    import numpy as np
+
+    from skyquill.errors import SolverError
+    from skyquill.io.trajectory_csv import write_flight_csv
+    from skyquill.viz.flight_plot import plot_flight
+
+    with console.status(
+        f"flying {trajectory.duration:.1f} s of {name} on {setup.sim} at {setup.rate:g} Hz"
+    ):
+        flight = _fly_once(trajectory, setup)
+    if not (np.all(np.isfinite(flight.p)) and np.all(np.isfinite(flight.v))):
+        raise SolverError(
+            f"{setup.sim}: the flight of {name} diverged (non-finite state), nothing written; "
+            "lower the disturbances"
+        )
+    out.mkdir(parents=True, exist_ok=True)
+    suffix = f"_{name}" if several else ""
+    with atomic_path(out / f"flight{suffix}.csv") as tmp:
+        rows = write_flight_csv(tmp, flight)
+    with console.status("plotting"), atomic_path(out / f"plot{suffix}.png") as tmp:
+        plot_flight(flight, tmp, name)
+    summary = flight.summary()
+    return summary | {
+        "name": name,
+        "realtime_factor": summary["sim_time_s"] / max(flight.wall_time_s, 1e-12),
+        "duration_s": trajectory.duration,
+        "flight_rows": rows,
+    }
+
+
+def _worst(flights: list[dict[str, Any]]) -> dict[str, Any]:
+    """The summary's top level: the worst drone by RMSE, the slowest simulation."""
+    worst = max(flights, key=lambda f: f["rmse_m"])
+    top = {k: v for k, v in worst.items() if k != "name"}
+    return top | {
+        "realtime_factor": min(f["realtime_factor"] for f in flights),
+        "flight_rows": sum(f["flight_rows"] for f in flights),
+    }
 
 
 def _fly_controller(name: str, sim: str) -> OuterLoop | Literal["se3"]:
@@ -117,19 +156,19 @@ def _fly_controller(name: str, sim: str) -> OuterLoop | Literal["se3"]:
     return RPTController() if name == "rpt" else CascadePID(feed_forward=name == "pid-ff")
 
 
-def _fly_once(
-    trajectory: SampledTrajectory,
-    loop: OuterLoop | Literal["se3"],
-    sim: str,
-    disturbances: Disturbances,
-    seed: int,
-    rate: float,
-) -> Flight:
+def _fly_once(trajectory: Trajectory, setup: _Setup) -> Flight:
     """One flight on the chosen simulator (RotorPy imported only when asked for)."""
     import numpy as np
 
     from skyquill.sim import simulate
 
+    loop, sim, disturbances, seed, rate = (
+        setup.loop,
+        setup.sim,
+        setup.disturbances,
+        setup.seed,
+        setup.rate,
+    )
     if sim == "skyquill":
         if isinstance(loop, str):  # _fly_controller refuses se3 here; this narrows the type
             raise InputError("--controller: got 'se3', expected rpt, pid-ff or pid")

@@ -26,9 +26,7 @@ class SkycExporter:
         fitted = [as_spline(p.trajectory, p.limits) for _, p in plans]
         show = write_skyc([f.spline for f in fitted], out.with_suffix(".skyc"))
         back = show_trajectories(read_show_json(show.path))
-        error = max(
-            max_distance(p.trajectory, b) for (_, p), b in zip(plans, back, strict=True)
-        )
+        error = max(max_distance(p.trajectory, b) for (_, p), b in zip(plans, back, strict=True))
         refit = max(f.max_deviation_m for f in fitted)
         return ExportReport(
             self.name,

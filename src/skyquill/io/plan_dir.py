@@ -114,7 +114,8 @@ def _write_drone(
     s = sample(planned.trajectory, rate)
     table = np.column_stack([s.t, s.p, s.v, s.a, s.j])
     with atomic_path(out / csv_name) as tmp:
-        rows = write_table_csv(tmp, table, pen=planned.pen(s.t))
+        pen = planned.pen(s.t) if planned.pen_windows_s else None  # a fit has no pen
+        rows = write_table_csv(tmp, table, pen=pen)
     back = read_trajectory_json(out / json_name)
     exact = back.trajectory
     written = read_trajectory_csv(out / csv_name)

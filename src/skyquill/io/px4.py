@@ -28,7 +28,8 @@ import numpy as np
 
 from skyquill.errors import InputError
 from skyquill.io.points import trajectory_table
-from skyquill.trajectory import Trajectory
+from skyquill.io.table import read_table
+from skyquill.trajectory import SampledTrajectory, Trajectory
 from skyquill.validation import FloatArray, as_float
 
 #: PX4 leaves offboard mode when setpoints arrive slower than 2 Hz.
@@ -226,3 +227,16 @@ async def _stream(mavsdk: Any, offboard: Any, sp: Px4Setpoints, address: str) ->
     finally:
         await drone.offboard.stop()
     return sent
+
+
+def read_px4_csv(path: str | Path) -> SampledTrajectory:
+    """Read a setpoint CSV of :meth:`Px4Setpoints.to_csv` back into the z-up world frame.
+
+    The NED columns are turned back with the inverse of :func:`enu_to_ned`
+    (the same swap: ``(n, e, d) -> (e, n, -d)``), as PX4's own NED setpoints
+    would be read by a ground station working in ENU.
+    """
+    table = read_table(path, required=PX4_COLUMNS, min_rows=2, name="PX4 setpoint file")
+    values = [table.select(PX4_COLUMNS[i : i + 3]) for i in (1, 4, 7)]
+    t = table.column("t")
+    return SampledTrajectory(t, *(enu_to_ned(v) for v in values))

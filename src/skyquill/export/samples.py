@@ -1,0 +1,71 @@
+"""The sampled formats: ``trajectory.csv`` columns, setpoints JSON, PX4 NED setpoints.
+
+Each samples the trajectory at the requested rate, writes, reads the file back
+with its reader (for PX4 with the NED-to-ENU conversion a consumer applies)
+and measures the distance of that read-back from the plan.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+from skyquill.export.base import ExportOptions, ExportReport, NamedPlan, max_distance, target
+from skyquill.io.points import write_trajectory_csv
+from skyquill.io.px4 import px4_setpoints, read_px4_csv
+from skyquill.io.setpoints_json import read_setpoints_json, write_setpoints_json
+from skyquill.io.trajectory_csv import read_trajectory_csv
+from skyquill.trajectory import SampledTrajectory, Trajectory
+
+
+def _write_csv(traj: Trajectory, path: Path, rate: float) -> SampledTrajectory:
+    write_trajectory_csv(path, traj, rate)
+    return read_trajectory_csv(path)
+
+
+def _write_json(traj: Trajectory, path: Path, rate: float) -> SampledTrajectory:
+    write_setpoints_json(traj, path, rate)
+    return read_setpoints_json(path).trajectory
+
+
+def _write_px4(traj: Trajectory, path: Path, rate: float) -> SampledTrajectory:
+    px4_setpoints(traj, rate_hz=rate).to_csv(path)
+    return read_px4_csv(path)
+
+
+@dataclass(frozen=True)
+class SampledExporter:
+    """A format that holds samples: one file per drone, read back by its own reader."""
+
+    name: str
+    suffix: str
+    help: str
+    write: Callable[[Trajectory, Path, float], SampledTrajectory]
+
+    def __call__(
+        self, plans: Sequence[NamedPlan], out: Path, options: ExportOptions
+    ) -> ExportReport:
+        """Write each drone's samples, read them back, compare with the plan."""
+        files, error = [], 0.0
+        for name, planned in plans:
+            path = target(out, name, len(plans) > 1, self.suffix)
+            back = self.write(planned.trajectory, path, options.rate_hz)
+            error = max(error, max_distance(planned.trajectory, back))
+            files.append(path)
+        return ExportReport(
+            self.name,
+            tuple(files),
+            exact=False,
+            max_error_m=error,
+            message=f"wrote {len(files)} {self.name} file(s) at {options.rate_hz:g} Hz: "
+            + ", ".join(f.name for f in files),
+            details={"rate_hz": options.rate_hz},
+        )
+
+
+CSV = SampledExporter("csv", ".csv", "trajectory.csv columns (t, x..jz), z-up, SI", _write_csv)
+JSON = SampledExporter("json", ".json", "setpoints JSON (rows of t, x..jz), z-up, SI", _write_json)
+PX4 = SampledExporter(
+    "px4", ".csv", "PX4 offboard setpoints CSV in NED, yaw in degrees", _write_px4
+)
