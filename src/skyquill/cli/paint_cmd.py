@@ -1,7 +1,8 @@
 """``skyquill paint``: a simulated dot-painting mission on a wall (paper 002).
 
-Writes ``summary.json``, ``painted.csv`` (per dot: reference and painted ``x, z``) and
-``plot.png`` into ``--out``.
+Writes a plan directory into ``--out``: ``painted.csv`` (per dot: reference and painted
+``x, z``), ``plot.png``, the flight's ``trajectory.csv``/``trajectory.json`` and
+``summary.json``.
 """
 
 from __future__ import annotations
@@ -65,8 +66,11 @@ def paint(
     """Paint DOTS.csv (or a stippled --image) on a wall; write summary.json, painted.csv, plot."""
     import numpy as np
 
-    from skyquill.io.atomic import write_json
+    from skyquill.io.atomic import atomic_path
+    from skyquill.io.plan_dir import write_plan
+    from skyquill.io.trajectory_json import PlannedTrajectory
     from skyquill.painting.dots import drawing_span
+    from skyquill.painting.flight import painting_flight
     from skyquill.painting.mission import MissionConfig, run_mission
     from skyquill.painting.wall import Placement, Wall, parse_angles
     from skyquill.viz.painting_plot import plot_mission
@@ -112,17 +116,26 @@ def paint(
                 progress=lambda done, total: bar.update(task, completed=done, total=total),
             )
         out.mkdir(parents=True, exist_ok=True)
-        _write_painted(out / "painted.csv", result)
-        with console.status("plotting"):
-            plot_mission(result, out / "plot.png", (dots_csv or image or Path("")).name)
-        summary = result.summary() | {
-            "source": str(dots_csv or image),
-            "seed": seed,
-            "order": order,
-            "gamma_deg": gamma,
-            "offset_m": [float(v) for v in delta],
-        }
-        write_json(out / "summary.json", summary)
+        with atomic_path(out / "painted.csv") as tmp:
+            _write_painted(tmp, result)
+        with console.status("timing the flight's legs, writing and checking the plan"):
+            flown = painting_flight(result)
+            write_plan(
+                out,
+                [PlannedTrajectory(flown.trajectory, flown.pen_windows_s, flown.limits)],
+                rate=100.0,
+                guaranteed=True,
+                summary=result.summary()
+                | {
+                    "source": str(dots_csv or image),
+                    "seed": seed,
+                    "order": order,
+                    "gamma_deg": gamma,
+                    "offset_m": [float(v) for v in delta],
+                    "trajectory_duration_s": flown.trajectory.duration,
+                },
+                plot=lambda path: plot_mission(result, path, (dots_csv or image or Path("")).name),
+            )
     console.print(
         f"[green]done[/] {out}: {result.painted.sum()} of {len(result.reference)} dots, RMSE "
         f"{100 * result.rmse_m:.2f} cm, max {100 * result.max_error_m:.2f} cm, "

@@ -207,6 +207,9 @@ class MissionConfig:
         Probability per approach of a false detection before the wall / of no detection.
     contact
         The bumper and IMU model.
+    max_acceleration_mps2, max_jerk_mps3
+        Norm limits of the flight's trajectory (:mod:`skyquill.painting.flight`): every
+        leg is a straight time-optimal move at its speed above within them.
     """
 
     waiting_distance_m: float = 0.6
@@ -222,6 +225,8 @@ class MissionConfig:
     false_contact_rate: float = 0.0
     missed_contact_rate: float = 0.0
     contact: ContactModel = field(default_factory=ContactModel)
+    max_acceleration_mps2: float = 1.0
+    max_jerk_mps3: float = 5.0
 
     def __post_init__(self) -> None:
         for name in (
@@ -231,6 +236,8 @@ class MissionConfig:
             "transit_speed_mps",
             "retreat_speed_mps",
             "battery_s",
+            "max_acceleration_mps2",
+            "max_jerk_mps3",
         ):
             as_float(name, getattr(self, name), positive=True)
         as_float("settle_s", self.settle_s, nonneg=True)
@@ -277,6 +284,11 @@ class MissionResult:
         True positions at each measured contact, shape (M, 3), m, ``R_w``.
     lines_rho
         The segment estimator's lines ``[a, b, x_lo, x_hi]`` in ``R_rho``, shape (L, 4).
+    path_w
+        The true path, shape (K + 1, 3), m, ``R_w``: home, then where each leg ends
+        (hover points, contacts, returns, home again).
+    leg_kinds
+        What each of the K legs is: ``"transit"``, ``"approach"`` or ``"retreat"``.
     """
 
     reference: FloatArray
@@ -300,6 +312,8 @@ class MissionResult:
     localization: str
     update: str
     transit_m: float
+    path_w: FloatArray
+    leg_kinds: tuple[str, ...]
 
     @property
     def painted(self) -> np.ndarray:
@@ -398,6 +412,13 @@ class _Flight:
         self.transit_m = 0.0
         self.landings = self.contacts = self.false_contacts = self.missed = self.unsafe = 0
         self.contacts_w: list[FloatArray] = []
+        # The true path, for the flight's trajectory: where each leg ends and what it is.
+        self.path_w: list[FloatArray] = [truth.to_w(np.zeros(3))]
+        self.leg_kinds: list[str] = []
+
+    def _reach(self, where_w: FloatArray, kind: str) -> None:
+        self.path_w.append(np.asarray(where_w, dtype=float).copy())
+        self.leg_kinds.append(kind)
 
     def fly(self, seconds: float) -> None:
         """Advance both clocks and the localization drift."""
@@ -413,6 +434,7 @@ class _Flight:
         self.transit_m += dist
         self.fly(dist / self.cfg.transit_speed_mps)
         self.pos_rho = to_rho.copy()
+        self._reach(self.truth.to_w(to_rho - self.drift), "transit")
 
     def land_if_needed(self, wait_rho: FloatArray) -> bool:
         """Land (and reset the drift) first if this dot would overrun the battery."""
@@ -464,6 +486,8 @@ class _Flight:
             return self._measure(start_w, u, stop), nan3
         if hit > travel_max:  # nothing within reach (or parallel): give up, come back
             self.fly(travel_max / cfg.approach_speed_mps + travel_max / cfg.retreat_speed_mps)
+            self._reach(np.array([*(start_w[:2] + travel_max * u), start_w[2]]), "approach")
+            self._reach(start_w, "retreat")
             return None, nan3
         hit = max(hit, 0.0)  # touched on the way in: painted where the path met the wall
         painted = np.array([*(start_w[:2] + hit * u), start_w[2]])
@@ -472,6 +496,8 @@ class _Flight:
         if not detected or (cfg.missed_contact_rate and rng.random() < cfg.missed_contact_rate):
             self.missed += 1  # the drone keeps pushing until the end of its travel
             self.fly(travel_max / cfg.approach_speed_mps + hit / cfg.retreat_speed_mps)
+            self._reach(painted, "approach")  # the wall stops it where it touches
+            self._reach(start_w, "retreat")
             return None, painted
         self.fly(delay)
         return self._measure(start_w, u, hit + squeeze), painted
@@ -485,6 +511,8 @@ class _Flight:
         believed = self.truth.to_rho(where_w) + self.drift  # the drift at the contact
         measured = believed + self.rng.normal(0.0, self.loc.noise_m, 3)
         self.fly(stop / self.cfg.retreat_speed_mps)
+        self._reach(where_w, "approach")
+        self._reach(start_w, "retreat")
         return measured
 
 
@@ -614,6 +642,8 @@ def run_mission(
         localization=loc.name,
         update=update if isinstance(est, SegmentEstimator) else "rigid",
         transit_m=flight.transit_m,
+        path_w=np.array(flight.path_w),
+        leg_kinds=tuple(flight.leg_kinds),
     )
 
 

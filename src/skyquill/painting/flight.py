@@ -1,0 +1,81 @@
+"""The trajectory of a painting mission's flight, for the plan directory.
+
+The mission model (:mod:`skyquill.painting.mission`) advances clocks; the path
+it records (home, hover points, contacts, returns, landings) is flown here as
+straight rest-to-rest legs, each time-optimal at its own speed (transit,
+approach, retreat) within the configured acceleration and jerk norms
+(:func:`skyquill.optimize.legs.stop_and_go`). The pen (the brush) is down at
+the end of every approach that reached the wall. The hover before each
+approach (``settle_s``) and the time on the ground between batteries are not
+in it: the mission's ``flight_time_s`` counts them, this trajectory does not.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from skyquill.limits import DerivativeLimit
+from skyquill.optimize.legs import LegLimits, stop_and_go
+from skyquill.painting.mission import MissionConfig, MissionResult
+from skyquill.trajectory import PiecewisePolynomial
+
+
+@dataclass(frozen=True)
+class PaintingFlight:
+    """The flown path as a trajectory.
+
+    Attributes
+    ----------
+    trajectory
+        Straight legs, at rest at every recorded point, world frame (x along the
+        wall, y towards it, z up), m.
+    pen_windows_s
+        When the brush touches the wall (each a single instant: the end of an
+        approach that touched), s.
+    limits
+        The norm limits it keeps (speed: the fastest leg).
+    """
+
+    trajectory: PiecewisePolynomial
+    pen_windows_s: tuple[tuple[float, float], ...]
+    limits: tuple[DerivativeLimit, ...]
+
+
+def painting_flight(result: MissionResult, config: MissionConfig | None = None) -> PaintingFlight:
+    """The trajectory of ``result``'s recorded path under ``config``'s speeds and limits."""
+    from skyquill.limits import vehicle_limits
+
+    cfg = config or MissionConfig()
+    speeds = {
+        "transit": cfg.transit_speed_mps,
+        "approach": cfg.approach_speed_mps,
+        "retreat": cfg.retreat_speed_mps,
+    }
+    legs = [
+        LegLimits(speeds[kind], cfg.max_acceleration_mps2, cfg.max_jerk_mps3)
+        for kind in result.leg_kinds
+    ]
+    flown = stop_and_go(result.path_w, legs)
+    touched = _touched(result)
+    windows = tuple(
+        (float(flown.arrivals[k + 1]),) * 2
+        for k, kind in enumerate(result.leg_kinds)
+        if kind == "approach" and touched[k]
+    )
+    # Straight legs: the speed, acceleration and jerk along each are the norms.
+    limits = vehicle_limits(
+        3, max(speeds.values()), cfg.max_acceleration_mps2, cfg.max_jerk_mps3, coupled_sides=None
+    )
+    return PaintingFlight(flown.trajectory, windows, limits)
+
+
+def _touched(result: MissionResult) -> list[bool]:
+    """Per leg: whether it ends at a contact with the wall (a painted or measured point)."""
+    marks = np.vstack([result.contacts_w, result.painted_w[np.isfinite(result.painted_w[:, 0])]])
+    ends = result.path_w[1:]
+    if marks.size == 0:
+        return [False] * len(ends)
+    gap = np.linalg.norm(ends[:, None, :] - marks[None, :, :], axis=2).min(axis=1)
+    return [bool(g < 1e-9) for g in gap]

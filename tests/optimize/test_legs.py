@@ -1,0 +1,66 @@
+"""Stop-and-go legs: Ruckig's profile as exact cubic pieces, rest at every waypoint."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from ruckig import InputParameter, Ruckig, Trajectory
+
+from skyquill.errors import InputError
+from skyquill.limits import vehicle_limits
+from skyquill.optimize.legs import LegLimits, leg_pieces, stop_and_go
+from skyquill.verify import verify
+
+
+def test_leg_matches_ruckig_and_the_s_curve_closed_form() -> None:
+    # 2 m at v 1, a 2, j 5: phases 0.4/0.1/0.4 accelerate, 1.1 cruise (the known S-curve).
+    durations, _ = leg_pieces(np.zeros(2), np.array([2.0, 0.0]), LegLimits(1.0, 2.0, 5.0))
+    assert durations.sum() == pytest.approx(2.9)
+    inp = InputParameter(1)
+    inp.current_position, inp.target_position = [0.0], [2.0]
+    inp.max_velocity, inp.max_acceleration, inp.max_jerk = [1.0], [2.0], [5.0]
+    ref = Trajectory(1)
+    Ruckig(1).calculate(inp, ref)
+    traj = stop_and_go(np.array([[0.0, 0.0], [2.0, 0.0]]), LegLimits(1.0, 2.0, 5.0)).trajectory
+    for t in np.linspace(0.0, 2.9, 37):
+        p, v, a = ref.at_time(float(t))
+        got = [traj.evaluate(np.array([t]), n)[0, 0] for n in range(3)]
+        np.testing.assert_allclose(got, [p[0], v[0], a[0]], atol=1e-9)
+
+
+def test_chain_rests_at_every_waypoint_inside_the_limits() -> None:
+    pts = np.array([[0.0, 0.0, 1.0], [3.0, 0.0, 1.0], [3.0, 2.0, 1.0], [3.0, 2.0, 1.0], [0, 0, 2]])
+    legs = stop_and_go(pts, LegLimits(1.5, 1.0, 3.0))
+    traj = legs.trajectory
+    np.testing.assert_allclose(traj.evaluate(legs.arrivals), pts, atol=1e-9)
+    at_break = traj.evaluate(traj.breaks)
+    gap = np.linalg.norm(at_break[:, None, :] - pts[None, :, :], axis=2).min(axis=1)
+    joins = traj.breaks[gap < 1e-9]
+    assert len(joins) >= 4
+    np.testing.assert_allclose(traj.evaluate(joins, 1), 0.0, atol=1e-9)
+    np.testing.assert_allclose(
+        traj.evaluate(np.array([0.0, traj.duration])), pts[[0, -1]], atol=1e-9
+    )
+    check = verify(traj, vehicle_limits(3, 1.5, 1.0, 3.0, coupled_sides=64))
+    assert check.max_speed <= 1.5 + 1e-9
+    assert np.linalg.norm(check.max_acc) <= 1.0 * np.sqrt(3) + 1e-9
+
+
+def test_per_axis_limits_along_a_diagonal() -> None:
+    lim = LegLimits(2.0, np.array([1.0, 1.0]), np.array([4.0, 4.0]), per_axis=True)
+    _, a, j = lim.along(np.array([1.0, 1.0]) / np.sqrt(2))
+    assert a == pytest.approx(np.sqrt(2)) and j == pytest.approx(4 * np.sqrt(2))
+    traj = stop_and_go(np.array([[0.0, 0.0], [5.0, 5.0]]), lim).trajectory
+    acc = traj.evaluate(np.linspace(0, traj.duration, 2001), 2)
+    assert np.abs(acc).max() <= 1.0 + 1e-9
+
+
+def test_bad_input() -> None:
+    with pytest.raises(InputError, match="waypoints: got 1 point"):
+        stop_and_go(np.zeros((1, 2)), LegLimits(1.0, 1.0, 1.0))
+    with pytest.raises(InputError, match="coincident"):
+        stop_and_go(np.zeros((3, 2)), LegLimits(1.0, 1.0, 1.0))
+    with pytest.raises(InputError, match="limits: got 1, expected one per leg"):
+        stop_and_go(np.eye(3)[:, :2], [LegLimits(1.0, 1.0, 1.0)])
+    with pytest.raises(InputError, match="vmax"):
+        stop_and_go(np.eye(2), LegLimits(-1.0, 1.0, 1.0))
