@@ -1,0 +1,119 @@
+"""Every planning command's output flies, exports to every format and reads back.
+
+For each bundled example and each command that plans, the test runs the
+command, then ``fly`` on its plan directory, then ``export`` to every format
+in the registry; each export is read back here with the format's own reader,
+independently of the exporter's own check, and compared with the plan's exact
+``trajectory.json``. The written ``trajectory.csv`` is checked densely (its
+own rows) by plain numpy: finite, and the speed at or below the limit.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from skyquill.cli.main import app
+from skyquill.export import EXPORTERS
+from skyquill.io.crazyswarm import read_crazyswarm
+from skyquill.io.px4 import read_px4_csv
+from skyquill.io.setpoints_json import read_setpoints_json
+from skyquill.io.skyc import read_show_json, show_trajectories
+from skyquill.io.trajectory_csv import read_trajectory_csv
+from skyquill.io.trajectory_json import read_trajectory_json
+from skyquill.trajectory import Trajectory
+
+runner = CliRunner()
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
+
+#: Each planning command on a bundled (or tiny) input: (name, args before --out, speed limit).
+PLANS: list[tuple[str, Callable[[Path], list[str]], float]] = [
+    ("fit-spiral", lambda _: ["fit", str(EXAMPLES / "spiral.csv"), "--vmax", "1.0"], 1.0),
+    (
+        "fit-segments",
+        lambda _: ["fit", str(EXAMPLES / "segments.csv"), "--timing", "segments", "--vmax", "1.5"],
+        1.5,
+    ),
+    ("write-text", lambda _: ["write", "Hi", "--size", "0.3", "--vmax", "1.0"], 1.0),
+    ("write-two-drones", lambda _: ["write", "一大", "--drones", "2", "--vmax", "1.0"], 1.0),
+    ("paint", lambda tmp: ["paint", str(_dots(tmp))], 0.5),
+]
+
+READERS: dict[str, Callable[[list[Path]], list[Trajectory]]] = {
+    "crazyswarm": lambda files: [read_crazyswarm(files)],
+    "skyc": lambda files: show_trajectories(read_show_json(files[0])),
+    "px4": lambda files: [read_px4_csv(f) for f in files],
+    "csv": lambda files: [read_trajectory_csv(f) for f in files],
+    "json": lambda files: [read_setpoints_json(f).trajectory for f in files],
+}
+#: Largest distance of a read-back export from the plan, m: exact formats to the float
+#: rounding of the files (Skybrush's cubic approximation: 1 mm); sampled formats to the
+#: Hermite interpolation between 100 Hz rows.
+TOLERANCE_M = {"crazyswarm": 1e-6, "skyc": 1.2e-3, "px4": 1e-3, "csv": 1e-3, "json": 1e-3}
+#: Refitting a trajectory that is not a B-spline (paint's straight legs) adds its deviation.
+REFIT_TOLERANCE_M = 0.02
+
+
+def _dots(tmp: Path) -> Path:
+    path = tmp / "dots.csv"
+    path.write_text("x,z\n0.2,1.0\n0.5,1.2\n0.8,1.0\n", encoding="utf-8")
+    return path
+
+
+def _distance(reference: Trajectory, back: Trajectory) -> float:
+    t = np.linspace(0.0, reference.duration, 4001)
+    return float(np.linalg.norm(reference.evaluate(t) - back.evaluate(t), axis=1).max())
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(("label", "args", "vmax"), PLANS, ids=[p[0] for p in PLANS])
+def test_plan_flies_exports_and_reads_back(
+    tmp_path: Path, label: str, args: Callable[[Path], list[str]], vmax: float
+) -> None:
+    plan = tmp_path / "plan"
+    result = runner.invoke(app, [*args(tmp_path), "--out", str(plan)])
+    assert result.exit_code == 0, result.output
+    summary = json.loads((plan / "summary.json").read_text())
+    drones = summary["plan"]["drones"]
+    exact = [read_trajectory_json(plan / d["json"]).trajectory for d in drones]
+
+    for entry in drones:  # the written CSV, checked by plain numpy
+        table = np.loadtxt(plan / entry["csv"], delimiter=",", skiprows=1, ndmin=2)
+        assert np.all(np.isfinite(table))
+        speed = np.linalg.norm(table[:, 4:7], axis=1)
+        assert speed.max() <= vmax * np.sqrt(3) * (1 + 1e-9)  # per-axis boxes until norms
+        assert entry["verification"]["csv_max_difference_m"] < 1e-6
+
+    flown = runner.invoke(app, ["fly", str(plan), "--out", str(tmp_path / "fly"), "--rate", "200"])
+    assert flown.exit_code == 0, flown.output
+    flight = json.loads((tmp_path / "fly" / "summary.json").read_text())
+    assert len(flight["drones"]) == len(drones) and flight["rmse_m"] < 0.05
+
+    for name in EXPORTERS:
+        out = tmp_path / "export" / f"{name}{EXPORTERS[name].suffix}"
+        done = runner.invoke(app, ["export", str(plan), "--format", name, "--out", str(out)])
+        assert done.exit_code == 0, done.output
+        report = json.loads(out.with_name(f"{out.stem}.summary.json").read_text())
+        files = [Path(f) for f in report["files"]]
+        backs = _by_drone(name, files, len(drones))
+        refit = report.get("refit_max_deviation_m", 0.0)
+        assert refit <= REFIT_TOLERANCE_M
+        for reference, back in zip(exact, backs, strict=True):
+            assert _distance(reference, back) <= TOLERANCE_M[name] + refit, name
+        assert report["max_error_m"] <= TOLERANCE_M[name] + refit
+
+
+def _by_drone(name: str, files: list[Path], drones: int) -> list[Trajectory]:
+    """One read-back trajectory per drone (Crazyswarm: each drone's upload parts together)."""
+    if name != "crazyswarm" or drones == 1:
+        backs = READERS[name](files)
+        return backs
+    groups: dict[str, list[Path]] = {}
+    for f in files:
+        groups.setdefault(f.stem.split("_part")[0], []).append(f)
+    return [read_crazyswarm(group) for group in groups.values()]
