@@ -135,7 +135,7 @@ def test_cubic_spline_curve_accepted() -> None:
         ({"grid": "auto"}, "grid"),
         ({"vmax": 0.0}, "vmax"),
         ({"vmax": -1.0}, "vmax"),
-        ({"n": 2}, "n must"),
+        ({"n": 2}, "^n: got"),
         ({"amax": [1.0, 2.0, 3.0]}, "amax"),
         ({"jmax": -1.0}, "jmax"),
         ({"chord_error": 0.0}, "chord_error"),
