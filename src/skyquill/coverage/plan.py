@@ -11,7 +11,7 @@ Three patterns, compared on equal terms (paper ``001_61beb0e01a19013a`` §4):
   corner, each leg time-optimal under the same limits (Ruckig).
 
 Concave regions are split into convex parts whose spirals (or zigzags) are
-joined into one path (:mod:`skyquill.coverage.decompose`, the paper's Fig. 5).
+joined into one path (:mod:`skyquill.coverage.joined`, the paper's Fig. 5).
 """
 
 from __future__ import annotations
@@ -215,14 +215,14 @@ def covering_waypoints(region: Polygon, options: CoverageOptions) -> FloatArray:
         if is_convex(region):
             rings = contours(region, w, options.contours, epsilon=eps)
             return spiral_control_points(rings, d, drift=options.drift)
-        from skyquill.coverage.decompose import multi_spiral_control_points
+        from skyquill.coverage.joined import multi_spiral_control_points
 
         return multi_spiral_control_points(region, eps * w, mode=options.contours, delta=d)
     # The sweep lines' spacing is the swath; epsilon < 1 packs them closer.
     if is_convex(region):
         stops = zigzag(region, eps * w, perimeter=options.perimeter)
     else:
-        from skyquill.coverage.decompose import multi_zigzag
+        from skyquill.coverage.joined import multi_zigzag
 
         stops = multi_zigzag(region, eps * w, perimeter=options.perimeter)
     return stops if options.pattern == "zigzag-stop" else with_corner_points(stops, d)
@@ -382,7 +382,7 @@ def _stop_between_parts(
     region: Polygon, opts: CoverageOptions
 ) -> tuple[FloatArray, FloatArray, _Timed]:
     """Each part's spiral timed on its own, the joins flown as stop-and-go legs."""
-    from skyquill.coverage.decompose import multi_spiral_pieces
+    from skyquill.coverage.joined import multi_spiral_pieces
 
     spirals, routes = multi_spiral_pieces(
         region, opts.epsilon * opts.width, mode=opts.contours, delta=opts.delta
