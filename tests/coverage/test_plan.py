@@ -162,3 +162,24 @@ def test_a_concave_spiral_too_tight_to_join_rests_between_its_parts() -> None:
     assert plan.coverage >= 0.97
     assert np.all(np.diff(plan.setpoints.t) > 0.0)
     assert float(shapely.distance(shapely.points(plan.path), region).max()) < 1e-6
+
+
+FINITE_REGIONS = {
+    "square": [[0, 0], [10, 0], [10, 10], [0, 10]],
+    "thin": [[0, 0], [30, 0], [30, 4], [0, 4]],
+    "triangle": [[0, 0], [20, 0], [8, 14]],
+    "L": [[0, 0], [20, 0], [20, 8], [8, 8], [8, 20], [0, 20]],
+    "hexagon": [[0, 0], [47, 0], [47, 15], [30, 30], [20, 18], [0, 30]],  # one reflex corner
+}
+
+
+@pytest.mark.parametrize("pattern", ["spiral", "zigzag"])
+@pytest.mark.parametrize("name", list(FINITE_REGIONS))
+def test_every_setpoint_is_finite(name: str, pattern: str) -> None:
+    # The last row (u = 1) had NaN acceleration and jerk on most regions.
+    region = region_from_vertices(FINITE_REGIONS[name])
+    options = CoverageOptions(width=2.0, vmax=3.0, amax=5.0, jmax=3.0, pattern=pattern)
+    sp = plan_coverage(region, options).setpoints
+    for x in (sp.t, sp.u, sp.p, sp.v, sp.a, sp.j):
+        assert np.all(np.isfinite(x)), name
+    assert np.all(np.abs(sp.a[-1]) <= 5.0 * 1.02) and np.all(np.abs(sp.j[-1]) <= 3.0 * 1.02)

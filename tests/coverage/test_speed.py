@@ -242,3 +242,17 @@ def test_uniform_grid_keeps_parameter() -> None:
     plan = plan_speed(_circle(), 1.0, 2.0, 3.0, n=101, grid="uniform")
     assert plan.grid == "uniform"
     assert np.allclose(plan.u, np.linspace(0.0, 1.0, 101))
+
+
+@pytest.mark.parametrize("n", [50, 99, 104])
+def test_last_setpoint_is_the_limit_at_the_end(n: int) -> None:
+    # For these n, h * (n - 1) rounds below 1: u = 1 fell off the profile spline
+    # and the last row's acceleration and jerk were NaN.
+    plan = plan_speed(_circle(), 1.0, 2.0, 3.0, n=n)
+    sp = plan.setpoints(plan.control_period / 10.0)
+    for x in (sp.t, sp.u, sp.p, sp.v, sp.a, sp.j):
+        assert np.all(np.isfinite(x))
+    # The end values continue the profile (left limits at u = 1), not zeros.
+    assert np.allclose(sp.a[-1], sp.a[-2], atol=0.01 * 2.0)
+    assert np.allclose(sp.j[-1], sp.j[-2], atol=0.01 * 3.0)
+    assert np.linalg.norm(sp.j[-1]) > 0.5

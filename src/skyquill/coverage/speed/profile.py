@@ -330,20 +330,23 @@ class SpeedPlan:
 
 def _profile_spline(sig: FloatArray, b: FloatArray, *, jerk: bool) -> BSpline:
     """Grid-profile interpolant: cubic in ``w = b**(3/4)`` (jerk limit), else linear in ``b``."""
-    return _w_spline(b, sig[1]) if jerk else make_interp_spline(sig, b, k=1)
+    return _w_spline(b) if jerk else make_interp_spline(sig, b, k=1)
 
 
-def _w_spline(b: FloatArray, h: float) -> BSpline:
-    """Cubic B-spline *quasi-interpolant* of ``w = b**(3/4)`` with the ``w_i`` as coefficients.
+def _w_spline(b: FloatArray) -> BSpline:
+    """Cubic B-spline *quasi-interpolant* of ``w = b**(3/4)`` on the uniform grid of ``[0, 1]``.
 
-    Odd reflection at the rest ends.  At the knots ``w''`` and ``w'`` are
-    exactly the discrete second/central differences and ``w''`` is linear in
-    between, so there is none of the ringing an interpolating spline shows at
-    the kinks of the optimal profile.
+    The ``w_i`` are the coefficients, with odd reflection at the rest ends.
+    At the knots ``w''`` and ``w'`` are exactly the discrete second/central
+    differences and ``w''`` is linear in between, so there is none of the
+    ringing an interpolating spline shows at the kinks of the optimal profile.
     """
     w = b**0.75
     coef = np.concatenate([[-w[1]], w, [-w[-2]]])
-    knots = h * (np.arange(b.size + 6, dtype=np.float64) - 3.0)
+    # Knots i / (n - 1), not i * h: the spline does not extrapolate, and
+    # h * (n - 1) can round to 1 - 1e-16, which put u = 1 outside the base
+    # interval (NaN acceleration and jerk in the last setpoint).
+    knots = (np.arange(b.size + 6, dtype=np.float64) - 3.0) / (b.size - 1)
     return BSpline(knots, coef, 3, extrapolate=False)
 
 
