@@ -7,6 +7,7 @@ from dataclasses import replace
 import numpy as np
 
 from skyquill.coverage.speed.curve import _derivs3
+from skyquill.coverage.speed.norms import limit_ratio
 from skyquill.coverage.speed.profile import SpeedPlan, _interval_times, _profile_spline
 from skyquill.coverage.speed.rows import _Bounds, _end_caps, _GridLP
 from skyquill.validation import FloatArray
@@ -136,7 +137,8 @@ def _interval_excess(plan: SpeedPlan) -> tuple[FloatArray, FloatArray, FloatArra
     differences) are evaluated on each interval at ``_SAMPLES`` points, or at
     least every ``control_period / 10`` of its traversal time (the default
     resolution of :meth:`SpeedPlan.verify`): the peaks at the kinks of the
-    jerk are narrow.
+    jerk are narrow.  Acceleration and jerk are measured against the limits
+    the caller asked for (per axis, or the norm), not the LP's polygon.
 
     Returns
     -------
@@ -153,11 +155,11 @@ def _interval_excess(plan: SpeedPlan) -> tuple[FloatArray, FloatArray, FloatArra
     ud, udd, uddd = plan._derivs(us)
     c1, c2, c3 = _derivs3(plan._path, us)
     speed = np.linalg.norm(c1, axis=1) * ud / plan.vmax
-    acc = np.max(np.abs(c2 * (ud**2)[:, None] + c1 * udd[:, None]) / plan.amax, axis=1)
+    acc = limit_ratio(c2 * (ud**2)[:, None] + c1 * udd[:, None], plan.amax, plan.norm_sides)
     out = [speed, acc]
     if plan.jmax is not None:
         jerk = c3 * (ud**3)[:, None] + 3.0 * c2 * (ud * udd)[:, None] + c1 * uddd[:, None]
-        out.append(np.max(np.abs(jerk) / plan.jmax, axis=1))
+        out.append(limit_ratio(jerk, plan.jmax, plan.norm_sides))
     else:
         out.append(np.zeros_like(speed))
     ex = [np.maximum(np.maximum.reduceat(x, start) - 1.0, 0.0) for x in out]

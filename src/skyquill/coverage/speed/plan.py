@@ -13,6 +13,7 @@ from scipy import sparse
 from skyquill.coverage.speed.curve import PathCurve, _derivs3, _eval, _Reparam
 from skyquill.coverage.speed.grid import _grid_map
 from skyquill.coverage.speed.iteration import _initial_solve, _refine
+from skyquill.coverage.speed.norms import component_limits, components
 from skyquill.coverage.speed.profile import SpeedPlan, _duration, _profile_spline
 from skyquill.coverage.speed.rows import (
     _acc_matrix,
@@ -22,9 +23,13 @@ from skyquill.coverage.speed.rows import (
     _ones,
     _speed_bounds,
 )
-from skyquill.coverage.speed.validate import _validate, _validate_refine
+from skyquill.coverage.speed.validate import (
+    _validate,
+    _validate_limits,
+    _validate_norm_sides,
+    _validate_refine,
+)
 from skyquill.errors import InputError
-from skyquill.validation import per_axis
 
 
 def plan_speed(
@@ -43,6 +48,7 @@ def plan_speed(
     refine_rounds: int = 8,
     lp_backend: str = "auto",
     grid: str = "uniform",
+    norm_sides: int | None = None,
 ) -> SpeedPlan:
     """Plan the time-optimal rest-to-rest speed profile along ``curve``.
 
@@ -55,9 +61,11 @@ def plan_speed(
     vmax : float
         Speed limit (> 0).
     amax : float or array_like, shape (d,)
-        Per-axis acceleration limit (> 0).
+        Per-axis acceleration limit (> 0); a number, the norm limit, with
+        ``norm_sides``.
     jmax : float or array_like, shape (d,), optional
-        Per-axis jerk limit; None disables jerk constraints.
+        Per-axis jerk limit (a number, the norm limit, with ``norm_sides``);
+        None disables jerk constraints.
     n : int, default 500
         Number of grid points (>= 3).
     chord_error : float, optional
@@ -97,6 +105,16 @@ def plan_speed(
         whose end hooks are shorter than a grid cell its pseudo-jerk
         iteration can cycle and stop the vehicle at the last interior node
         (``InfeasibleError``) or plan twice as slowly.
+    norm_sides : int, optional
+        None (default): ``amax`` and ``jmax`` hold per axis.  An even ``m >= 4``:
+        they are Euclidean norm limits ``|a| <= amax``, ``|j| <= jmax``, held in
+        the LP by the inscribed regular ``m``-gon (rows
+        ``n_k . (C'' b + 0.5 C' b') <= amax cos(pi/m)``, likewise the
+        pseudo-jerk rows), i.e. up to ``1 - cos(pi/m)`` conservative at the
+        grid nodes (0.5 % at ``m = 32``); the refinement and
+        ``excess_estimate`` measure the norm itself.  2-D paths; on a 3-D
+        path the polygon holds the horizontal norm and ``|a_z| <= amax``,
+        ``|j_z| <= jmax`` the vertical component.
 
     Returns
     -------
@@ -125,8 +143,8 @@ def plan_speed(
     backend = _validate_refine(max_excess, refine_rounds, lp_backend, grid)
     n = args.n
     d = _eval(curve, np.array([0.0, 1.0]), 1).shape[1]
-    amax_a = per_axis("amax", amax, d)
-    jmax_a = None if jmax is None else per_axis("jmax", jmax, d)
+    norm = _validate_norm_sides(norm_sides, d)
+    amax_a, jmax_a = _validate_limits(amax, jmax, d, norm_sides=norm)
     umap = None
     path: PathCurve = curve
     if grid == "adaptive":
@@ -144,14 +162,17 @@ def plan_speed(
     ub, vb = _speed_bounds(
         c1, c2, args.vmax, chord_error=args.chord_error, period=args.control_period
     )
-    a = _acc_matrix(sig, (c1, c2), amax_a * args.safety)
-    if jmax_a is not None:
-        a = sparse.vstack([a, _jerk_matrix((c1, c2, c3), jmax_a * args.safety, vb)], format="csr")
-    lp = _GridLP(a, backend=backend)
-    bounds = _Bounds(ub, None if jmax_a is None else vb, d, *_ones(n))
+    # The LP limits components: the axes, or the projections on the polygon's normals.
+    p1, p2, p3 = (components(c, norm) for c in (c1, c2, c3))
+    a = _acc_matrix(sig, (p1, p2), component_limits(amax_a, norm) * args.safety)
+    jlim = None if jmax_a is None else component_limits(jmax_a, norm)
+    if jlim is not None:
+        a = sparse.vstack([a, _jerk_matrix((p1, p2, p3), jlim * args.safety, vb)], format="csr")
+    lp = _GridLP(a, backend=backend, time_scale=p1.shape[1] / d)
+    bounds = _Bounds(ub, None if jlim is None else vb, p1.shape[1], *_ones(n))
     log: tuple[list[float], list[float]] = ([], [])
     stop = (args.jerk_iterations, args.jerk_tol)
-    b, iterations = _initial_solve(lp, bounds, c1=c1, jmax=jmax_a, stop=stop, log=log)
+    b, iterations = _initial_solve(lp, bounds, c1=p1, jmax=jlim, stop=stop, log=log)
     plan = SpeedPlan(
         curve=curve,
         u=sig,
@@ -171,6 +192,7 @@ def plan_speed(
         _bsig=b,
         _umap=umap,
         grid=grid,
+        norm_sides=norm,
     )
     plan, rounds, est, extra = _refine(
         plan, lp, bounds, target=max_excess, rounds=refine_rounds, stop=stop, log=log

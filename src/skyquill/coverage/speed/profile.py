@@ -11,6 +11,7 @@ import numpy as np
 from scipy.interpolate import BSpline, PPoly, make_interp_spline
 
 from skyquill.coverage.speed.curve import PathCurve, _eval
+from skyquill.coverage.speed.norms import limit_ratio
 from skyquill.errors import InfeasibleError, InputError
 from skyquill.validation import FloatArray
 
@@ -57,7 +58,9 @@ class Verification:
     max_jerk : ndarray, shape (d,) or None
         Per-axis largest ``|j|`` (third differences); None without jerk limit.
     speed_excess, acc_excess, jerk_excess : float
-        Relative excess over the respective limit (0 when respected).
+        Relative excess over the respective limit (0 when respected): per
+        axis, or of the norm when the plan holds norm limits
+        (``SpeedPlan.norm_sides``).
     max_excess : float
         Largest of the three relative excesses.
     period : float
@@ -103,7 +106,8 @@ class SpeedPlan:
         ``max |sqrt(b_k) - sqrt(b_{k-1})| / max sqrt(b_k)`` per iteration
         (refinement rounds appended).
     vmax, amax, jmax :
-        The limits (``amax``/``jmax`` per axis).
+        The limits (``amax``/``jmax`` per axis; with ``norm_sides`` every
+        entry is the one norm limit).
     control_period : float
         Interpolation period ``T`` of §2.2.
     refinements : int
@@ -117,6 +121,11 @@ class SpeedPlan:
         Number of LPs solved.
     grid : str
         ``"uniform"`` or ``"adaptive"`` (see :func:`plan_speed`).
+    norm_sides : int or None
+        None: ``amax``/``jmax`` hold per axis.  Else they are Euclidean norm
+        limits, held in the LP by the inscribed polygon of this many sides
+        (see ``norm_sides`` of :func:`plan_speed`) and measured as norms by
+        ``excess_estimate`` and :meth:`verify`.
     """
 
     curve: PathCurve
@@ -140,6 +149,7 @@ class SpeedPlan:
     excess_estimate: float = 0.0
     lp_solves: int = 0
     grid: str = "uniform"
+    norm_sides: int | None = None
 
     def _b_eval(self, u: FloatArray, nu: int) -> FloatArray:
         return np.asarray(self._bspline(u, nu), dtype=np.float64)
@@ -297,7 +307,8 @@ class SpeedPlan:
         Returns
         -------
         Verification
-            Per-axis maxima and relative excesses over the limits.
+            Per-axis maxima and relative excesses over the limits (over the
+            norm limits when ``norm_sides`` is set).
         """
         T = self.control_period / 10.0 if period is None else float(period)
         sp = self.setpoints(T)
@@ -309,13 +320,14 @@ class SpeedPlan:
         max_speed = float(np.max(np.linalg.norm(vel, axis=1)))
         max_acc = np.max(np.abs(acc), axis=0)
         speed_ex = max(max_speed / self.vmax - 1.0, 0.0)
-        acc_ex = max(float(np.max(max_acc / self.amax)) - 1.0, 0.0)
+        acc_ex = max(float(np.max(limit_ratio(acc, self.amax, self.norm_sides))) - 1.0, 0.0)
         max_jerk: FloatArray | None = None
         jerk_ex = 0.0
         if self.jmax is not None:
             jerk = np.diff(p, n=3, axis=0) / T**3
             max_jerk = np.max(np.abs(jerk), axis=0)
-            jerk_ex = max(float(np.max(max_jerk / self.jmax)) - 1.0, 0.0)
+            ratio = limit_ratio(jerk, self.jmax, self.norm_sides)
+            jerk_ex = max(float(np.max(ratio)) - 1.0, 0.0)
         return Verification(
             max_speed=max_speed,
             max_acc=max_acc,

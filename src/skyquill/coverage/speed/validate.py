@@ -7,9 +7,12 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numpy as np
+import numpy.typing as npt
+
 from skyquill.errors import InputError
 from skyquill.solvers.lp import LPBackend, resolve_backend
-from skyquill.validation import as_float, as_int
+from skyquill.validation import FloatArray, as_float, as_int, per_axis
 
 #: Grid kinds of :func:`~skyquill.coverage.speed.plan_speed`.
 GRIDS = ("uniform", "adaptive")
@@ -87,3 +90,19 @@ def _validate_norm_sides(norm_sides: object, d: int) -> int | None:
             f"norm_sides: got {m} for a {d}-D path, expected None (norm limits need 2-D or 3-D)"
         )
     return m
+
+
+def _validate_limits(
+    amax: float | npt.ArrayLike,
+    jmax: float | npt.ArrayLike | None,
+    d: int,
+    *,
+    norm_sides: int | None,
+) -> tuple[FloatArray, FloatArray | None]:
+    """``amax``, ``jmax`` as ``(d,)`` arrays: per axis, or the one norm limit repeated."""
+    if norm_sides is None:
+        return per_axis("amax", amax, d), None if jmax is None else per_axis("jmax", jmax, d)
+    # A norm limit is one number; an array here would be a per-axis intent.
+    acc = np.full(d, as_float("amax", amax, positive=True))
+    jerk = None if jmax is None else np.full(d, as_float("jmax", jmax, positive=True))
+    return acc, jerk
