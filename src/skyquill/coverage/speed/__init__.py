@@ -52,6 +52,17 @@ Discretisation choices (the grid LP is otherwise optimistic):
   the round, 1, 2, ...) and re-solves from the previous basis, until the
   excess is below ``max_excess`` (2 % by default).  Unlike the global
   ``safety`` factor (still available) this keeps the speed elsewhere.
+
+With ``norm_sides`` the acceleration and jerk limits are Euclidean norms held
+through an inscribed regular polygon (:mod:`.norms`) instead of per axis.
+
+Modules, one job each: :mod:`.curve` (the path, checked evaluation,
+reparametrisation), :mod:`.profile` (:class:`SpeedPlan`, the interpolated
+profile and its setpoints), :mod:`.rows` (the grid LP's rows and bounds, on
+:class:`skyquill.solvers.lp.LinearProgram`), :mod:`.norms` (per-axis or norm
+limits), :mod:`.iteration` (pseudo-jerk iteration, certification,
+refinement), :mod:`.grid` (the adaptive grid), :mod:`.validate` and
+:mod:`.plan` (:func:`plan_speed`).
 """
 
 from skyquill.coverage.speed.curve import PathCurve
