@@ -55,9 +55,21 @@ import numpy as np
 from threadpoolctl import threadpool_info, threadpool_limits
 
 from common import jsonable, machine_info, time_calls, time_stats
-from skyquill.coverage import speed as sp
 from skyquill.coverage.paths import contours, spiral_control_points, spiral_curve
 from skyquill.coverage.regions import region_from_vertices
+from skyquill.coverage.speed import SpeedPlan, plan_speed
+from skyquill.coverage.speed.curve import _derivs3, _Reparam
+from skyquill.coverage.speed.grid import _grid_map
+from skyquill.coverage.speed.iteration import _pseudo_jerk
+from skyquill.coverage.speed.rows import (
+    _acc_matrix,
+    _Bounds,
+    _end_caps,
+    _GridLP,
+    _jerk_matrix,
+    _ones,
+    _speed_bounds,
+)
 
 RESULTS = Path(__file__).resolve().parent / "results" / "coverage_lp.json"
 QUICK_RESULTS = RESULTS.with_name("coverage_lp_quick.json")
@@ -83,21 +95,21 @@ def measure(fn: Callable[[], Any], runs: int, warmup: int = WARMUP) -> tuple[dic
     return time_stats(times, warmup), out
 
 
-def grid_lp(curve: Any, grid: str) -> tuple[Any, sp._Bounds]:
+def grid_lp(curve: Any, grid: str) -> tuple[Any, _Bounds]:
     """Rows and bounds of the grid LP with jerk rows, as ``plan_speed`` builds them."""
     u = np.linspace(0.0, 1.0, N)
     amax, jmax = np.full(2, AMAX), np.full(2, JMAX)
     if grid == "adaptive":
-        curve = sp._Reparam(curve, sp._grid_map(curve, N, vmax=VMAX, amax=amax, jmax=jmax))
-    c1, c2, c3 = sp._derivs3(curve, u)
-    ub, vb = sp._speed_bounds(c1, c2, VMAX, chord_error=None, period=0.02)
-    a_acc = sp._acc_matrix(u, (c1, c2), amax)
-    a_jerk = sp._jerk_matrix((c1, c2, c3), jmax, vb)
+        curve = _Reparam(curve, _grid_map(curve, N, vmax=VMAX, amax=amax, jmax=jmax))
+    c1, c2, c3 = _derivs3(curve, u)
+    ub, vb = _speed_bounds(c1, c2, VMAX, chord_error=None, period=0.02)
+    a_acc = _acc_matrix(u, (c1, c2), amax)
+    a_jerk = _jerk_matrix((c1, c2, c3), jmax, vb)
     from scipy import sparse
 
     a = sparse.vstack([a_acc, a_jerk], format="csr")
-    bounds = sp._Bounds(ub, vb, 2, *sp._ones(N))
-    sp._end_caps(bounds.ub, c1, jmax)
+    bounds = _Bounds(ub, vb, 2, *_ones(N))
+    _end_caps(bounds.ub, c1, jmax)
     return a, bounds
 
 
@@ -110,14 +122,14 @@ def lp_cases(curve: Any, runs: int, grid: str) -> list[dict[str, Any]]:
     for backend in ("linprog", "highspy"):
 
         def solve_cold(be: str = backend) -> Any:
-            return sp._GridLP(a, backend=be).solve(free, bounds.cols())
+            return _GridLP(a, backend=be).solve(free, bounds.cols())
 
         cold[backend], _ = measure(solve_cold, runs)
     entries.append(_pair(f"lp_cold_{grid}", cold, "one jerk-free LP from scratch, n=2000"))
     entries.append(first_jerk_lp(a, bounds, runs, grid))
     # Converge the pseudo-jerk iteration once, then time re-solves after a bound change.
-    lp = sp._GridLP(a, backend="highspy")
-    b, _ = sp._pseudo_jerk(lp, bounds, lp.solve(free, bounds.cols()), stop=(20, 1e-3), log=([], []))
+    lp = _GridLP(a, backend="highspy")
+    b, _ = _pseudo_jerk(lp, bounds, lp.solve(free, bounds.cols()), stop=(20, 1e-3), log=([], []))
     rows_a, rows_b = bounds.rows(b), bounds.rows(0.99 * b)
     flip = [False]
 
@@ -126,19 +138,19 @@ def lp_cases(curve: Any, runs: int, grid: str) -> list[dict[str, Any]]:
         return lp.solve(rows_a if flip[0] else rows_b, bounds.cols())
 
     hot_stats, _ = measure(hot, max(runs, 20))
-    ref = sp._GridLP(a, backend="linprog")
+    ref = _GridLP(a, backend="linprog")
     scratch, _ = measure(lambda: ref.solve(rows_b, bounds.cols()), runs)
     what = "pseudo-jerk re-solve, n=2000"
     entries.append(_pair(f"lp_hot_{grid}", {"linprog": scratch, "highspy": hot_stats}, what))
     return entries
 
 
-def first_jerk_lp(a: Any, bounds: sp._Bounds, runs: int, grid: str) -> dict[str, Any]:
+def first_jerk_lp(a: Any, bounds: _Bounds, runs: int, grid: str) -> dict[str, Any]:
     """The heaviest single LP: the first pseudo-jerk LP, hot-started from the jerk-free basis."""
     free = bounds.rows(None)
     times = []
     for _ in range(WARMUP + runs):
-        lp = sp._GridLP(a, backend="highspy")
+        lp = _GridLP(a, backend="highspy")
         b0 = lp.solve(free, bounds.cols())
         before = lp.time
         lp.solve(bounds.rows(b0), bounds.cols())
@@ -183,8 +195,8 @@ def plan_case(curve: Any, delta: float, runs: int) -> list[dict[str, Any]]:
     for name, kwargs in PLAN_VARIANTS.items():
         slow = "linprog" in name  # seconds per call: 1 warm-up, 3 runs
 
-        def run(kw: dict[str, Any] = kwargs) -> sp.SpeedPlan:
-            return sp.plan_speed(curve, VMAX, AMAX, JMAX, n=N, **kw)
+        def run(kw: dict[str, Any] = kwargs) -> SpeedPlan:
+            return plan_speed(curve, VMAX, AMAX, JMAX, n=N, **kw)
 
         stats, plan = measure(run, 3 if slow else runs, 1 if slow else WARMUP)
         ver = plan.verify()
@@ -251,8 +263,8 @@ def toppra_case(curve: Any, runs: int) -> dict[str, Any] | None:
         )
         return inst.compute_trajectory(0, 0)
 
-    def ours() -> sp.SpeedPlan:
-        return sp.plan_speed(curve, 100.0, AMAX, None, n=N + 1)
+    def ours() -> SpeedPlan:
+        return plan_speed(curve, 100.0, AMAX, None, n=N + 1)
 
     t_peer, traj = measure(peer, runs)
     t_ours, plan = measure(ours, runs)

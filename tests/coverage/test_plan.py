@@ -79,6 +79,8 @@ def test_an_unreachable_coverage_target_is_infeasible() -> None:
         ({"contours": "wavy"}, "contours"),
         ({"epsilon": 1.5}, "epsilon"),
         ({"delta": 0.0}, "delta"),
+        ({"limit_norm_sides": 2}, r"^limit_norm_sides: got 2"),
+        ({"limit_norm_sides": 7}, r"^limit_norm_sides: got 7, expected an even integer"),
     ],
 )
 def test_bad_options_are_named(options: dict[str, object], match: str) -> None:
@@ -162,3 +164,41 @@ def test_a_concave_spiral_too_tight_to_join_rests_between_its_parts() -> None:
     assert plan.coverage >= 0.97
     assert np.all(np.diff(plan.setpoints.t) > 0.0)
     assert float(shapely.distance(shapely.points(plan.path), region).max()) < 1e-6
+
+
+FINITE_REGIONS = {
+    "square": [[0, 0], [10, 0], [10, 10], [0, 10]],
+    "thin": [[0, 0], [30, 0], [30, 4], [0, 4]],
+    "triangle": [[0, 0], [20, 0], [8, 14]],
+    "L": [[0, 0], [20, 0], [20, 8], [8, 8], [8, 20], [0, 20]],
+    "hexagon": [[0, 0], [47, 0], [47, 15], [30, 30], [20, 18], [0, 30]],  # one reflex corner
+}
+
+
+@pytest.mark.parametrize("pattern", ["spiral", "zigzag"])
+@pytest.mark.parametrize("name", list(FINITE_REGIONS))
+def test_every_setpoint_is_finite(name: str, pattern: str) -> None:
+    # The last row (u = 1) had NaN acceleration and jerk on most regions.
+    region = region_from_vertices(FINITE_REGIONS[name])
+    options = CoverageOptions(width=2.0, vmax=3.0, amax=5.0, jmax=3.0, pattern=pattern)
+    sp = plan_coverage(region, options).setpoints
+    for x in (sp.t, sp.u, sp.p, sp.v, sp.a, sp.j):
+        assert np.all(np.isfinite(x)), name
+    assert np.all(np.abs(sp.a[-1]) <= 5.0 * 1.02) and np.all(np.abs(sp.j[-1]) <= 3.0 * 1.02)
+
+
+@pytest.mark.parametrize("pattern", ["spiral", "zigzag", "zigzag-stop"])
+def test_norm_limits_hold_as_norms(pattern: str) -> None:
+    region = region_from_vertices(FINITE_REGIONS["triangle"])
+    options = CoverageOptions(pattern=pattern, limit_norm_sides=16)  # type: ignore[arg-type]
+    plan = plan_coverage(region, options)
+    assert plan.limits["max_excess"] <= 0.02
+    sp = plan.setpoints
+    assert np.max(np.linalg.norm(sp.a, axis=1)) <= options.amax * 1.02
+    assert np.max(np.linalg.norm(sp.j, axis=1)) <= options.jmax * 1.02
+    if plan.speed_plan is not None:
+        assert plan.speed_plan.norm_sides == 16
+    # Per axis (the default) the same path may exceed the norms but not the axes.
+    box = plan_coverage(region, CoverageOptions(pattern=pattern))  # type: ignore[arg-type]
+    assert box.limits["max_excess"] <= 0.02
+    assert box.duration <= plan.duration

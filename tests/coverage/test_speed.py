@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from scipy.interpolate import BSpline, CubicSpline, make_interp_spline
 
-from skyquill.coverage.speed import plan_speed
+from skyquill.coverage.speed import SpeedPlan, plan_speed
 from skyquill.errors import InputError
 
 
@@ -135,7 +135,7 @@ def test_cubic_spline_curve_accepted() -> None:
         ({"grid": "auto"}, "grid"),
         ({"vmax": 0.0}, "vmax"),
         ({"vmax": -1.0}, "vmax"),
-        ({"n": 2}, "n must"),
+        ({"n": 2}, "^n: got"),
         ({"amax": [1.0, 2.0, 3.0]}, "amax"),
         ({"jmax": -1.0}, "jmax"),
         ({"chord_error": 0.0}, "chord_error"),
@@ -242,3 +242,93 @@ def test_uniform_grid_keeps_parameter() -> None:
     plan = plan_speed(_circle(), 1.0, 2.0, 3.0, n=101, grid="uniform")
     assert plan.grid == "uniform"
     assert np.allclose(plan.u, np.linspace(0.0, 1.0, 101))
+
+
+@pytest.mark.parametrize("n", [50, 99, 104])
+def test_last_setpoint_is_the_limit_at_the_end(n: int) -> None:
+    # For these n, h * (n - 1) rounds below 1: u = 1 fell off the profile spline
+    # and the last row's acceleration and jerk were NaN.
+    plan = plan_speed(_circle(), 1.0, 2.0, 3.0, n=n)
+    sp = plan.setpoints(plan.control_period / 10.0)
+    for x in (sp.t, sp.u, sp.p, sp.v, sp.a, sp.j):
+        assert np.all(np.isfinite(x))
+    # The end values continue the profile (left limits at u = 1), not zeros.
+    assert np.allclose(sp.a[-1], sp.a[-2], atol=0.01 * 2.0)
+    assert np.allclose(sp.j[-1], sp.j[-2], atol=0.01 * 3.0)
+    assert np.linalg.norm(sp.j[-1]) > 0.5
+
+
+def _dense_norms(plan: SpeedPlan, amax: float, jmax: float | None) -> tuple[float, float]:
+    """Largest ``|a| / amax`` and ``|j| / jmax`` of the chain-rule setpoints at ``T / 10``."""
+    sp = plan.setpoints(plan.control_period / 10.0)
+    acc = float(np.max(np.linalg.norm(sp.a, axis=1))) / amax
+    jerk = 0.0 if jmax is None else float(np.max(np.linalg.norm(sp.j, axis=1))) / jmax
+    return acc, jerk
+
+
+@pytest.mark.parametrize("jmax", [None, 3.0])
+def test_norm_limits_on_a_circle(jmax: float | None) -> None:
+    amax, sides = 2.0, 16
+    plan = plan_speed(_circle(), 10.0, amax, jmax, n=500, norm_sides=sides)
+    assert plan.norm_sides == sides
+    acc, jerk = _dense_norms(plan, amax, jmax)
+    assert acc <= 1.0 + 0.02
+    assert jerk <= 1.0 + 0.02
+    ver = plan.verify()  # finite differences of the positions, measured as norms
+    assert ver.max_excess <= 0.02
+    if jmax is None:
+        # The acceleration binds, at least at the polygon's inner radius.
+        assert acc >= np.cos(np.pi / sides) - 1e-3
+    # Per axis the same limits allow up to sqrt(2) times the norm on the diagonals.
+    box = plan_speed(_circle(), 10.0, amax, jmax, n=500)
+    assert box.norm_sides is None
+    box_acc, box_jerk = _dense_norms(box, amax, jmax)
+    assert max(box_acc, box_jerk) > 1.3
+    assert box.duration < plan.duration
+
+
+def test_norm_limits_on_a_coverage_spiral() -> None:
+    plan = plan_speed(_square_spiral(1.0), 3.0, 5.0, 3.0, n=1000, norm_sides=16)
+    acc, jerk = _dense_norms(plan, 5.0, 3.0)
+    assert acc <= 1.0 + 0.02 and jerk <= 1.0 + 0.02
+    assert plan.excess_estimate <= 0.02
+    assert plan.verify().max_excess <= 0.02
+    assert jerk > 0.95  # the jerk norm binds
+    # Per axis (as before): the same 30.69 s plan, whose jerk norm exceeds jmax.
+    box = plan_speed(_square_spiral(1.0), 3.0, 5.0, 3.0, n=1000)
+    assert 30.0 < box.duration < 31.0 < plan.duration
+    assert _dense_norms(box, 5.0, 3.0)[1] > 1.2
+
+
+def test_norm_limits_on_a_3d_path() -> None:
+    th = np.linspace(0.0, 1.0, 60)
+    helix = make_interp_spline(
+        th, np.column_stack([np.cos(2 * np.pi * th), np.sin(2 * np.pi * th), 0.5 * th]), k=5
+    )
+    plan = plan_speed(helix, 10.0, 2.0, None, n=400, norm_sides=16)
+    sp = plan.setpoints(plan.control_period / 10.0)
+    assert np.max(np.linalg.norm(sp.a[:, :2], axis=1)) <= 2.0 * 1.02
+    assert np.max(np.abs(sp.a[:, 2])) <= 2.0 * 1.02
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"norm_sides": 5}, r"^norm_sides: got 5, expected an even integer"),
+        ({"norm_sides": 2}, r"^norm_sides: got 2, expected an integer >= 4"),
+        ({"norm_sides": 8, "amax": [1.0, 2.0]}, r"^amax: got .*, expected a number"),
+        ({"norm_sides": 8, "jmax": [1.0, 2.0]}, r"^jmax: got .*, expected a number"),
+    ],
+)
+def test_bad_norm_input(kwargs: dict[str, object], match: str) -> None:
+    args: dict[str, object] = {"vmax": 1.0, "amax": 1.0, "jmax": None, "n": 50}
+    args.update(kwargs)
+    with pytest.raises(InputError, match=match):
+        plan_speed(_circle(), **args)  # type: ignore[arg-type]
+
+
+def test_norm_needs_a_planar_or_spatial_path() -> None:
+    x = np.linspace(0.0, 1.0, 8)
+    line = make_interp_spline(x, x[:, None], k=3)
+    with pytest.raises(InputError, match=r"^norm_sides: got 8 for a 1-D path"):
+        plan_speed(line, 1.0, 1.0, norm_sides=8)

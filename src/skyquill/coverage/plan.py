@@ -11,7 +11,7 @@ Three patterns, compared on equal terms (paper ``001_61beb0e01a19013a`` §4):
   corner, each leg time-optimal under the same limits (Ruckig).
 
 Concave regions are split into convex parts whose spirals (or zigzags) are
-joined into one path (:mod:`skyquill.coverage.decompose`, the paper's Fig. 5).
+joined into one path (:mod:`skyquill.coverage.joined`, the paper's Fig. 5).
 """
 
 from __future__ import annotations
@@ -72,7 +72,8 @@ class CoverageOptions:
     vmax : float
         Speed limit, m/s.
     amax, jmax : float
-        Per-axis acceleration (m/s^2) and jerk (m/s^3) limits.
+        Acceleration (m/s^2) and jerk (m/s^3) limits: per axis, or Euclidean
+        norms with ``limit_norm_sides``.
     pattern : {"spiral", "zigzag", "zigzag-stop"}
     contours : {"offset", "homothetic"}
         Spiral rings: true inward offsets, or the paper's shrink (eq. 1-3).
@@ -95,6 +96,11 @@ class CoverageOptions:
         Flight height written to the setpoints, m.
     grid : int or None
         Speed-LP grid points; ``None`` picks them from the path length.
+    limit_norm_sides : int or None
+        None: ``amax`` and ``jmax`` hold per axis.  An even ``m >= 4``: they
+        are norm limits, held in the speed LP by the inscribed regular
+        ``m``-gon (``norm_sides`` of :func:`~skyquill.coverage.speed.plan_speed`;
+        16 is within 2 % of the circle) and measured as norms in ``limits``.
     """
 
     width: float = 2.0
@@ -110,6 +116,7 @@ class CoverageOptions:
     rate: float = 50.0
     altitude: float = 2.0
     grid: int | None = None
+    limit_norm_sides: int | None = None
 
     def __post_init__(self) -> None:
         for name in ("width", "vmax", "amax", "jmax", "delta", "rate"):
@@ -125,6 +132,12 @@ class CoverageOptions:
             raise InputError(f"epsilon: got {self.epsilon!r}, expected a value in (0, 1]")
         if self.grid is not None:
             as_int("grid", self.grid, low=3, high=20_000)
+        if self.limit_norm_sides is not None:
+            sides = as_int("limit_norm_sides", self.limit_norm_sides, low=4, high=1024)
+            if sides % 2:
+                raise InputError(
+                    f"limit_norm_sides: got {sides}, expected an even integer from 4 to 1024"
+                )
 
 
 @dataclass(frozen=True, eq=False)
@@ -215,14 +228,14 @@ def covering_waypoints(region: Polygon, options: CoverageOptions) -> FloatArray:
         if is_convex(region):
             rings = contours(region, w, options.contours, epsilon=eps)
             return spiral_control_points(rings, d, drift=options.drift)
-        from skyquill.coverage.decompose import multi_spiral_control_points
+        from skyquill.coverage.joined import multi_spiral_control_points
 
         return multi_spiral_control_points(region, eps * w, mode=options.contours, delta=d)
     # The sweep lines' spacing is the swath; epsilon < 1 packs them closer.
     if is_convex(region):
         stops = zigzag(region, eps * w, perimeter=options.perimeter)
     else:
-        from skyquill.coverage.decompose import multi_zigzag
+        from skyquill.coverage.joined import multi_zigzag
 
         stops = multi_zigzag(region, eps * w, perimeter=options.perimeter)
     return stops if options.pattern == "zigzag-stop" else with_corner_points(stops, d)
@@ -370,7 +383,8 @@ def _timed_path(waypoints: FloatArray, path: FloatArray, opts: CoverageOptions) 
     """Setpoints, limits report and speed plan (``None`` for stop-and-go) of one path."""
     period = 1.0 / opts.rate
     if opts.pattern == "zigzag-stop":
-        legs = stop_and_go_legs(waypoints, opts.vmax, opts.amax, opts.jmax)
+        norm = opts.limit_norm_sides is not None
+        legs = stop_and_go_legs(waypoints, opts.vmax, opts.amax, opts.jmax, norm=norm)
         fine = stop_and_go_setpoints(legs, period / 10.0)
         return stop_and_go_setpoints(legs, period), limits_report(fine, opts), None
     n = opts.grid or grid_points(_length(path))
@@ -382,7 +396,7 @@ def _stop_between_parts(
     region: Polygon, opts: CoverageOptions
 ) -> tuple[FloatArray, FloatArray, _Timed]:
     """Each part's spiral timed on its own, the joins flown as stop-and-go legs."""
-    from skyquill.coverage.decompose import multi_spiral_pieces
+    from skyquill.coverage.joined import multi_spiral_pieces
 
     spirals, routes = multi_spiral_pieces(
         region, opts.epsilon * opts.width, mode=opts.contours, delta=opts.delta
@@ -462,6 +476,7 @@ def _timed(curve: Any, options: CoverageOptions, n: int) -> tuple[SpeedPlan, Ver
             plan = plan_speed(
                 curve, options.vmax, options.amax, options.jmax,
                 n=factor * n, control_period=period, grid=kind,
+                norm_sides=options.limit_norm_sides,
             )  # fmt: skip
         except InfeasibleError as exc:
             seen.append(f"{kind} grid of {factor * n}: {exc}")
@@ -503,12 +518,22 @@ def _vertex_distances(line: LineString) -> FloatArray:
 def limits_report(setpoints: Setpoints, options: CoverageOptions) -> dict[str, Any]:
     """Largest speed, per-axis |acceleration| and |jerk| of ``setpoints``, and the excess.
 
-    ``max_excess`` is the largest relative excess over any limit (0 when all hold).
+    ``max_excess`` is the largest relative excess over any limit (0 when all
+    hold); with ``limit_norm_sides`` the acceleration and jerk are measured
+    by their norms.
     """
     speed = float(np.max(np.linalg.norm(setpoints.v, axis=1)))
     acc = np.max(np.abs(setpoints.a), axis=0)
     jerk = np.max(np.abs(setpoints.j), axis=0)
-    return _report(speed, acc, jerk, options)
+    if options.limit_norm_sides is None:
+        return _report(speed, acc, jerk, options)
+    excess = max(
+        speed / options.vmax - 1.0,
+        float(np.max(np.linalg.norm(setpoints.a, axis=1))) / options.amax - 1.0,
+        float(np.max(np.linalg.norm(setpoints.j, axis=1))) / options.jmax - 1.0,
+        0.0,
+    )
+    return _report(speed, acc, jerk, options) | {"max_excess": excess}
 
 
 def _lp_limits(ver: Verification, options: CoverageOptions) -> dict[str, Any]:
@@ -519,7 +544,9 @@ def _lp_limits(ver: Verification, options: CoverageOptions) -> dict[str, Any]:
     rule that produced the setpoints' own velocity, acceleration and jerk.
     """
     jerk = ver.max_jerk if ver.max_jerk is not None else np.zeros_like(ver.max_acc)
-    return _report(ver.max_speed, ver.max_acc, jerk, options)
+    report = _report(ver.max_speed, ver.max_acc, jerk, options)
+    # With norm limits the plan's own check measured the norms.
+    return report if options.limit_norm_sides is None else report | {"max_excess": ver.max_excess}
 
 
 def _report(

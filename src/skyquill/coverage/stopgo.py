@@ -3,11 +3,11 @@
 The paper's zigzag baseline (``001_61beb0e01a19013a`` §4) flies straight legs and
 stops at every corner. Each leg is a rest-to-rest move along its own direction
 ``d`` (a unit vector), so the per-axis limits become scalar limits along the
-leg, ``a <= min_k amax_k / |d_k|`` and ``j <= min_k jmax_k / |d_k|``; the
-speed limit is the norm ``vmax``. The time-optimal jerk-limited rest-to-rest
-profile of each leg comes from Ruckig (Berscheid & Kröger, RSS 2021), the
-reference implementation of such profiles, rather than from a hand-written
-seven-phase S-curve.
+leg, ``a <= min_k amax_k / |d_k|`` and ``j <= min_k jmax_k / |d_k|`` (norm
+limits are the leg's limits as they are); the speed limit is the norm
+``vmax``. The time-optimal jerk-limited rest-to-rest profile of each leg comes
+from Ruckig (Berscheid & Kröger, RSS 2021), the reference implementation of
+such profiles, rather than from a hand-written seven-phase S-curve.
 """
 
 from __future__ import annotations
@@ -41,13 +41,22 @@ class Leg:
         return float(self.profile.duration)
 
 
-def _leg(start: FloatArray, end: FloatArray, limits: tuple[float, FloatArray, FloatArray]) -> Leg:
+def _leg(
+    start: FloatArray,
+    end: FloatArray,
+    limits: tuple[float, FloatArray, FloatArray],
+    *,
+    norm: bool,
+) -> Leg:
     vmax, amax, jmax = limits
     length = float(np.linalg.norm(end - start))
     d = (end - start) / length
-    with np.errstate(divide="ignore"):
-        a = float(np.min(amax / np.abs(d)))
-        j = float(np.min(jmax / np.abs(d)))
+    if norm:
+        a, j = float(amax[0]), float(jmax[0])
+    else:
+        with np.errstate(divide="ignore"):
+            a = float(np.min(amax / np.abs(d)))
+            j = float(np.min(jmax / np.abs(d)))
     inp = InputParameter(1)
     inp.current_position = [0.0]
     inp.target_position = [length]
@@ -62,7 +71,12 @@ def _leg(start: FloatArray, end: FloatArray, limits: tuple[float, FloatArray, Fl
 
 
 def stop_and_go_legs(
-    waypoints: FloatArray, vmax: float, amax: float | FloatArray, jmax: float | FloatArray
+    waypoints: FloatArray,
+    vmax: float,
+    amax: float | FloatArray,
+    jmax: float | FloatArray,
+    *,
+    norm: bool = False,
 ) -> list[Leg]:
     """Time-optimal rest-to-rest legs between consecutive waypoints.
 
@@ -73,7 +87,11 @@ def stop_and_go_legs(
     vmax
         Speed limit, m/s.
     amax, jmax
-        Per-axis acceleration (m/s^2) and jerk (m/s^3) limits, scalar or (d,).
+        Per-axis acceleration (m/s^2) and jerk (m/s^3) limits, scalar or (d,);
+        with ``norm`` the Euclidean norm limits (scalars).
+    norm
+        Hold ``amax`` and ``jmax`` as norms (along a straight leg the norm is
+        the leg's own acceleration/jerk) instead of per axis.
 
     Returns
     -------
@@ -84,14 +102,18 @@ def stop_and_go_legs(
         raise InputError(f"waypoints: got {pts.shape[0]} point(s), expected at least 2")
     d = pts.shape[1]
     v = as_float("vmax", vmax, positive=True)
-    a = per_axis("amax", amax, d)
-    j = per_axis("jmax", jmax, d)
+    if norm:
+        a = np.full(d, as_float("amax", amax, positive=True))
+        j = np.full(d, as_float("jmax", jmax, positive=True))
+    else:
+        a = per_axis("amax", amax, d)
+        j = per_axis("jmax", jmax, d)
     steps = np.linalg.norm(np.diff(pts, axis=0), axis=1)
     keep = np.concatenate([[True], steps > 1e-9 * max(1.0, float(np.abs(pts).max()))])
     pts = pts[keep]
     if pts.shape[0] < 2:
         raise InputError("waypoints: got coincident points, expected a path of positive length")
-    return [_leg(p, q, (v, a, j)) for p, q in itertools.pairwise(pts)]
+    return [_leg(p, q, (v, a, j), norm=norm) for p, q in itertools.pairwise(pts)]
 
 
 def _leg_samples(leg: Leg, tau: FloatArray) -> FloatArray:

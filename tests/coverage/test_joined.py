@@ -1,51 +1,20 @@
-"""Concave regions: convex parts, their order and the joined multi-spiral / zigzag."""
+"""Concave regions, step 3: the joined multi-spiral and multi-zigzag."""
 
 from __future__ import annotations
-
-import itertools
 
 import numpy as np
 import pytest
 import shapely
+from concave_regions import CONCAVE, L_SHAPE, STAR, WIDTH, is_convex, union_error
 from coverage_strategies import star_shaped
 from hypothesis import HealthCheck, given, settings
 from shapely.geometry import LineString, Polygon
 
-from skyquill.coverage.decompose import (
-    convex_parts,
-    multi_spiral_control_points,
-    multi_zigzag,
-    order_parts,
-)
+from skyquill.coverage.joined import multi_spiral_control_points, multi_zigzag
+from skyquill.coverage.partition import convex_parts
 from skyquill.coverage.paths import spiral_curve
 from skyquill.coverage.regions import coverage_fraction, region_from_vertices
 from skyquill.errors import InputError
-
-L_SHAPE = region_from_vertices([[0, 0], [12, 0], [12, 4], [4, 4], [4, 12], [0, 12]])
-U_SHAPE = region_from_vertices(
-    [[0, 0], [15, 0], [15, 12], [11, 12], [11, 4], [4, 4], [4, 12], [0, 12]]
-)
-FIELD = region_from_vertices(
-    [[0, 0], [14, -2], [21, 3], [15, 8], [18, 16], [9, 19], [2, 14], [-1, 6]]
-)
-_ANGLES = np.arange(10) * np.pi / 5
-STAR = region_from_vertices(
-    np.c_[np.cos(_ANGLES), np.sin(_ANGLES)] * np.where(np.arange(10) % 2 == 0, 12.0, 6.0)[:, None]
-)
-CONCAVE = {"L": L_SHAPE, "U": U_SHAPE, "field": FIELD, "star": STAR}
-WIDTH = 2.0
-
-
-def _is_convex(part: Polygon) -> bool:
-    return bool(part.convex_hull.area - part.area <= 1e-9 * part.area)
-
-
-def _union_error(region: Polygon, parts: list[Polygon]) -> float:
-    return float(region.symmetric_difference(shapely.union_all(parts)).area / region.area)
-
-
-def _shares_edge(a: Polygon, b: Polygon) -> bool:
-    return bool(shapely.intersection(a.boundary, b.boundary).length > 1e-9)
 
 
 def _spiral(region: Polygon, delta: float) -> np.ndarray:
@@ -56,45 +25,6 @@ def _spiral(region: Polygon, delta: float) -> np.ndarray:
 
 def _outside(region: Polygon, path: np.ndarray) -> float:
     return float(shapely.distance(shapely.points(path), region).max())
-
-
-def test_a_convex_region_is_one_part() -> None:
-    square = region_from_vertices([[0, 0], [10, 0], [10, 10], [0, 10]])
-    parts = convex_parts(square, WIDTH)
-    assert len(parts) == 1
-    assert parts[0].equals(square)
-
-
-@pytest.mark.parametrize("name", list(CONCAVE))
-def test_parts_are_convex_and_tile_the_region(name: str) -> None:
-    region = CONCAVE[name]
-    parts = convex_parts(region, WIDTH)
-    assert len(parts) >= 2
-    assert all(_is_convex(p) for p in parts)
-    assert _union_error(region, parts) <= 1e-9
-    assert sum(p.area for p in parts) == pytest.approx(region.area, rel=1e-9)
-
-
-def test_rectilinear_shapes_are_cut_into_rectangles() -> None:
-    # Reflex-vertex cuts beat Hertel-Mehlhorn's 45° trapezoids here.
-    for region, count in ((L_SHAPE, 2), (U_SHAPE, 3)):
-        parts = convex_parts(region, WIDTH)
-        assert len(parts) == count
-        assert all(p.minimum_rotated_rectangle.area == pytest.approx(p.area) for p in parts)
-
-
-@pytest.mark.parametrize("name", ["L", "U", "field"])
-def test_order_visits_adjacent_parts(name: str) -> None:
-    parts = convex_parts(CONCAVE[name], WIDTH)
-    ordered = order_parts(parts[::-1])
-    assert sorted(p.wkt for p in ordered) == sorted(p.wkt for p in parts)
-    assert all(_shares_edge(a, b) for a, b in itertools.pairwise(ordered))
-
-
-def test_order_honours_the_start() -> None:
-    parts = convex_parts(U_SHAPE, WIDTH)
-    for k in range(len(parts)):
-        assert order_parts(parts, start=k)[0].equals(parts[k])
 
 
 @pytest.mark.parametrize("name", ["L", "U", "field"])
@@ -136,14 +66,6 @@ def test_multi_zigzag_stays_inside_and_covers(name: str) -> None:
 
 
 def test_bad_inputs_are_named() -> None:
-    with pytest.raises(InputError, match="width"):
-        convex_parts(L_SHAPE, 5.0)
-    with pytest.raises(InputError, match="region"):
-        convex_parts(LineString([(0, 0), (1, 1)]), WIDTH)  # type: ignore[arg-type]
-    with pytest.raises(InputError, match="parts"):
-        order_parts([])
-    with pytest.raises(InputError, match="start"):
-        order_parts(convex_parts(L_SHAPE, WIDTH), start=2)
     with pytest.raises(InputError, match="delta"):
         multi_spiral_control_points(L_SHAPE, WIDTH, delta=0.0)
     with pytest.raises(InputError, match="mode"):
@@ -160,7 +82,7 @@ def test_random_star_shaped_regions_work_or_are_refused(vertices: np.ndarray) ->
         sweep = multi_zigzag(region, WIDTH, perimeter=True)
     except InputError:
         return
-    assert all(_is_convex(p) for p in parts)
-    assert _union_error(region, parts) <= 1e-9
+    assert all(is_convex(p) for p in parts)
+    assert union_error(region, parts) <= 1e-9
     assert _outside(region, spiral) <= 0.05
     assert region.buffer(1e-6).covers(LineString(sweep))

@@ -1,0 +1,198 @@
+"""The pseudo-jerk iteration, its certification LP and the local refinement."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from skyquill.coverage.speed.curve import _derivs3
+from skyquill.coverage.speed.norms import limit_ratio
+from skyquill.coverage.speed.profile import SpeedPlan, _interval_times, _profile_spline
+from skyquill.coverage.speed.rows import _Bounds, _end_caps, _GridLP
+from skyquill.validation import FloatArray
+
+#: Fewest / most points per grid interval at which the refinement checks the plan.
+_SAMPLES = 8
+_MAX_SAMPLES = 256
+
+
+def _initial_solve(
+    lp: _GridLP,
+    bounds: _Bounds,
+    *,
+    c1: FloatArray,
+    jmax: FloatArray | None,
+    stop: tuple[int, float],
+    log: tuple[list[float], list[float]],
+) -> tuple[FloatArray, int]:
+    """Jerk-free LP; with a jerk limit then the end caps and the pseudo-jerk iteration."""
+    b = lp.solve(bounds.rows(None), bounds.cols())
+    log[0].append(float(b.sum()))
+    if jmax is None:
+        return b, 0
+    _end_caps(bounds.ub, c1, jmax)
+    start = lp.solve(bounds.rows(None), bounds.cols())
+    log[0].append(float(start.sum()))
+    return _pseudo_jerk(lp, bounds, start, stop=stop, log=log)
+
+
+def _pseudo_jerk(
+    lp: _GridLP,
+    bounds: _Bounds,
+    start: FloatArray,
+    *,
+    stop: tuple[int, float],
+    log: tuple[list[float], list[float]],
+) -> tuple[FloatArray, int]:
+    """Pseudo-jerk fixed-point iteration from ``start``, then the certification LP.
+
+    Starting from an over-estimate (the jerk-free optimum, or the previous
+    plan before a refinement), each LP linearises ``sqrt(b)`` at the previous
+    iterate; the iterates then alternate around the fixed point with
+    shrinking amplitude.  The final LP linearises at
+    ``B = max(b_k, b_{k-1})`` and imposes ``b <= B``, which makes the true
+    grid jerk ``sqrt(b) |X| <= sqrt(B) |X| <= jmax``.
+
+    Parameters
+    ----------
+    lp
+        The grid LP (hot-started between solves).
+    bounds
+        Row/column bounds with the refinement factors.
+    start
+        First linearisation point.
+    stop
+        ``(max_iterations, tolerance)`` on the relative change of ``sqrt(b)``.
+    log
+        Lists that receive the objectives and the relative changes.
+
+    Returns
+    -------
+    tuple
+        Final ``b`` and the number of iterations.
+    """
+    max_iter, tol = stop
+    objectives, changes = log
+    ub = bounds.cols()
+    prev = prev2 = start
+    iterations = 0
+    for _ in range(max_iter):
+        bn = lp.solve(bounds.rows(prev), ub)
+        iterations += 1
+        objectives.append(float(bn.sum()))
+        sq_new = np.sqrt(bn)
+        change = float(np.max(np.abs(sq_new - np.sqrt(prev))) / max(np.max(sq_new), 1e-300))
+        changes.append(change)
+        prev2, prev = prev, bn
+        if change < tol and iterations >= 2:
+            break
+    big = np.maximum(prev, prev2)
+    b = lp.solve(bounds.rows(big), np.minimum(ub, big))
+    objectives.append(float(b.sum()))
+    return b, iterations
+
+
+def _refine(
+    plan: SpeedPlan,
+    lp: _GridLP,
+    bounds: _Bounds,
+    *,
+    target: float | None,
+    rounds: int,
+    stop: tuple[int, float],
+    log: tuple[list[float], list[float]],
+) -> tuple[SpeedPlan, int, float, int]:
+    """Tighten the limits locally and re-solve until the estimated excess meets ``target``.
+
+    Returns
+    -------
+    tuple
+        Final plan, refinement rounds done, its estimated max excess, extra
+        pseudo-jerk iterations.
+    """
+    done = extra = 0
+    while True:
+        excess = _interval_excess(plan)
+        est = float(max(np.max(x) for x in excess))
+        if target is None or est <= target or done >= rounds:
+            return plan, done, est, extra
+        _tighten(bounds, excess, power=1.0 + done)
+        if plan.jmax is None:
+            b = lp.solve(bounds.rows(None), bounds.cols())
+            log[0].append(float(b.sum()))
+        else:
+            b, its = _pseudo_jerk(lp, bounds, plan._bsig, stop=stop, log=log)
+            extra += its
+        spline = _profile_spline(plan._sigma, b, jerk=plan.jmax is not None)
+        plan = replace(plan, _bsig=b, _bspline=spline)
+        done += 1
+
+
+def _interval_excess(plan: SpeedPlan) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Relative speed, acceleration and jerk excess of each grid interval.
+
+    The chain-rule derivatives of the interpolated plan (what
+    :meth:`SpeedPlan.setpoints` outputs and :meth:`SpeedPlan.verify`
+    differences) are evaluated on each interval at ``_SAMPLES`` points, or at
+    least every ``control_period / 10`` of its traversal time (the default
+    resolution of :meth:`SpeedPlan.verify`): the peaks at the kinks of the
+    jerk are narrow.  Acceleration and jerk are measured against the limits
+    the caller asked for (per axis, or the norm), not the LP's polygon.
+
+    Returns
+    -------
+    tuple of ndarray, shape (n - 1,)
+        ``max(ratio - 1, 0)`` per interval for speed, acceleration, jerk.
+    """
+    sig = plan._sigma
+    h = sig[1] - sig[0]
+    dt = _interval_times(plan._bsig, h, jerk=plan.jmax is not None)
+    m = np.clip(np.ceil(dt / (0.1 * plan.control_period)), _SAMPLES, _MAX_SAMPLES).astype(int)
+    start = np.concatenate([[0], np.cumsum(m)[:-1]])
+    frac = (np.arange(int(m.sum())) - np.repeat(start, m)) / np.repeat(m, m)
+    us = np.minimum(np.repeat(sig[:-1], m) + h * frac, 1.0)
+    ud, udd, uddd = plan._derivs(us)
+    c1, c2, c3 = _derivs3(plan._path, us)
+    speed = np.linalg.norm(c1, axis=1) * ud / plan.vmax
+    acc = limit_ratio(c2 * (ud**2)[:, None] + c1 * udd[:, None], plan.amax, plan.norm_sides)
+    out = [speed, acc]
+    if plan.jmax is not None:
+        jerk = c3 * (ud**3)[:, None] + 3.0 * c2 * (ud * udd)[:, None] + c1 * uddd[:, None]
+        out.append(limit_ratio(jerk, plan.jmax, plan.norm_sides))
+    else:
+        out.append(np.zeros_like(speed))
+    ex = [np.maximum(np.maximum.reduceat(x, start) - 1.0, 0.0) for x in out]
+    return ex[0], ex[1], ex[2]
+
+
+def _spread(x: FloatArray, lo: int, hi: int, size: int) -> FloatArray:
+    """``out[i] = max(x[i - hi .. i - lo])`` (clipped), for mapping intervals to nodes."""
+    out = np.zeros(size)
+    for s in range(lo, hi + 1):
+        dst = slice(max(s, 0), min(size, x.size + s))
+        src = slice(max(-s, 0), max(-s, 0) + dst.stop - dst.start)
+        out[dst] = np.maximum(out[dst], x[src])
+    return out
+
+
+def _tighten(
+    bounds: _Bounds, excess: tuple[FloatArray, FloatArray, FloatArray], *, power: float
+) -> None:
+    """Lower the limits near every interval with an excess by ``(1 + excess)**power``.
+
+    Interval ``k`` of the cubic ``w`` interpolant depends on nodes ``k - 1 .. k + 2``;
+    all of them are tightened (speed, jerk), and the acceleration rows of the
+    interval and its neighbours.  The caller raises ``power`` round by round:
+    where the interpolant's jerk is not proportional to the grid's (short
+    features, rest ends) a plain ``1 / (1 + excess)`` converges only
+    geometrically.  The rest-end caps on ``b_1``, ``b_{n-2}`` are jerk limits
+    too (``b_1**1.5`` scales like the jerk) and follow the end intervals.
+    """
+    ev, ea, ej = excess
+    n = bounds.ub.size
+    bounds.speed = bounds.speed / (1.0 + _spread(ev, -1, 2, n)) ** power
+    bounds.jerk = bounds.jerk / (1.0 + _spread(ej, -1, 2, n)) ** power
+    bounds.acc = bounds.acc / (1.0 + _spread(ea, -1, 1, n - 1)) ** power
+    # speed**2 multiplies the column bound, so b scales like (1 + e)**(-2/3).
+    bounds.speed[[1, n - 2]] /= (1.0 + ej[[0, n - 2]]) ** (power / 3.0)

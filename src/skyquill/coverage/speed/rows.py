@@ -1,0 +1,175 @@
+"""The grid LP: its constraint rows, row and column bounds, and the solve."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from scipy import sparse
+
+from skyquill.errors import InfeasibleError, SolverError
+from skyquill.solvers.lp import HOT_SOLVE_LIMIT_S, LinearProgram
+from skyquill.validation import FloatArray
+
+
+def _acc_matrix(u: FloatArray, derivs: tuple[FloatArray, FloatArray], amax: FloatArray) -> Any:
+    """Rows ``(C'' b + 0.5 C' b') / amax`` of the piecewise-linear-``b`` model (bound ``|.| <= 1``).
+
+    Every interval is checked at its two ends, each with the interval's own
+    slope ``b' = (b_{k+1} - b_k) / h``.  Rows are ordered (left end, right
+    end) x axis, ``n - 1`` rows each.  (Midpoint rows change the optimum by
+    ~1e-6 relative on the spiral but cost ~40 % of every simplex pivot; an
+    excess between the nodes is left to the refinement.)
+    """
+    c1, c2 = derivs
+    n, d = c1.shape
+    h = u[1] - u[0]
+    k_idx = np.arange(n - 1)
+    ri = np.concatenate([k_idx, k_idx])
+    ci = np.concatenate([k_idx, k_idx + 1])
+    rows = []
+    for p1, p2, wl in ((c1[:-1], c2[:-1], 1.0), (c1[1:], c2[1:], 0.0)):
+        left = p2 * wl - 0.5 * p1 / h
+        right = p2 * (1.0 - wl) + 0.5 * p1 / h
+        for ax in range(d):
+            data = np.concatenate([left[:, ax], right[:, ax]]) / amax[ax]
+            rows.append(sparse.csr_array((data, (ri, ci)), shape=(n - 1, n)))
+    return sparse.vstack(rows, format="csr")
+
+
+def _jerk_matrix(
+    derivs: tuple[FloatArray, FloatArray, FloatArray], jmax: FloatArray, scale: FloatArray
+) -> Any:
+    """Pseudo-jerk rows ``sqrt(scale_i) X_i(b) / jmax`` at the interior nodes, axis by axis.
+
+    ``X_i = C3 b_i + 1.5 C2 (b_{i+1} - b_{i-1}) / (2h)
+    + 0.5 C1 (b_{i+1} - 2 b_i + b_{i-1}) / h**2`` with ``Ck`` the k-th
+    derivative of the curve.  The linearisation ``sqrt(ref_i) |X_i| <= jmax``
+    becomes the row bound ``sqrt(scale_i / ref_i)``, so the iteration only
+    changes bounds; ``scale`` (a fixed speed-like reference) keeps the rows
+    well scaled.
+    """
+    c1, c2, c3 = derivs
+    n, d = c1.shape
+    h = 1.0 / (n - 1)
+    i_idx = np.arange(1, n - 1)
+    cm = -1.5 * c2[1:-1] / (2 * h) + 0.5 * c1[1:-1] / h**2
+    cc = c3[1:-1] - c1[1:-1] / h**2
+    cp = 1.5 * c2[1:-1] / (2 * h) + 0.5 * c1[1:-1] / h**2
+    r = np.sqrt(scale[1:-1])
+    ri = np.tile(np.arange(n - 2), 3)
+    ci = np.concatenate([i_idx - 1, i_idx, i_idx + 1])
+    blocks = []
+    for ax in range(d):
+        sc = r / jmax[ax]
+        data = np.concatenate([cm[:, ax] * sc, cc[:, ax] * sc, cp[:, ax] * sc])
+        blocks.append(sparse.csr_array((data, (ri, ci)), shape=(n - 2, n)))
+    return sparse.vstack(blocks, format="csr")
+
+
+@dataclass
+class _Bounds:
+    """Row and column bounds of the grid LP, with the per-node refinement factors.
+
+    ``acc`` (per interval), ``jerk`` and ``speed`` (per node) multiply the
+    limits handed to the LP; they start at 1 and are lowered where the
+    time-domain check finds an excess.
+    """
+
+    ub: FloatArray
+    jerk_ref: FloatArray | None
+    d: int
+    acc: FloatArray
+    jerk: FloatArray
+    speed: FloatArray
+
+    def rows(self, ref: FloatArray | None) -> FloatArray:
+        """Row bounds; ``ref`` is the pseudo-jerk linearisation point (None: jerk rows free)."""
+        acc = np.tile(self.acc, 2 * self.d)
+        if self.jerk_ref is None:
+            return acc
+        if ref is None:
+            return np.concatenate([acc, np.full(self.d * (self.ub.size - 2), np.inf)])
+        r = ref[1:-1]
+        with np.errstate(divide="ignore"):
+            jr = np.where(r > 0.0, self.jerk[1:-1] * np.sqrt(self.jerk_ref[1:-1] / r), np.inf)
+        return np.concatenate([acc, np.tile(jr, self.d)])
+
+    def cols(self) -> FloatArray:
+        """Column upper bounds (speed/chord limits, rest ends, refinement)."""
+        return self.ub * self.speed**2
+
+
+def _ones(n: int) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Initial refinement factors: acceleration per interval, jerk and speed per node."""
+    return np.ones(n - 1), np.ones(n), np.ones(n)
+
+
+def _speed_bounds(
+    c1: FloatArray, c2: FloatArray, vmax: float, *, chord_error: float | None, period: float
+) -> tuple[FloatArray, FloatArray]:
+    """Column bounds from the speed (and chord-error) limit, and ``vmax**2 / |C'|**2``."""
+    speed2 = np.sum(c1 * c1, axis=1)
+    ub = vmax**2 / speed2
+    vb = ub.copy()
+    if chord_error is not None:
+        cross2 = np.maximum(speed2 * np.sum(c2 * c2, axis=1) - np.sum(c1 * c2, axis=1) ** 2, 0.0)
+        with np.errstate(divide="ignore"):
+            rho = np.where(cross2 > 0.0, speed2**1.5 / np.sqrt(cross2), np.inf)
+        ub = np.minimum(ub, 8.0 * rho * float(chord_error) / period**2 / speed2)
+    ub[0] = 0.0
+    ub[-1] = 0.0
+    return ub, vb
+
+
+def _end_caps(ub: FloatArray, c1: FloatArray, jmax: FloatArray) -> None:
+    """Cap ``b`` at nodes 1 and ``n - 2`` so the rest-end acceleration ramps at <= jmax.
+
+    The first/last interval is crossed in ``dt = 2h / sqrt(b_1)`` with
+    acceleration ``0.5 C' b_1 / h`` that must build up from 0 at <= jmax:
+    ``0.5 |C'_k| b_1 / h <= jmax_k * 2 h / sqrt(b_1)``.
+    """
+    n = ub.size
+    h = 1.0 / (n - 1)
+    for node in (1, n - 2):
+        with np.errstate(divide="ignore"):
+            cap = (4.0 * jmax * h * h / np.abs(c1[node])) ** (2.0 / 3.0)
+        ub[node] = min(ub[node], float(np.min(cap)))
+
+
+class _GridLP:
+    """``max sum(b)`` s.t. ``|A b| <= r`` row-wise, ``0 <= b <= ub``; re-solved as bounds change.
+
+    One :class:`~skyquill.solvers.lp.LinearProgram` (hot-started with
+    highspy) for the whole plan: a pseudo-jerk iteration or a refinement round
+    only changes bounds.
+    """
+
+    def __init__(self, a: Any, *, backend: str, time_scale: float = 1.0) -> None:
+        # A hot solve's time limit grows with the rows per node: polygon
+        # norm limits have m/2 components where per-axis limits have d (the
+        # first pseudo-jerk LP took 0.24 / 0.5 / 1.15 s at m = 8 / 16 / 32
+        # on the 10 m square spiral, n = 1000).
+        limit = HOT_SOLVE_LIMIT_S * max(1.0, time_scale)
+        self.lp = LinearProgram(a, -np.ones(a.shape[1]), backend=backend, time_limit_s=limit)
+
+    @property
+    def time(self) -> float:
+        """Wall time spent in the LP solver, s."""
+        return self.lp.solve_time_s
+
+    @property
+    def solves(self) -> int:
+        """LPs solved."""
+        return self.lp.solves
+
+    def solve(self, r: FloatArray, ub: FloatArray) -> FloatArray:
+        """Solve with row bounds ``-r <= A b <= r`` (``inf`` = free row) and ``b <= ub``."""
+        self.lp.update_bounds(row_lower=-r, row_upper=r, col_upper=ub)
+        sol = self.lp.solve()
+        if sol.status == "infeasible":
+            raise InfeasibleError("speed-planning LP is infeasible", ("speed_lp",))
+        if sol.x is None:
+            raise SolverError(f"HiGHS failed on the speed-planning LP: {sol.message}")
+        return sol.x

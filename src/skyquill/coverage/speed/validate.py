@@ -1,0 +1,108 @@
+"""Argument checks of :func:`~skyquill.coverage.speed.plan_speed`.
+
+Every message names the argument, what came and what was expected.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+
+from skyquill.errors import InputError
+from skyquill.solvers.lp import LPBackend, resolve_backend
+from skyquill.validation import FloatArray, as_float, as_int, per_axis
+
+#: Grid kinds of :func:`~skyquill.coverage.speed.plan_speed`.
+GRIDS = ("uniform", "adaptive")
+#: Fewest sides of the polygon that holds a norm limit.
+MIN_NORM_SIDES = 4
+
+
+@dataclass(frozen=True)
+class Scalars:
+    """The checked scalar arguments of ``plan_speed``."""
+
+    n: int
+    vmax: float
+    control_period: float
+    chord_error: float | None
+    jerk_iterations: int
+    jerk_tol: float
+    safety: float
+
+
+def _validate(
+    curve: object,
+    n: object,
+    vmax: object,
+    *,
+    control_period: object,
+    chord_error: object,
+    jerk_iterations: object,
+    jerk_tol: object,
+    safety: object,
+) -> Scalars:
+    """Check the curve and the scalar arguments; their clean values."""
+    if not callable(curve):
+        raise InputError(f"curve: got {type(curve).__name__}, expected a callable curve(u, nu=k)")
+    sf = as_float("safety", safety)
+    if not 0.0 < sf <= 1.0:
+        raise InputError(f"safety: got {sf:g}, expected a number in (0, 1]")
+    return Scalars(
+        n=as_int("n", n, low=3),
+        vmax=as_float("vmax", vmax, positive=True),
+        control_period=as_float("control_period", control_period, positive=True),
+        chord_error=None
+        if chord_error is None
+        else as_float("chord_error", chord_error, positive=True),
+        jerk_iterations=as_int("jerk_iterations", jerk_iterations, low=0),
+        jerk_tol=as_float("jerk_tol", jerk_tol, nonneg=True),
+        safety=sf,
+    )
+
+
+def _validate_refine(
+    max_excess: object, refine_rounds: object, lp_backend: str, grid: object
+) -> LPBackend:
+    """Check the refinement/back-end/grid options; returns the back-end actually used."""
+    if grid not in GRIDS:
+        raise InputError(f"grid: got {grid!r}, expected one of {GRIDS}")
+    if max_excess is not None:
+        as_float("max_excess", max_excess, nonneg=True)
+    as_int("refine_rounds", refine_rounds, low=0)
+    return resolve_backend(lp_backend, argument="lp_backend")
+
+
+def _validate_norm_sides(norm_sides: object, d: int) -> int | None:
+    """``None`` (per-axis limits) or an even number of polygon sides >= 4 on a 2-D/3-D path."""
+    if norm_sides is None:
+        return None
+    m = as_int("norm_sides", norm_sides, low=MIN_NORM_SIDES)
+    if m % 2:
+        # The LP's rows are two-sided (|n . a| <= r): a direction and its
+        # opposite come in pairs, so an odd polygon would be held as its
+        # 2m-gon intersection with its reflection.
+        raise InputError(f"norm_sides: got {m}, expected an even integer >= {MIN_NORM_SIDES}")
+    if d not in (2, 3):
+        raise InputError(
+            f"norm_sides: got {m} for a {d}-D path, expected None (norm limits need 2-D or 3-D)"
+        )
+    return m
+
+
+def _validate_limits(
+    amax: float | npt.ArrayLike,
+    jmax: float | npt.ArrayLike | None,
+    d: int,
+    *,
+    norm_sides: int | None,
+) -> tuple[FloatArray, FloatArray | None]:
+    """``amax``, ``jmax`` as ``(d,)`` arrays: per axis, or the one norm limit repeated."""
+    if norm_sides is None:
+        return per_axis("amax", amax, d), None if jmax is None else per_axis("jmax", jmax, d)
+    # A norm limit is one number; an array here would be a per-axis intent.
+    acc = np.full(d, as_float("amax", amax, positive=True))
+    jerk = None if jmax is None else np.full(d, as_float("jmax", jmax, positive=True))
+    return acc, jerk

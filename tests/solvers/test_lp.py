@@ -1,0 +1,87 @@
+"""The rebuild-free LP adapter: both backends against closed forms and each other."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+from skyquill.errors import InputError
+from skyquill.solvers.lp import LinearProgram, highspy_available, resolve_backend
+
+BACKENDS = ["linprog", *(["highspy"] if highspy_available() else [])]
+
+
+def _box_lp(backend: str) -> LinearProgram:
+    # max x + y  s.t.  -1 <= x - y <= 1,  x + 2y <= 4  (rows), 0 <= x, y.
+    a = sp.csr_array(np.array([[1.0, -1.0], [1.0, 2.0]]))
+    lp = LinearProgram(a, [-1.0, -1.0], backend=backend)
+    lp.update_bounds(row_lower=np.array([-1.0, -np.inf]), row_upper=np.array([1.0, 4.0]))
+    return lp
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_optimum_matches_the_vertex(backend: str) -> None:
+    lp = _box_lp(backend)
+    sol = lp.solve()
+    # Vertex of x - y = 1 and x + 2y = 4: x = 2, y = 1.
+    assert sol.status == "optimal" and sol.solver == backend
+    assert sol.x is not None
+    assert np.allclose(sol.x, [2.0, 1.0], atol=1e-9)
+    assert lp.solves == 1 and lp.solve_time_s >= 0.0
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_re_solve_after_bound_changes(backend: str) -> None:
+    lp = _box_lp(backend)
+    lp.solve()
+    lp.update_bounds(col_upper=np.array([1.5, np.inf]))
+    sol = lp.solve()
+    assert sol.x is not None
+    # x capped at 1.5: y = min(1.5 + 1, (4 - 1.5) / 2) = 1.25.
+    assert np.allclose(sol.x, [1.5, 1.25], atol=1e-9)
+    lp.update_bounds(row_upper=np.array([1.0, 1.0]), col_upper=np.array([np.inf, np.inf]))
+    sol = lp.solve()
+    assert sol.x is not None
+    # x - y <= 1 and x + 2y <= 1: x = 1, y = 0.
+    assert np.allclose(sol.x, [1.0, 0.0], atol=1e-9)
+    assert lp.solves == 3
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_infeasible_is_a_status(backend: str) -> None:
+    lp = _box_lp(backend)
+    lp.update_bounds(row_lower=np.array([-1.0, -np.inf]), row_upper=np.array([1.0, -1.0]))
+    sol = lp.solve()
+    assert sol.status == "infeasible" and sol.x is None
+
+
+def test_backends_agree_on_a_random_lp() -> None:
+    if not highspy_available():
+        pytest.skip("highspy not installed")
+    rng = np.random.default_rng(3)
+    a = sp.random_array((40, 25), density=0.3, rng=rng, format="csr")
+    cost = -rng.uniform(0.5, 1.5, 25)
+    xs = []
+    for backend in ("highspy", "linprog"):
+        lp = LinearProgram(a, cost, backend=backend)
+        for scale in (1.0, 0.7):
+            rows = np.full(40, scale)
+            lp.update_bounds(row_lower=-rows, row_upper=rows, col_upper=np.full(25, 3.0))
+            sol = lp.solve()
+        assert sol.x is not None
+        xs.append(sol.x)
+    assert cost @ xs[0] == pytest.approx(cost @ xs[1], rel=1e-9)
+
+
+def test_bad_arguments_are_named() -> None:
+    a = sp.csr_array(np.eye(2))
+    with pytest.raises(InputError, match=r"^cost: got shape"):
+        LinearProgram(a, [1.0, 2.0, 3.0])
+    with pytest.raises(InputError, match=r"^backend: got 'glpk'"):
+        LinearProgram(a, [1.0, 1.0], backend="glpk")
+    with pytest.raises(InputError, match=r"^lp_backend: got 'cplex'"):
+        resolve_backend("cplex")
+    lp = LinearProgram(a, [1.0, 1.0])
+    with pytest.raises(InputError, match=r"^col_upper: got shape"):
+        lp.update_bounds(col_upper=np.ones(3))
