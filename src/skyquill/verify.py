@@ -1,4 +1,4 @@
-"""The one dense check of every trajectory kind (DESIGN.md, "verified").
+"""The one dense check of every trajectory kind (docs/architecture.md, "verified").
 
 :func:`verify` takes any :class:`~skyquill.trajectory.Trajectory`: the
 B-spline a planner holds, or the file a command wrote, read back. The

@@ -12,6 +12,50 @@ from skyquill.optimize.legs import LegLimits, leg_pieces, stop_and_go
 from skyquill.verify import verify
 
 
+def _rest_to_rest(length: float, v: float, a: float, j: float) -> float:
+    """Time-optimal rest-to-rest time of a 1-D jerk-limited move (closed form).
+
+    Reaching speed ``w`` from rest takes ``t(w) = w/a + a/j`` (acceleration
+    limit reached) or ``2 sqrt(w/j)``, over ``w t(w) / 2``; braking mirrors it.
+    """
+
+    def ramp(w: float) -> float:
+        return w / a + a / j if w * j >= a * a else 2.0 * np.sqrt(w / j)
+
+    if v * ramp(v) <= length:
+        return 2.0 * ramp(v) + (length - v * ramp(v)) / v
+    lo, hi = 0.0, v  # the peak speed w with w t(w) = length, by bisection
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if mid * ramp(mid) <= length else (lo, mid)
+    return 2.0 * ramp(lo)
+
+
+@pytest.mark.parametrize("length", [0.3, 2.0, 8.0, 40.0])
+def test_leg_time_is_the_closed_form(length: float) -> None:
+    legs = stop_and_go(np.array([[0.0, 0.0], [length, 0.0]]), LegLimits(3.0, 5.0, 3.0))
+    assert legs.trajectory.duration == pytest.approx(_rest_to_rest(length, 3.0, 5.0, 3.0), rel=1e-6)
+
+
+def test_diagonal_leg_uses_the_per_axis_limits_along_the_line() -> None:
+    # At 45 deg each axis sees a / sqrt(2): the line may accelerate sqrt(2) times harder.
+    box = LegLimits(3.0, np.array([5.0, 5.0]), np.array([3.0, 3.0]), per_axis=True)
+    leg = stop_and_go(np.array([[0.0, 0.0], [6.0, 6.0]]), box).trajectory
+    s2 = np.sqrt(2.0)
+    assert leg.duration == pytest.approx(_rest_to_rest(6 * s2, 3.0, 5 * s2, 3 * s2), rel=1e-6)
+
+
+def test_finite_differences_of_positions_respect_the_limits() -> None:
+    pts = np.array([[0.0, 0.0], [8.0, 0.0], [8.0, 2.0], [0.0, 3.0]])
+    traj = stop_and_go(pts, LegLimits(3.0, 5.0, 3.0)).trajectory
+    t = np.arange(0.0, traj.duration, 0.001)
+    p = traj.evaluate(t)
+    # Finite differences of the positions (independent of Ruckig's own derivatives).
+    assert (np.linalg.norm(np.diff(p, n=3, axis=0), axis=1) / 0.001**3).max() <= 3.0 * 1.001
+    assert (np.linalg.norm(np.diff(p, n=2, axis=0), axis=1) / 0.001**2).max() <= 5.0 * 1.001
+    assert (np.linalg.norm(np.diff(p, axis=0), axis=1) / 0.001).max() <= 3.0 + 1e-6
+
+
 def test_leg_matches_ruckig_and_the_s_curve_closed_form() -> None:
     # 2 m at v 1, a 2, j 5: phases 0.4/0.1/0.4 accelerate, 1.1 cruise (the known S-curve).
     durations, _ = leg_pieces(np.zeros(2), np.array([2.0, 0.0]), LegLimits(1.0, 2.0, 5.0))

@@ -1,7 +1,7 @@
 """Validation at construction: every bad input raises InputError with a useful message.
 
 Each message names the argument, what came and what was expected
-(DESIGN.md); the tests match all three parts where the message has them.
+(docs/architecture.md); the tests match all three parts where the message has them.
 """
 
 from __future__ import annotations

@@ -8,7 +8,6 @@ from typing import Annotated
 import typer
 
 from skyquill.cli.main import OutDir, app, console, user_errors
-from skyquill.io.atomic import write_json
 
 
 @app.command()
@@ -37,11 +36,15 @@ def cover(
     altitude: Annotated[float, typer.Option(help="Flight height, m.")] = 2.0,
 ) -> None:
     """Plan a coverage flight of REGION; write summary.json, trajectory.csv and plot.png."""
-    import numpy as np
-
-    from skyquill.coverage.plan import CoverageOptions, plan_coverage, plan_tuned
+    from skyquill.coverage.plan import (
+        CoverageOptions,
+        coverage_limits,
+        plan_coverage,
+        plan_tuned,
+    )
     from skyquill.coverage.regions import load_region
-    from skyquill.io.points import write_table_csv
+    from skyquill.io.plan_dir import write_plan
+    from skyquill.io.trajectory_json import PlannedTrajectory
     from skyquill.viz.coverage_plot import plot_coverage
 
     with user_errors():
@@ -65,21 +68,22 @@ def cover(
                 plan = plan_coverage(shape, options)
             else:
                 plan = plan_tuned(shape, options, min_coverage)
-    out.mkdir(parents=True, exist_ok=True)
-    sp = plan.setpoints
-    n = sp.t.size
-    zeros = np.zeros((n, 1))
-    table = np.column_stack(
-        [sp.t, sp.p, np.full((n, 1), altitude), sp.v, zeros, sp.a, zeros, sp.j, zeros]
-    )
-    # The spray (pen) is on from the first to the last setpoint: the whole path covers.
-    rows = write_table_csv(out / "trajectory.csv", table, pen=np.ones(n))
-    plot_coverage(plan, out / "plot.png")
-    summary = plan.summary() | {"region": str(region), "trajectory_rows": rows}
-    write_json(out / "summary.json", summary)
+        with console.status("writing and checking the plan"):
+            # The spray is on along the whole path: every part of it covers.
+            planned = PlannedTrajectory(
+                plan.trajectory, ((0.0, plan.duration),), coverage_limits(plan.options)
+            )
+            summary = write_plan(
+                out,
+                [planned],
+                rate=rate,
+                guaranteed=False,
+                summary=plan.summary() | {"region": str(region)},
+                plot=lambda path: plot_coverage(plan, path),
+            )
     console.print(
         f"{plan.options.pattern}: {plan.duration:.2f} s, {plan.path_length:.1f} m, "
-        f"coverage {plan.coverage:.4f}, max excess {plan.limits['max_excess']:.4f}, "
+        f"coverage {plan.coverage:.4f}, max excess {summary['plan']['max_excess']:.4f}, "
         f"planned in {plan.planning_time:.2f} s -> {out}",
         highlight=False,
     )

@@ -1,4 +1,4 @@
-"""Coverage missions end to end: region -> covering path -> timed, verified setpoints.
+"""Coverage missions end to end: region -> covering path -> timed, verified trajectory.
 
 Three patterns, compared on equal terms (paper ``001_61beb0e01a19013a`` §4):
 
@@ -36,10 +36,13 @@ from skyquill.coverage.paths import (
     zigzag,
 )
 from skyquill.coverage.regions import check_width, coverage_fraction
-from skyquill.coverage.speed import Setpoints, SpeedPlan, Verification, plan_speed
-from skyquill.coverage.stopgo import stop_and_go_legs, stop_and_go_setpoints
+from skyquill.coverage.speed import SpeedPlan, plan_speed
 from skyquill.errors import InfeasibleError, InputError
+from skyquill.limits import BoxLimit, CylinderLimit, DerivativeLimit
+from skyquill.optimize.legs import LegLimits, stop_and_go
+from skyquill.trajectory import Samples, Trajectory, concatenate
 from skyquill.validation import as_float, as_int
+from skyquill.verify import Verification, verify
 
 FloatArray = NDArray[np.float64]
 Pattern = Literal["spiral", "zigzag", "zigzag-stop"]
@@ -152,12 +155,14 @@ class CoveragePlan:
         The control polygon (spline patterns) or the stop points (zigzag-stop), m.
     path : ndarray, shape (M, 2)
         The flown path, densely sampled (every ~2 cm), m.
-    setpoints : Setpoints
-        Time-domain samples at ``options.rate`` (2-D: x, y).
+    trajectory : Trajectory
+        The flight at ``options.altitude``, 3-D: a retimed path (spline
+        patterns), straight legs (stop-and-go) or parts at rest between them.
     coverage : float
         Covered fraction of the region's area.
     limits : dict
-        Measured maxima and excess (see :func:`limits_report`).
+        The dense check of ``trajectory`` against :func:`coverage_limits`
+        (see :func:`limits_report`) and ``joins``.
     planning_time : float
         Wall time of :func:`plan_coverage`, s.
     speed_plan : SpeedPlan or None
@@ -168,7 +173,7 @@ class CoveragePlan:
     options: CoverageOptions
     waypoints: FloatArray
     path: FloatArray
-    setpoints: Setpoints
+    trajectory: Trajectory
     coverage: float
     limits: dict[str, Any]
     planning_time: float
@@ -177,7 +182,11 @@ class CoveragePlan:
     @property
     def duration(self) -> float:
         """Flight time from rest to rest, s."""
-        return float(self.setpoints.t[-1])
+        return self.trajectory.duration
+
+    def samples(self) -> Samples:
+        """The trajectory sampled at ``options.rate`` (the setpoints a controller gets)."""
+        return self.trajectory.sample(self.options.rate)
 
     @property
     def path_length(self) -> float:
@@ -362,13 +371,14 @@ def plan_coverage(region: Polygon, options: CoverageOptions | None = None) -> Co
         # each part's spiral rest to rest instead, joined by straight legs.
         waypoints, path, timed = _stop_between_parts(region, opts)
         joins = "stop"
-    setpoints, limits, speed_plan = timed
+    trajectory, speed_plan = timed
+    limits = limits_report(verify(trajectory, coverage_limits(opts), guaranteed=False))
     return CoveragePlan(
         region=region,
         options=opts,
         waypoints=waypoints,
         path=path,
-        setpoints=setpoints,
+        trajectory=trajectory,
         coverage=coverage_fraction(region, path, opts.width),
         limits=limits | {"joins": joins},
         planning_time=time.perf_counter() - start,
@@ -376,20 +386,41 @@ def plan_coverage(region: Polygon, options: CoverageOptions | None = None) -> Co
     )
 
 
-_Timed = tuple[Setpoints, dict[str, Any], SpeedPlan | None]
+_Timed = tuple[Trajectory, SpeedPlan | None]
+
+
+def coverage_limits(options: CoverageOptions) -> tuple[DerivativeLimit, ...]:
+    """The limits of a coverage flight (3-D, at constant height), as the verifier states them.
+
+    The speed is the norm; acceleration and jerk per axis, or horizontal norms
+    with ``limit_norm_sides``.
+    """
+
+    def norm(order: int, bound: float) -> CylinderLimit:
+        return CylinderLimit(order, bound, z_lower=-bound, z_upper=bound)
+
+    if options.limit_norm_sides is not None:
+        return (norm(1, options.vmax), norm(2, options.amax), norm(3, options.jmax))
+    return (
+        norm(1, options.vmax),
+        BoxLimit.symmetric(2, options.amax, 3),
+        BoxLimit.symmetric(3, options.jmax, 3),
+    )
+
+
+def _lifted(points: FloatArray, altitude: float) -> FloatArray:
+    return np.column_stack([points, np.full(points.shape[0], altitude)])
 
 
 def _timed_path(waypoints: FloatArray, path: FloatArray, opts: CoverageOptions) -> _Timed:
-    """Setpoints, limits report and speed plan (``None`` for stop-and-go) of one path."""
-    period = 1.0 / opts.rate
+    """The path's trajectory at the flight height and its speed plan (``None`` for stop-and-go)."""
     if opts.pattern == "zigzag-stop":
-        norm = opts.limit_norm_sides is not None
-        legs = stop_and_go_legs(waypoints, opts.vmax, opts.amax, opts.jmax, norm=norm)
-        fine = stop_and_go_setpoints(legs, period / 10.0)
-        return stop_and_go_setpoints(legs, period), limits_report(fine, opts), None
+        legs = LegLimits(opts.vmax, opts.amax, opts.jmax, per_axis=opts.limit_norm_sides is None)
+        flown = stop_and_go(_lifted(waypoints, opts.altitude), legs)
+        return flown.trajectory, None
     n = opts.grid or grid_points(_length(path))
-    speed_plan, verification = _timed(spiral_curve(waypoints), opts, n)
-    return speed_plan.setpoints(), _lp_limits(verification, opts), speed_plan
+    speed_plan, trajectory = _timed(spiral_curve(waypoints), opts, n)
+    return trajectory, speed_plan
 
 
 def _stop_between_parts(
@@ -412,34 +443,13 @@ def _stop_between_parts(
             pieces.append(_piece(spiral, stop, _densified(spiral)))
     waypoints = np.vstack([p[0] for p in pieces])
     path = np.vstack([p[1] for p in pieces])
-    setpoints = _concatenated([p[2][0] for p in pieces], 1.0 / opts.rate)
-    reports = [p[2][1] for p in pieces]
-    limits = {
-        "max_speed": max(r["max_speed"] for r in reports),
-        "max_acc": np.max([r["max_acc"] for r in reports], axis=0).tolist(),
-        "max_jerk": np.max([r["max_jerk"] for r in reports], axis=0).tolist(),
-        "max_excess": max(r["max_excess"] for r in reports),
-    }
-    return waypoints, path, (setpoints, limits, None)
+    return waypoints, path, (concatenate([p[2][0] for p in pieces]), None)
 
 
 def _piece(
     waypoints: FloatArray, opts: CoverageOptions, path: FloatArray
 ) -> tuple[FloatArray, FloatArray, _Timed]:
     return waypoints, path, _timed_path(waypoints, path, opts)
-
-
-def _concatenated(parts: list[Setpoints], period: float) -> Setpoints:
-    """Rest-to-rest setpoints one after the other (each next one's first sample dropped)."""
-    t, arrays = [parts[0].t], [[p] for p in (parts[0].p, parts[0].v, parts[0].a, parts[0].j)]
-    for part in parts[1:]:
-        t.append(t[-1][-1] + part.t[1:])
-        for store, x in zip(arrays, (part.p, part.v, part.a, part.j), strict=True):
-            store.append(x[1:])
-    p, v, a, j = (np.vstack(x) for x in arrays)
-    travelled = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(p, axis=0), axis=1))])
-    u = travelled / max(float(travelled[-1]), 1e-300)
-    return Setpoints(t=np.concatenate(t), u=u, p=p, v=v, a=a, j=j, period=period)
 
 
 #: Degree of the covering splines (paper 001: 4, so that jerk is differentiable).
@@ -454,8 +464,11 @@ GRID_LADDER: tuple[tuple[int, Literal["uniform", "adaptive"]], ...] = (
 )
 
 
-def _timed(curve: Any, options: CoverageOptions, n: int) -> tuple[SpeedPlan, Verification]:
-    """The speed plan on the first grid of :data:`GRID_LADDER` that verifies, and its check.
+def _timed(curve: Any, options: CoverageOptions, n: int) -> tuple[SpeedPlan, Trajectory]:
+    """The speed plan on the first grid of :data:`GRID_LADDER` that verifies, and its trajectory.
+
+    The check is the one dense check of the trajectory the plan becomes (the
+    one that is written and flown), not of the planner's own setpoints.
 
     A turn shorter than a grid cell (a join of a multi-spiral, the hook at a
     spiral's end) can make the grid LP stop the vehicle between two nodes --
@@ -481,10 +494,10 @@ def _timed(curve: Any, options: CoverageOptions, n: int) -> tuple[SpeedPlan, Ver
         except InfeasibleError as exc:
             seen.append(f"{kind} grid of {factor * n}: {exc}")
             continue
-        verification = plan.verify()
-        excess = verification.max_excess
+        trajectory = plan.trajectory(options.altitude)
+        excess = verify(trajectory, coverage_limits(options), guaranteed=False).max_excess
         if excess <= MAX_EXCESS:
-            return plan, verification
+            return plan, trajectory
         seen.append(f"{kind} grid of {factor * n}: excess {100 * excess:.1f} %")
     raise InfeasibleError(
         f"pattern {options.pattern!r}: could not time the path within the limits ("
@@ -515,52 +528,12 @@ def _vertex_distances(line: LineString) -> FloatArray:
     return np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(xy, axis=0), axis=1))])
 
 
-def limits_report(setpoints: Setpoints, options: CoverageOptions) -> dict[str, Any]:
-    """Largest speed, per-axis |acceleration| and |jerk| of ``setpoints``, and the excess.
-
-    ``max_excess`` is the largest relative excess over any limit (0 when all
-    hold); with ``limit_norm_sides`` the acceleration and jerk are measured
-    by their norms.
-    """
-    speed = float(np.max(np.linalg.norm(setpoints.v, axis=1)))
-    acc = np.max(np.abs(setpoints.a), axis=0)
-    jerk = np.max(np.abs(setpoints.j), axis=0)
-    if options.limit_norm_sides is None:
-        return _report(speed, acc, jerk, options)
-    excess = max(
-        speed / options.vmax - 1.0,
-        float(np.max(np.linalg.norm(setpoints.a, axis=1))) / options.amax - 1.0,
-        float(np.max(np.linalg.norm(setpoints.j, axis=1))) / options.jmax - 1.0,
-        0.0,
-    )
-    return _report(speed, acc, jerk, options) | {"max_excess": excess}
-
-
-def _lp_limits(ver: Verification, options: CoverageOptions) -> dict[str, Any]:
-    """The limits report of a speed plan, from finite differences of its positions.
-
-    :meth:`SpeedPlan.verify` differences the setpoints' positions on a grid ten
-    times finer than the control period: a check independent of the chain
-    rule that produced the setpoints' own velocity, acceleration and jerk.
-    """
-    jerk = ver.max_jerk if ver.max_jerk is not None else np.zeros_like(ver.max_acc)
-    report = _report(ver.max_speed, ver.max_acc, jerk, options)
-    # With norm limits the plan's own check measured the norms.
-    return report if options.limit_norm_sides is None else report | {"max_excess": ver.max_excess}
-
-
-def _report(
-    speed: float, acc: FloatArray, jerk: FloatArray, options: CoverageOptions
-) -> dict[str, Any]:
-    excess = max(
-        speed / options.vmax - 1.0,
-        float(acc.max()) / options.amax - 1.0,
-        float(jerk.max()) / options.jmax - 1.0,
-        0.0,
-    )
+def limits_report(check: Verification) -> dict[str, Any]:
+    """Largest speed, per-axis |acceleration| and |jerk|, and the largest relative excess."""
     return {
-        "max_speed": speed,
-        "max_acc": acc.tolist(),
-        "max_jerk": jerk.tolist(),
-        "max_excess": excess,
+        "max_speed": check.max_speed,
+        "max_acc": list(check.max_acc),
+        "max_jerk": list(check.max_jerk),
+        "max_excess": check.max_excess,
+        "limits": check.limits_report(),
     }

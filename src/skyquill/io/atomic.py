@@ -1,7 +1,7 @@
 """Files written whole or not at all: a temporary file in the same folder, then a rename.
 
 An interrupted run leaves the previous file or the new one, never half of one
-(DESIGN.md "Outputs and errors"); the rename is atomic on POSIX within one file
+(docs/architecture.md "Outputs and errors"); the rename is atomic on POSIX within one file
 system, which a temporary file in the same folder guarantees.
 """
 

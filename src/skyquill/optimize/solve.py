@@ -42,7 +42,7 @@ from skyquill.verify import Verification
 
 log = logging.getLogger(__name__)
 
-#: Hull constraints must hold to this relative tolerance (DESIGN.md: 1e-9).
+#: Hull constraints must hold to this relative tolerance (docs/architecture.md: 1e-9).
 GUARANTEE_RTOL = 1e-9
 _MARGINS = (1e-9, 1e-8, 1e-7, 1e-6, 1e-5)
 _DENSE_KKT = 300

@@ -15,7 +15,7 @@ import numpy as np
 from skyquill.errors import InputError
 from skyquill.validation import FloatArray, as_array, as_float
 
-#: DESIGN.md "verified": at least 20 samples per knot span and never fewer than 10,000.
+#: docs/architecture.md "verified": at least 20 samples per knot span and never fewer than 10,000.
 DENSE_PER_SPAN = 20
 DENSE_MIN_TOTAL = 10_000
 #: Most samples one call of :func:`sample_times` may produce (memory: 13 columns
@@ -116,7 +116,7 @@ def sample(traj: Trajectory, rate: float) -> Samples:
 
 
 def dense_times(breakpoints: FloatArray) -> FloatArray:
-    """Times for the dense check (DESIGN.md): >= 20 per span and >= 10,000 in all.
+    """Times for the dense check (docs/architecture.md): >= 20 per span and >= 10,000 in all.
 
     Every span between consecutive ``breakpoints`` (L + 1,) gets the same number
     of evenly spaced samples, both ends of every span included, so that short

@@ -139,7 +139,7 @@ class SplineTrajectory:
     def verify(
         self, limits: Sequence[DerivativeLimit] = (), corridors: Sequence[Region] = ()
     ) -> Verification:
-        """The dense check (DESIGN.md) of this trajectory against ``limits`` and ``corridors``."""
+        """The dense check (docs/architecture.md) against ``limits`` and ``corridors``."""
         from skyquill.verify import verify  # the verifier imports the trajectory kinds
 
         return verify(self, limits, corridors)

@@ -39,7 +39,7 @@ def plot_coverage(plan: CoveragePlan, path: str | Path) -> None:
         PNG file to write.
     """
     opts = plan.options
-    sp = plan.setpoints
+    sp = plan.samples()
     fig = plt.figure(figsize=(13, 6.5), layout="constrained")
     grid = fig.add_gridspec(3, 2, width_ratios=(1.1, 1.0))
     top = fig.add_subplot(grid[:, 0])
@@ -60,8 +60,8 @@ def plot_coverage(plan: CoveragePlan, path: str | Path) -> None:
     )
     rows = (
         ("speed (m/s)", speed[:, None], opts.vmax),
-        ("|acc| (m/s²)", np.abs(sp.a), opts.amax),
-        ("|jerk| (m/s³)", np.abs(sp.j), opts.jmax),
+        ("|acc| (m/s²)", np.abs(sp.a[:, :2]), opts.amax),
+        ("|jerk| (m/s³)", np.abs(sp.j[:, :2]), opts.jmax),
     )
     for k, (label, values, limit) in enumerate(rows):
         ax = fig.add_subplot(grid[k, 1])

@@ -67,6 +67,6 @@ refinement), :mod:`.grid` (the adaptive grid), :mod:`.validate` and
 
 from skyquill.coverage.speed.curve import PathCurve
 from skyquill.coverage.speed.plan import plan_speed
-from skyquill.coverage.speed.profile import Setpoints, SpeedPlan, Verification
+from skyquill.coverage.speed.profile import Setpoints, SpeedPlan
 
-__all__ = ["PathCurve", "Setpoints", "SpeedPlan", "Verification", "plan_speed"]
+__all__ = ["PathCurve", "Setpoints", "SpeedPlan", "plan_speed"]

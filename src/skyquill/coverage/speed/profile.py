@@ -11,9 +11,11 @@ import numpy as np
 from scipy.interpolate import BSpline, PPoly, make_interp_spline
 
 from skyquill.coverage.speed.curve import PathCurve, _eval
-from skyquill.coverage.speed.norms import limit_ratio
 from skyquill.errors import InfeasibleError, InputError
+from skyquill.limits import BoxLimit, CylinderLimit, DerivativeLimit
+from skyquill.trajectory import RetimedPath
 from skyquill.validation import FloatArray
+from skyquill.verify import Verification, verify
 
 #: Largest step of the Taylor walk, as a fraction of the control period.
 _WALK_FRACTION = 0.25
@@ -42,38 +44,6 @@ class Setpoints:
     v: FloatArray
     a: FloatArray
     j: FloatArray
-    period: float
-
-
-@dataclass(frozen=True, eq=False)
-class Verification:
-    """Limits measured on finite differences of the setpoints.
-
-    Attributes
-    ----------
-    max_speed : float
-        Largest speed (first differences).
-    max_acc : ndarray, shape (d,)
-        Per-axis largest ``|a|`` (second central differences).
-    max_jerk : ndarray, shape (d,) or None
-        Per-axis largest ``|j|`` (third differences); None without jerk limit.
-    speed_excess, acc_excess, jerk_excess : float
-        Relative excess over the respective limit (0 when respected): per
-        axis, or of the norm when the plan holds norm limits
-        (``SpeedPlan.norm_sides``).
-    max_excess : float
-        Largest of the three relative excesses.
-    period : float
-        Sampling period used for the differences.
-    """
-
-    max_speed: float
-    max_acc: FloatArray
-    max_jerk: FloatArray | None
-    speed_excess: float
-    acc_excess: float
-    jerk_excess: float
-    max_excess: float
     period: float
 
 
@@ -180,13 +150,26 @@ class SpeedPlan:
         T = self.control_period if period is None else float(period)
         if not np.isfinite(T) or T <= 0.0:
             raise InputError(f"period must be a positive finite number, got {period!r}")
+        return self._samples(self.walk(T), T)
+
+    def walk(self, period: float) -> FloatArray:
+        """The planning parameter every ``period`` s from 0 (rest) to 1 (rest), shape (m,).
+
+        The last step is shorter than ``period`` (the walk snaps to 1).
+        """
         if self.jmax is None:
-            return self._samples(self._exact_walk(T), T)
-        sub = max(1, math.ceil(T / (_WALK_FRACTION * self.control_period) - 1e-9))
-        u = self._taylor_walk(T / sub)[::sub]
+            return self._exact_walk(period)
+        sub = max(1, math.ceil(period / (_WALK_FRACTION * self.control_period) - 1e-9))
+        u = self._taylor_walk(period / sub)[::sub]
         if u[-1] < 1.0:
             u = np.append(u, 1.0)
-        return self._samples(u, T)
+        return u
+
+    def trajectory(self, z: float | None = None) -> RetimedPath:
+        """The plan as a trajectory (:func:`~skyquill.coverage.speed.retime.retimed_path`)."""
+        from skyquill.coverage.speed.retime import retimed_path
+
+        return retimed_path(self, z)
 
     def _exact_walk(self, T: float) -> FloatArray:
         """Sample ``u(t)`` of the piecewise-linear-``b`` model at period ``T``.
@@ -295,49 +278,39 @@ class SpeedPlan:
         u_out = uarr if self._umap is None else np.clip(self._umap(uarr), 0.0, 1.0)
         return Setpoints(t=t, u=u_out, p=c0, v=v, a=a, j=j, period=T)
 
-    def verify(self, period: float | None = None) -> Verification:
-        """Measure speed, acceleration and jerk of the setpoints by finite differences.
+    def limits(self, dim: int) -> tuple[DerivativeLimit, ...]:
+        """The plan's limits as the verifier states them for a ``dim``-axis trajectory.
 
-        Parameters
-        ----------
-        period : float, optional
-            Sampling period of the setpoints that are differenced; defaults to
-            ``control_period / 10`` (a fine grid).
-
-        Returns
-        -------
-        Verification
-            Per-axis maxima and relative excesses over the limits (over the
-            norm limits when ``norm_sides`` is set).
+        The speed is a norm (the LP holds ``|C'|^2 b <= vmax^2``); acceleration
+        and jerk are per-axis boxes, or norms with ``norm_sides``. A 3-D
+        trajectory of a 2-D plan (lifted to a height) has those norms horizontal.
         """
-        T = self.control_period / 10.0 if period is None else float(period)
-        sp = self.setpoints(T)
-        # Rest before and after: pad with the end points so that a start or
-        # stop with non-zero acceleration shows up as jerk.
-        p = np.concatenate([np.repeat(sp.p[:1], 3, axis=0), sp.p, np.repeat(sp.p[-1:], 3, axis=0)])
-        vel = np.diff(p, axis=0) / T
-        acc = np.diff(p, n=2, axis=0) / T**2
-        max_speed = float(np.max(np.linalg.norm(vel, axis=1)))
-        max_acc = np.max(np.abs(acc), axis=0)
-        speed_ex = max(max_speed / self.vmax - 1.0, 0.0)
-        acc_ex = max(float(np.max(limit_ratio(acc, self.amax, self.norm_sides))) - 1.0, 0.0)
-        max_jerk: FloatArray | None = None
-        jerk_ex = 0.0
-        if self.jmax is not None:
-            jerk = np.diff(p, n=3, axis=0) / T**3
-            max_jerk = np.max(np.abs(jerk), axis=0)
-            ratio = limit_ratio(jerk, self.jmax, self.norm_sides)
-            jerk_ex = max(float(np.max(ratio)) - 1.0, 0.0)
-        return Verification(
-            max_speed=max_speed,
-            max_acc=max_acc,
-            max_jerk=max_jerk,
-            speed_excess=speed_ex,
-            acc_excess=acc_ex,
-            jerk_excess=jerk_ex,
-            max_excess=max(speed_ex, acc_ex, jerk_ex),
-            period=T,
-        )
+        out: list[DerivativeLimit] = [_norm_limit(1, self.vmax, dim)]
+        for order, bound in ((2, self.amax), (3, self.jmax)):
+            if bound is None:
+                continue
+            if self.norm_sides is not None:
+                out.append(_norm_limit(order, float(np.min(bound)), dim))
+            else:
+                upper = np.resize(np.asarray(bound, dtype=float), dim)
+                out.append(BoxLimit(order, -upper, upper))
+        return tuple(out)
+
+    def verify(self, z: float | None = None) -> Verification:
+        """The one dense check (:func:`skyquill.verify.verify`) of :meth:`trajectory`.
+
+        The limits are held on the LP's grid only: they are reported as not
+        guaranteed, with the excess measured.
+        """
+        traj = self.trajectory(z)
+        return verify(traj, self.limits(traj.dim), guaranteed=False)
+
+
+def _norm_limit(order: int, bound: float, dim: int) -> CylinderLimit:
+    """``|horizontal derivative| <= bound`` (and the vertical component within it in 3-D)."""
+    if dim == 3:
+        return CylinderLimit(order, bound, z_lower=-bound, z_upper=bound)
+    return CylinderLimit(order, bound)
 
 
 def _profile_spline(sig: FloatArray, b: FloatArray, *, jerk: bool) -> BSpline:
