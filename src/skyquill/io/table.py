@@ -193,7 +193,7 @@ def _parse(name: str, text: Iterator[str], wanted: _Wanted, min_rows: int, max_r
         for row in rows:
             line = reader.line_num
             _check_row(f"{name} line {line}", len(row), len(header), len(lines), max_rows)
-            values.extend(parse_cell(name, line, c, row, i) for c, i in index)
+            values.extend(_cell(name, line, c, row, i) for c, i in index)
             lines.append(line)
     except csv.Error as exc:
         raise InputError(
@@ -252,27 +252,26 @@ def _check_header(name: str, header: list[str], wanted: _Wanted) -> tuple[str, .
     repeated = sorted({c for c in header if header.count(c) > 1})
     if repeated:
         raise InputError(
-            f"{name}: got column(s) {','.join(repeated)} more than once, expected each column once"
+            f"{name}: got column(s) {_names(repeated)} more than once, expected each column once"
         )
     missing = [c for c in wanted.required if c not in header]
     if missing:
         raise InputError(
-            f"{name}: got columns {header}, expected {wanted.describe()}; "
+            f"{name}: got columns {_shorten(str(header), 200)}, expected {wanted.describe()}; "
             f"missing {','.join(missing)}"
         )
     known = wanted.required + wanted.optional
     extra = [c for c in header if c not in known]
     if extra and wanted.unknown == "refuse":
         raise InputError(
-            f"{name}: got unknown column(s) {','.join(map(repr, extra))}, expected only "
-            f"{','.join(known)}"
+            f"{name}: got unknown column(s) {_names(extra)}, expected only {','.join(known)}"
         )
     return wanted.required + tuple(c for c in wanted.optional if c in header)
 
 
-def parse_cell(name: str, line: int, column: str, row: Sequence[str], i: int) -> float:
+def _cell(name: str, line: int, column: str, row: Sequence[str], i: int) -> float:
     """Cell ``i`` of a CSV ``row`` as a finite float; InputError naming file, line, column."""
-    text = row[i].strip() if i < len(row) else ""
+    text = row[i].strip()
     try:
         value = float(text)
     except ValueError:
@@ -284,6 +283,11 @@ def parse_cell(name: str, line: int, column: str, row: Sequence[str], i: int) ->
             f"{name} line {line}, column {column}: got {_shorten(text)!r}, expected a finite number"
         )
     return value
+
+
+def _names(columns: Sequence[str]) -> str:
+    """Column names as written in messages: quoted, so that an empty name shows."""
+    return _shorten(",".join(map(repr, columns)), 200)
 
 
 def _shorten(text: str, limit: int = 40) -> str:
