@@ -134,7 +134,7 @@ def plan_show(
         ``pip install 'skyquill[dask]'`` here, and skyquill on a remote
         cluster's workers. The missions are the same as planned locally.
     board_kind
-        ``"horizontal"`` boards (paper 000) or ``"wall"`` s, see :func:`layout`.
+        ``"horizontal"`` boards (paper 000) or ``"wall"``; see :func:`layout`.
     lift_m
         Brush lift between strokes, m.
     fly
