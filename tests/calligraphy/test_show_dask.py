@@ -88,3 +88,10 @@ def test_missing_dask_names_the_extra(
     monkeypatch.setitem(sys.modules, "distributed", None)
     with pytest.raises(InputError, match=r"pip install 'skyquill\[dask\]'"):
         plan_show(parts, OPTIONS, SEPARATION_M, scheduler="local")
+
+
+def test_progress_as_the_cluster_returns_each_drone(parts: list[Strokes]) -> None:
+    calls: list[tuple[int, int, str]] = []
+    plan_show(parts, OPTIONS, SEPARATION_M, scheduler="local", progress=lambda *c: calls.append(c))
+    assert [c[:2] for c in calls] == [(0, 2), (1, 2), (2, 2)]
+    assert sorted(c[2] for c in calls[1:]) == ["planned drone 1 of 2", "planned drone 2 of 2"]

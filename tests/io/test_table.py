@@ -55,8 +55,9 @@ def test_header_only_gives_an_empty_table(tmp_path: Path) -> None:
     [
         ("", "t.csv: got an empty file, expected a header line with columns x,y"),
         ("\n \n,\n", "t.csv: got an empty file"),
-        ("x,y,x\n1,2,3\n", "t.csv: got column.s. x more than once, expected each column once"),
-        ("X, x ,y\n1,2,3\n", "got column.s. x more than once"),
+        ("x,y,x\n1,2,3\n", "t.csv: got column.s. 'x' more than once, expected each column once"),
+        ("X, x ,y\n1,2,3\n", "got column.s. 'x' more than once"),
+        ("x,y,,\n1,2,,\n", "got column.s. '' more than once"),
         (
             "a,b\n1,2\n",
             r"t.csv: got columns \['a', 'b'\], expected columns x,y \(optionally z; other "

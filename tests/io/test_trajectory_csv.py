@@ -176,7 +176,7 @@ BAD = [
         r"line 3, column vx: got 1e\+09, expected a magnitude of at most 1e\+06",
     ),
     (rows(3, (*REQUIRED_COLUMNS, "jx")), "got jerk column.s. jx, expected all of jx,jy,jz or none"),
-    (rows().replace("\n", ",0\n").replace("jz,0", "jz,vx"), r"got column\(s\) vx more than once"),
+    (rows().replace("\n", ",0\n").replace("jz,0", "jz,vx"), r"got column\(s\) 'vx' more than once"),
     ('t,x\n"0,0\n', "traj.csv: got columns"),
 ]
 

@@ -3,7 +3,9 @@
 Each drone gets its own board and home, its mission is planned in a process
 of its own (planning is CPU-bound and independent), they all start together,
 and the pairwise separation is checked over the whole flight, take-off and
-landing included: a violation is an error.
+landing included: a violation is an error. Optionally each mission is then
+flown in closed-loop simulation over its board. This is the one show planner:
+``skyquill write`` and the studio both call :func:`plan_show`.
 
 For large shows the planning can go to a ``dask.distributed`` cluster instead
 of the local process pool (``plan_show(..., scheduler="tcp://host:8786")``,
@@ -12,19 +14,28 @@ needs ``pip install 'skyquill[dask]'``); the missions are the same.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-from concurrent.futures import ProcessPoolExecutor
+from collections.abc import Callable, Iterator, Sequence
+from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
 from types import ModuleType
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 
 from skyquill.calligraphy.board import Board
-from skyquill.calligraphy.mission import Mission, WritingOptions, check_separation, plan_writing
+from skyquill.calligraphy.mission import (
+    Mission,
+    WritingOptions,
+    check_separation,
+    contact_board,
+    plan_writing,
+)
 from skyquill.errors import InputError
 from skyquill.strokes import Strokes
 from skyquill.validation import FloatArray, as_float, as_int
+
+if TYPE_CHECKING:
+    from skyquill.sim import Flight
 
 #: Extra room between boards beyond the required separation, m (lifts, transits).
 BOARD_MARGIN_M = 0.25
@@ -35,14 +46,34 @@ SCHEDULER_TIMEOUT_S = 5.0
 #: One drone's planning job: the arguments of :func:`plan_writing`.
 Job = tuple[Strokes, Board, WritingOptions, FloatArray]
 
+#: ``progress(done, total, stage)``: called with ``done = 0`` before the first step and
+#: after each step of a show (one drone planned, one drone flown), in the calling
+#: process; ``stage`` says what was just done, for a person. It may raise to stop the
+#: show (pending drones are cancelled).
+Progress = Callable[[int, int, str], None]
+
 
 @dataclass(frozen=True)
 class Show:
-    """Planned missions of every drone and their closest approach."""
+    """Planned missions of every drone and their closest approach.
+
+    Attributes
+    ----------
+    missions
+        One per drone, in the order of the parts.
+    homes
+        Each drone's take-off and landing point, shape (3,), m, world frame.
+    min_separation_m
+        Smallest distance between two drones over the whole show, m (``inf`` for one).
+    flights
+        Each mission flown in closed loop (:func:`fly_mission`) when asked
+        (``plan_show(..., fly=True)``), else empty.
+    """
 
     missions: tuple[Mission, ...]
     homes: tuple[FloatArray, ...]
     min_separation_m: float
+    flights: tuple[Flight, ...] = ()
 
 
 def layout(
@@ -78,6 +109,8 @@ def plan_show(
     scheduler: str | None = None,
     board_kind: Literal["horizontal", "wall"] = "horizontal",
     lift_m: float = 0.05,
+    fly: bool = False,
+    progress: Progress | None = None,
 ) -> Show:
     """Plan one mission per part (one drone each) and check their separation.
 
@@ -100,52 +133,129 @@ def plan_show(
         processes=False)`` started for this call and closed after it. Needs
         ``pip install 'skyquill[dask]'`` here, and skyquill on a remote
         cluster's workers. The missions are the same as planned locally.
+    board_kind
+        ``"horizontal"`` boards (paper 000) or ``"wall"``; see :func:`layout`.
+    lift_m
+        Brush lift between strokes, m.
+    fly
+        Also fly every mission in closed-loop simulation, in this process, after
+        the separation check (:attr:`Show.flights`).
+    progress
+        See :data:`Progress`; with a process pool or a cluster it is called as
+        the drones arrive, in any order. ``total`` is the number of drones,
+        twice that with ``fly``.
 
     Returns
     -------
     Show
-        The missions, homes and closest approach.
+        The missions, homes, closest approach and, with ``fly``, the flights.
 
     Raises
     ------
     InputError
         Separation not positive, dask not installed, or the scheduler not
         reachable within :data:`SCHEDULER_TIMEOUT_S`.
+    InfeasibleError
+        A drone cannot be planned, or two drones come closer than ``separation_m``.
     """
     opts = options or WritingOptions()
     separation = as_float("separation_m", separation_m, positive=True)
     places = layout(len(parts), opts.size_m, separation, kind=board_kind, lift_m=lift_m)
     jobs = [(part, board, opts, home) for part, (board, home) in zip(parts, places, strict=True)]
-    missions = _plan_all(jobs, workers, scheduler)
+    steps = _Steps(len(jobs) * (2 if fly else 1), progress)
+    steps.start(f"planning {len(jobs)} drone(s)")
+    missions = _plan_all(jobs, workers, scheduler, steps)
     closest = check_separation([m.trajectory for m in missions], separation)
-    return Show(tuple(missions), tuple(home for _, home in places), closest)
+    flights = []
+    if fly:
+        for i, mission in enumerate(missions):
+            flights.append(fly_mission(mission))
+            steps.done(f"flew drone {i + 1} of {len(missions)} in simulation")
+    homes = tuple(home for _, home in places)
+    return Show(tuple(missions), homes, closest, tuple(flights))
 
 
-def _plan_all(jobs: list[Job], workers: int | None, scheduler: str | None) -> list[Mission]:
+def fly_mission(mission: Mission) -> Flight:
+    """Fly ``mission``'s vehicle trajectory in closed loop (RPT) over its board.
+
+    A horizontal board is the simulator's contact board (:func:`contact_board`), so the
+    flight records the ink; a wall has no contact model and records none.
+    """
+    from skyquill.sim import Quadrotor, simulate
+
+    return simulate(
+        mission.vehicle_trajectory(),
+        Quadrotor(brush_length_m=mission.options.brush_length_m),
+        board=contact_board(mission),
+    )
+
+
+class _Steps:
+    """Counts a show's steps and reports each to ``progress`` (if any)."""
+
+    def __init__(self, total: int, progress: Progress | None) -> None:
+        self.total, self.count, self.progress = total, 0, progress
+
+    def start(self, stage: str) -> None:
+        if self.progress is not None:
+            self.progress(0, self.total, stage)
+
+    def done(self, stage: str) -> None:
+        self.count += 1
+        if self.progress is not None:
+            self.progress(self.count, self.total, stage)
+
+    def planned(self, i: int, n: int) -> None:
+        self.done(f"planned drone {i + 1} of {n}")
+
+
+def _plan_all(
+    jobs: list[Job], workers: int | None, scheduler: str | None, steps: _Steps
+) -> list[Mission]:
     """Plan every job: on a dask cluster, in this process or in a process pool."""
     if scheduler is not None:
-        return _plan_on_cluster(jobs, scheduler)
+        return _plan_on_cluster(jobs, scheduler, steps)
     if len(jobs) == 1 or workers == 1:
-        return [_plan(job) for job in jobs]
-    with ProcessPoolExecutor(max_workers=workers) as pool:
-        return list(pool.map(_plan, jobs))
+        missions = []
+        for i, job in enumerate(jobs):
+            missions.append(_plan(job))
+            steps.planned(i, len(jobs))
+        return missions
+    pool = ProcessPoolExecutor(max_workers=workers)
+    try:
+        futures = [pool.submit(_plan, job) for job in jobs]
+        return _collect(futures, as_completed(futures), steps)
+    finally:
+        # On an error (a drone, or progress asking to stop) the pending drones are dropped.
+        pool.shutdown(wait=True, cancel_futures=True)
+
+
+def _collect(futures: Sequence[Any], arrivals: Iterator[Any], steps: _Steps) -> list[Mission]:
+    """The futures' missions in job order, reporting each as it arrives."""
+    index = {f: i for i, f in enumerate(futures)}
+    missions: list[Mission | None] = [None] * len(futures)
+    for future in arrivals:
+        i = index[future]
+        missions[i] = future.result()
+        steps.planned(i, len(futures))
+    return [m for m in missions if m is not None]
 
 
 def _plan(job: Job) -> Mission:
     return plan_writing(*job)
 
 
-def _plan_on_cluster(jobs: list[Job], scheduler: str) -> list[Mission]:
+def _plan_on_cluster(jobs: list[Job], scheduler: str, steps: _Steps) -> list[Mission]:
     """Plan the jobs on the ``dask.distributed`` scheduler ``scheduler`` (or a local one)."""
     if not isinstance(scheduler, str) or not scheduler:
         raise InputError(f"scheduler: expected an address or 'local', got {scheduler!r}")
     distributed = _import_distributed()
     if scheduler != "local":
-        return _plan_with_client(distributed, scheduler, jobs)
+        return _plan_with_client(distributed, scheduler, jobs, steps)
     with distributed.LocalCluster(
         n_workers=2, threads_per_worker=1, processes=False, dashboard_address=None
     ) as cluster:
-        return _plan_with_client(distributed, cluster.scheduler_address, jobs)
+        return _plan_with_client(distributed, cluster.scheduler_address, jobs, steps)
 
 
 def _import_distributed() -> ModuleType:
@@ -158,7 +268,9 @@ def _import_distributed() -> ModuleType:
     return distributed
 
 
-def _plan_with_client(distributed: ModuleType, address: str, jobs: list[Job]) -> list[Mission]:
+def _plan_with_client(
+    distributed: ModuleType, address: str, jobs: list[Job], steps: _Steps
+) -> list[Mission]:
     """Submit one task per job to the scheduler at ``address`` and gather the missions."""
     try:
         client = distributed.Client(address, timeout=SCHEDULER_TIMEOUT_S, set_as_default=False)
@@ -169,5 +281,5 @@ def _plan_with_client(distributed: ModuleType, address: str, jobs: list[Job]) ->
         ) from exc
     with client:
         futures: list[Any] = client.map(_plan, jobs, pure=False)
-        missions: list[Mission] = client.gather(futures)
-    return missions
+        arrivals = distributed.as_completed(futures, loop=client.loop)
+        return _collect(futures, arrivals, steps)

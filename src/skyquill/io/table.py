@@ -181,7 +181,7 @@ def _parse(name: str, text: Iterator[str], wanted: _Wanted, min_rows: int, max_r
     values: array[float] = array("d")
     lines: array[int] = array("q")
     try:
-        rows = _non_blank(name, reader)
+        rows = _non_blank(reader)
         header = next(rows, None)
         if header is None:
             raise InputError(
@@ -193,7 +193,7 @@ def _parse(name: str, text: Iterator[str], wanted: _Wanted, min_rows: int, max_r
         for row in rows:
             line = reader.line_num
             _check_row(f"{name} line {line}", len(row), len(header), len(lines), max_rows)
-            values.extend(parse_cell(name, line, c, row, i) for c, i in index)
+            values.extend(_row_values(name, line, row, index))
             lines.append(line)
     except csv.Error as exc:
         raise InputError(
@@ -226,25 +226,23 @@ def _frozen(values: array[Any], shape: tuple[int, ...] | None = None) -> Any:
 
 
 def _lines(name: str, handle: TextIO) -> Iterator[str]:
-    """The lines of ``handle``, each read with a length limit (:data:`MAX_LINE_CHARS`)."""
+    """The lines of ``handle``, each read with a length limit; refuses NUL characters."""
     while line := handle.readline(MAX_LINE_CHARS + 1):
         if len(line) > MAX_LINE_CHARS:
             raise InputError(
                 f"{name}: got a line longer than {MAX_LINE_CHARS} characters, expected CSV "
                 "lines (is this a CSV file?)"
             )
-        yield line
-
-
-def _non_blank(name: str, reader: Iterator[list[str]]) -> Iterator[list[str]]:
-    """The rows with at least one non-blank cell; a NUL character is refused."""
-    for row in reader:
-        if any("\x00" in cell for cell in row):
+        if "\x00" in line:
             raise InputError(
                 f"{name}: got a NUL character (binary data or UTF-16 text), expected UTF-8 text"
             )
-        if any(cell.strip() for cell in row):
-            yield row
+        yield line
+
+
+def _non_blank(reader: Iterator[list[str]]) -> Iterator[list[str]]:
+    """The rows with at least one non-blank cell."""
+    return (row for row in reader if "".join(row).strip())
 
 
 def _check_header(name: str, header: list[str], wanted: _Wanted) -> tuple[str, ...]:
@@ -252,27 +250,38 @@ def _check_header(name: str, header: list[str], wanted: _Wanted) -> tuple[str, .
     repeated = sorted({c for c in header if header.count(c) > 1})
     if repeated:
         raise InputError(
-            f"{name}: got column(s) {','.join(repeated)} more than once, expected each column once"
+            f"{name}: got column(s) {_names(repeated)} more than once, expected each column once"
         )
     missing = [c for c in wanted.required if c not in header]
     if missing:
         raise InputError(
-            f"{name}: got columns {header}, expected {wanted.describe()}; "
+            f"{name}: got columns {_shorten(str(header), 200)}, expected {wanted.describe()}; "
             f"missing {','.join(missing)}"
         )
     known = wanted.required + wanted.optional
     extra = [c for c in header if c not in known]
     if extra and wanted.unknown == "refuse":
         raise InputError(
-            f"{name}: got unknown column(s) {','.join(map(repr, extra))}, expected only "
-            f"{','.join(known)}"
+            f"{name}: got unknown column(s) {_names(extra)}, expected only {','.join(known)}"
         )
     return wanted.required + tuple(c for c in wanted.optional if c in header)
 
 
-def parse_cell(name: str, line: int, column: str, row: Sequence[str], i: int) -> float:
+def _row_values(name: str, line: int, row: list[str], index: list[tuple[str, int]]) -> list[float]:
+    """The cells ``index`` (column, position) of ``row`` as finite floats."""
+    try:
+        # Fast path: float() strips spaces itself; the named error is found only on failure.
+        values = [float(row[i]) for _, i in index]
+        if all(map(math.isfinite, values)):
+            return values
+    except ValueError:
+        pass
+    return [_cell(name, line, c, row, i) for c, i in index]
+
+
+def _cell(name: str, line: int, column: str, row: Sequence[str], i: int) -> float:
     """Cell ``i`` of a CSV ``row`` as a finite float; InputError naming file, line, column."""
-    text = row[i].strip() if i < len(row) else ""
+    text = row[i].strip()
     try:
         value = float(text)
     except ValueError:
@@ -284,6 +293,11 @@ def parse_cell(name: str, line: int, column: str, row: Sequence[str], i: int) ->
             f"{name} line {line}, column {column}: got {_shorten(text)!r}, expected a finite number"
         )
     return value
+
+
+def _names(columns: Sequence[str]) -> str:
+    """Column names as written in messages: quoted, so that an empty name shows."""
+    return _shorten(",".join(map(repr, columns)), 200)
 
 
 def _shorten(text: str, limit: int = 40) -> str:

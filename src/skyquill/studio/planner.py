@@ -1,11 +1,13 @@
 """One studio plan, start to finish: request -> missions -> simulated flights -> files.
 
-This is the work a job does off the event loop. It is the ``skyquill write``
-pipeline (:mod:`skyquill.cli.write_cmd`) with two differences: the drones are
-planned one after the other in this thread so that progress can be reported
-(and the time limit checked) between them, and the exports are generated in a
-temporary directory and kept in memory, keyed by the job, never at a path that
-came from a request.
+This is the work a job does off the event loop. The show is planned (and
+flown) by :func:`skyquill.calligraphy.show.plan_show`, the planner of
+``skyquill write``; what is the studio's own is around it: the request turned
+into strokes, the drones planned one after the other in the job's process
+(``workers=1``: the job's time limit kills that one process, and progress is
+reported between drones), the JSON view of the result, and the exports
+generated in a temporary directory and kept in memory, keyed by the job, never
+at a path that came from a request.
 """
 
 from __future__ import annotations
@@ -19,24 +21,21 @@ import zipfile
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from skyquill.calligraphy.board import Board
-from skyquill.calligraphy.mission import (
-    Mission,
-    WritingOptions,
-    check_separation,
-    contact_board,
-    plan_writing,
-)
-from skyquill.calligraphy.show import layout
+from skyquill.calligraphy.mission import Mission, WritingOptions
+from skyquill.calligraphy.show import Show, plan_show
 from skyquill.errors import InfeasibleError, InputError, SolverError
 from skyquill.strokes import Strokes
 from skyquill.studio.models import DownloadFile, DronePlan, LimitCheck, Limits, PlanRequest
 from skyquill.studio.models import PlanResult as PlanResultModel
 from skyquill.validation import FloatArray
+
+if TYPE_CHECKING:
+    from skyquill.sim import Flight
 
 #: Smallest distance between two drones at any time, m (``skyquill write``'s default).
 SEPARATION_M = 1.0
@@ -128,29 +127,23 @@ def run_plan(
     options = WritingOptions(
         size_m=request.size_m, vmax=request.vmax, amax=request.amax, jmax=request.jmax
     )
-    places = layout(len(parts), options.size_m, SEPARATION_M, kind=request.board)
-    missions: list[Mission] = []
-    for i, (part, (board, home)) in enumerate(zip(parts, places, strict=True)):
-        progress(0.05 + 0.6 * i / len(parts), f"planning drone {i + 1} of {len(parts)}")
-        missions.append(_plan_one(part, board, options, home, i))
-    closest = None
-    if len(missions) > 1:
-        progress(0.65, "checking the separation between drones")
-        closest = check_separation([m.trajectory for m in missions], SEPARATION_M)
-    drones = []
-    for i, (mission, part) in enumerate(zip(missions, parts, strict=True)):
-        progress(0.7 + 0.2 * i / len(parts), f"flying drone {i + 1} of {len(parts)} in simulation")
-        drones.append(_drone_plan(mission, part, places[0][0], fly=request.fly))
+    show = _plan_show(parts, options, request, progress)
+    first_board = show.missions[0].board
+    flights = show.flights or (None,) * len(parts)
+    drones = [
+        _drone_plan(mission, part, first_board, flight)
+        for mission, part, flight in zip(show.missions, parts, flights, strict=True)
+    ]
     progress(0.92, "writing the files")
-    files, notes = _exports(missions, [home for _, home in places])
+    files, notes = _exports(show.missions, show.homes)
     result = PlanResultModel(
         source="text" if request.text is not None else "strokes",
         board=request.board,
         size_m=request.size_m,
         limits=Limits(vmax=request.vmax, amax=request.amax, jmax=request.jmax),
-        duration_s=max(m.trajectory.duration for m in missions),
-        planning_time_s=sum(m.planning_time_s for m in missions),
-        min_separation_m=closest,
+        duration_s=max(m.trajectory.duration for m in show.missions),
+        planning_time_s=sum(m.planning_time_s for m in show.missions),
+        min_separation_m=show.min_separation_m if len(show.missions) > 1 else None,
         drones=drones,
         files=[
             DownloadFile(
@@ -163,19 +156,35 @@ def run_plan(
     return PlanOutput(result, files)
 
 
-def _plan_one(
-    part: Strokes, board: Board, options: WritingOptions, home: FloatArray, i: int
-) -> Mission:
-    """One drone's mission; a solver that gives up is told as limits not met."""
+def _plan_show(
+    parts: list[Strokes], options: WritingOptions, request: PlanRequest, progress: Progress
+) -> Show:
+    """:func:`plan_show` in this process, its steps mapped to 5 % .. 90 % of the job."""
+    planned = 0
+
+    def report(done: int, total: int, stage: str) -> None:
+        nonlocal planned
+        planned = min(done, len(parts))
+        progress(0.05 + 0.85 * done / total, stage)
+
     try:
-        return plan_writing(part, board, options, home)
+        return plan_show(
+            parts,
+            options,
+            SEPARATION_M,
+            workers=1,
+            board_kind=request.board,
+            fly=request.fly,
+            progress=report,
+        )
     except SolverError as exc:
         # Seen with tiny jerk limits: the QP backends hit their iteration limit
         # instead of proving infeasibility. To the person it is the same answer.
+        # Drones are planned in order (workers=1): the one that failed is the next.
         raise InfeasibleError(
-            f"limits: could not plan drone {i + 1}'s flight within speed {options.vmax:g} m/s, "
-            f"acceleration {options.amax:g} m/s^2 and jerk {options.jmax:g} m/s^3 ({exc}); "
-            "expected looser limits or a smaller drawing"
+            f"limits: could not plan drone {planned + 1}'s flight within speed "
+            f"{options.vmax:g} m/s, acceleration {options.amax:g} m/s^2 and jerk "
+            f"{options.jmax:g} m/s^3 ({exc}); expected looser limits or a smaller drawing"
         ) from exc
 
 
@@ -189,8 +198,10 @@ def _view_times(duration: float) -> FloatArray:
     return np.linspace(0.0, duration, max(n, 2))
 
 
-def _drone_plan(mission: Mission, part: Strokes, first_board: Board, *, fly: bool) -> DronePlan:
-    """One drone's curves for the page, in its board's coordinates."""
+def _drone_plan(
+    mission: Mission, part: Strokes, first_board: Board, flight: Flight | None
+) -> DronePlan:
+    """One drone's curves for the page, in its board's coordinates (and its flight's)."""
     traj, board = mission.trajectory, mission.board
     t = _view_times(traj.duration)
     v, a, j = (np.abs(traj.evaluate(t, n)).max(axis=1) for n in (1, 2, 3))
@@ -214,21 +225,14 @@ def _drone_plan(mission: Mission, part: Strokes, first_board: Board, *, fly: boo
         "deviation_max_m": mission.deviation.max_m,
         "checks": [LimitCheck.model_validate(c) for c in check.limits_report()],
     }
-    if fly:
-        fields |= _flight_fields(mission, t)
+    if flight is not None:
+        fields |= _flight_fields(mission, flight, t)
     return DronePlan.model_validate(fields)
 
 
-def _flight_fields(mission: Mission, t: FloatArray) -> dict[str, Any]:
+def _flight_fields(mission: Mission, flight: Flight, t: FloatArray) -> dict[str, Any]:
     """The closed-loop flight (RPT) of the vehicle trajectory, as :class:`DronePlan` fields."""
-    from skyquill.sim import Quadrotor, simulate
-
     board = mission.board
-    flight = simulate(
-        mission.vehicle_trajectory(),
-        Quadrotor(brush_length_m=mission.options.brush_length_m),
-        board=contact_board(mission),
-    )
     # The tip hangs the brush length below the vehicle (its swing with tilt is not drawn).
     tip = np.column_stack([np.interp(t, flight.t, flight.p[:, k]) for k in range(3)])
     tip = tip - mission.brush_offset
