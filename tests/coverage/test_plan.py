@@ -33,7 +33,7 @@ def test_stop_and_go_zigzag_reproduces_the_papers_baseline() -> None:
 @pytest.mark.parametrize("pattern", ["spiral", "zigzag", "zigzag-stop"])
 def test_every_pattern_plans_a_rest_to_rest_flight_inside_the_region(pattern: str) -> None:
     plan = plan_coverage(SQUARE, CoverageOptions(pattern=pattern, delta=1.0))  # type: ignore[arg-type]
-    sp = plan.setpoints
+    sp = plan.samples()
     assert np.allclose(sp.v[[0, -1]], 0.0, atol=1e-9)
     assert float(shapely.distance(shapely.points(plan.path), SQUARE).max()) < 1e-6
     assert plan.coverage > 0.9
@@ -147,7 +147,7 @@ def test_random_concave_regions_plan_or_are_refused(vertices: np.ndarray, patter
         return
     assert float(shapely.distance(shapely.points(plan.path), region).max()) < 0.05
     assert np.isfinite(plan.duration) and plan.duration > 0.0
-    assert np.allclose(plan.setpoints.v[[0, -1]], 0.0, atol=1e-9)
+    assert np.allclose(plan.samples().v[[0, -1]], 0.0, atol=1e-9)
     assert plan.limits["max_excess"] <= 0.02
 
 
@@ -162,7 +162,7 @@ def test_a_concave_spiral_too_tight_to_join_rests_between_its_parts() -> None:
     assert plan.limits["joins"] == "stop"
     assert plan.limits["max_excess"] <= 0.02
     assert plan.coverage >= 0.97
-    assert np.all(np.diff(plan.setpoints.t) > 0.0)
+    assert np.all(np.diff(plan.samples().t) > 0.0)
     assert float(shapely.distance(shapely.points(plan.path), region).max()) < 1e-6
 
 
@@ -181,8 +181,8 @@ def test_every_setpoint_is_finite(name: str, pattern: str) -> None:
     # The last row (u = 1) had NaN acceleration and jerk on most regions.
     region = region_from_vertices(FINITE_REGIONS[name])
     options = CoverageOptions(width=2.0, vmax=3.0, amax=5.0, jmax=3.0, pattern=pattern)
-    sp = plan_coverage(region, options).setpoints
-    for x in (sp.t, sp.u, sp.p, sp.v, sp.a, sp.j):
+    sp = plan_coverage(region, options).samples()
+    for x in (sp.t, sp.p, sp.v, sp.a, sp.j):
         assert np.all(np.isfinite(x)), name
     assert np.all(np.abs(sp.a[-1]) <= 5.0 * 1.02) and np.all(np.abs(sp.j[-1]) <= 3.0 * 1.02)
 
@@ -193,7 +193,7 @@ def test_norm_limits_hold_as_norms(pattern: str) -> None:
     options = CoverageOptions(pattern=pattern, limit_norm_sides=16)  # type: ignore[arg-type]
     plan = plan_coverage(region, options)
     assert plan.limits["max_excess"] <= 0.02
-    sp = plan.setpoints
+    sp = plan.samples()
     assert np.max(np.linalg.norm(sp.a, axis=1)) <= options.amax * 1.02
     assert np.max(np.linalg.norm(sp.j, axis=1)) <= options.jmax * 1.02
     if plan.speed_plan is not None:
