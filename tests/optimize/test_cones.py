@@ -15,6 +15,8 @@ from numpy.typing import NDArray
 from skyquill.errors import InfeasibleError
 from skyquill.limits import NormLimit, VehicleLimits
 from skyquill.optimize import Boundary, FitResult, PointDeviation, SmoothingProblem, solve
+from skyquill.optimize.assemble import assemble
+from skyquill.optimize.solve import _hull_excess, _to_qp
 from skyquill.spline import HullKind
 
 Array = NDArray[np.float64]
@@ -163,3 +165,27 @@ def test_cone_is_looser_than_its_polytope_at_the_same_duration() -> None:
     assert ok.verification.max_speed > 0.9 * vmax
     with pytest.raises(InfeasibleError, match=r"speed norm \(8-gon globe\)"):
         solve(SmoothingProblem(limits=(NormLimit(1, vmax, 8),), **base))  # type: ignore[arg-type]
+
+
+def test_margin_shrinks_the_radius_and_the_check_sees_the_cone() -> None:
+    """The margin loop's two halves for cones: tightened radius in, untightened check out."""
+    points = noisy_curve("helix", n=100)
+    asm = assemble(problem(points, 8.0, (NormLimit(1, 0.5), NormLimit(2, 2.0, 8))))
+    assert asm.cones is not None
+    n_points = asm.cones.radius.size
+    qp = _to_qp(asm, 1e-3)
+    assert qp.cones is not None
+    assert qp.cones.dims == (4,) * n_points
+    np.testing.assert_allclose(qp.cones.b[::4], 0.5 * (1 - 1e-3))
+    assert not np.any(qp.cones.b.reshape(n_points, 4)[:, 1:])
+    # At rest everything holds; move one control point and compare with the
+    # speed limit's own measure on the velocity hull points.
+    C = np.tile([1.0, 0.0, 0.0], (asm.F.shape[0], 1))
+    assert _hull_excess(asm, C.ravel()) == 0.0
+    prob = problem(points, 8.0)
+    C[3] += [0.1, -0.2, 0.15]
+    hull_v = prob.alpha * (prob.basis.hull_map(1) @ C)
+    expected = NormLimit(1, 0.5).relative_excess(hull_v)[1]
+    assert expected > 0.1
+    speed_only = assemble(problem(points, 8.0, (NormLimit(1, 0.5),)))
+    assert _hull_excess(speed_only, C.ravel()) == pytest.approx(expected, rel=1e-12)
