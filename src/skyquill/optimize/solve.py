@@ -70,7 +70,7 @@ class FitResult:
     trajectory
         The B-spline trajectory.
     method
-        ``"closed_form"`` or ``"qp"``.
+        ``"closed_form"`` or ``"qp"`` (also for the conic program of exact norm limits).
     solver
         ``"sparse-lu"`` or the QP backend's name.
     cost
