@@ -7,14 +7,24 @@ derivative ``q``, paper 003 §3.8). Each limit is a convex polytope
 trajectory planner imposes it on hull points, so it holds on the whole
 trajectory, not only on samples (paper 003 eq. 39).
 
-Two shapes:
+Three shapes:
 
 * :class:`BoxLimit` -- an axis-aligned, possibly asymmetric box.
+* :class:`NormLimit` -- the Euclidean norm over all axes, ``||d^n p/dt^n|| <= r``
+  (``vmax`` is the *speed*, DESIGN.md "One meaning per limit"). The ball is
+  convex, so holding it on every hull point holds it on the whole curve. With
+  ``sides=None`` the engine imposes it exactly, as a second-order cone per
+  hull point; with ``sides=m`` through an inscribed polytope (see
+  :meth:`NormLimit.halfspaces`).
 * :class:`CylinderLimit` -- horizontal norm ``sqrt(x'^2 + y'^2) <= r`` and
   separate vertical bounds (paper 003 eq. 55). It is enforced through a
   regular ``m``-gon prism *inscribed* in the cylinder, so meeting the polytope
   implies meeting the cylinder. (The paper's text says "hexagonal" while its
   Fig. 4 shows an octagon; ``sides`` is a parameter, default 8.)
+
+:class:`VehicleLimits` is the one value the entry points build: the three
+norms and optional per-axis boxes, turned into limits by
+:meth:`VehicleLimits.derivative_limits`.
 
 Units are SI: m/s, m/s^2, m/s^3, ...
 """
@@ -22,9 +32,11 @@ Units are SI: m/s, m/s^2, m/s^3, ...
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import lru_cache
 from typing import Any
 
 import numpy as np
+import scipy.spatial
 
 from skyquill.errors import InputError
 from skyquill.validation import FloatArray, as_array, as_float, as_int
@@ -188,7 +200,208 @@ class CylinderLimit:
         return norm, rel
 
 
-DerivativeLimit = BoxLimit | CylinderLimit
+@lru_cache(maxsize=32)
+def _unit_polytope(sides: int, dim: int) -> tuple[FloatArray, FloatArray]:
+    """``(A, b)`` of a polytope inscribed in the unit ball of ``R^dim``, unit normals.
+
+    1-D: the interval itself. 2-D: the regular ``sides``-gon with vertices at
+    angles ``2 pi j / m`` (the horizontal polygon of :class:`CylinderLimit`).
+    3-D: the "globe" -- the convex hull of points on the unit sphere at
+    longitudes ``2 pi j / m`` and latitudes spaced by the same angle (rings
+    at ``k * 2 pi / m`` below +-90 deg, plus both poles). Every vertex lies on
+    the sphere, so the polytope is inside the ball. Its equator is the 2-D
+    ``m``-gon (level flight loses what the paper's prism loses) and it has no
+    preferred direction, unlike an ``m``-gon prism inscribed in the sphere,
+    which must trade horizontal against vertical reach (at best
+    ``sqrt(2/3) r`` horizontally and ``r / sqrt(3)`` vertically). Facets
+    come from Qhull; the triangles of one planar quadrilateral give the same
+    row, kept once.
+    """
+    if dim == 1:
+        return np.array([[1.0], [-1.0]]), np.ones(2)
+    angles = 2 * np.pi * np.arange(sides) / sides
+    if dim == 2:
+        points = np.column_stack([np.cos(angles), np.sin(angles)])
+    else:
+        n_half = max(1, -(-sides // 4))  # rings per hemisphere, equator included
+        lat = (np.pi / 2) * np.arange(-(n_half - 1), n_half) / n_half
+        lon_g, lat_g = np.meshgrid(angles, lat)
+        ring = np.column_stack(
+            [
+                (np.cos(lat_g) * np.cos(lon_g)).ravel(),
+                (np.cos(lat_g) * np.sin(lon_g)).ravel(),
+                np.sin(lat_g).ravel(),
+            ]
+        )
+        points = np.vstack([ring, [[0.0, 0.0, 1.0], [0.0, 0.0, -1.0]]])
+    eq = scipy.spatial.ConvexHull(points).equations  # n.x + offset <= 0 inside
+    rows = np.unique(np.round(eq, 12), axis=0)
+    return rows[:, :dim], -rows[:, dim]
+
+
+@dataclass(frozen=True)
+class NormLimit:
+    """Euclidean norm over all axes ``||d^n p / dt^n||_2 <= radius`` on derivative ``order``.
+
+    Parameters
+    ----------
+    order
+        Derivative order ``n >= 1`` (1: the speed).
+    radius
+        Bound on the norm, > 0, SI units.
+    sides
+        ``None``: held exactly (a second-order cone on every hull point,
+        solved by a conic solver). An integer ``m`` in [3, 1024]: held by a
+        polytope inscribed in the ball (:meth:`halfspaces`), solvable by any
+        QP backend but smaller than the ball.
+    dim
+        Number of axes, 1 to 16 (a polytope only for 1 to 3).
+    """
+
+    order: int
+    radius: float
+    sides: int | None = None
+    dim: int = 3
+
+    def __post_init__(self) -> None:
+        as_int("order", self.order, low=1, high=7)
+        r = as_float(f"{order_name(self.order)} norm radius", self.radius, positive=True)
+        object.__setattr__(self, "radius", r)
+        as_int("dim", self.dim, low=1, high=16)
+        if self.sides is not None:
+            as_int("sides", self.sides, low=3, high=1024)
+            if self.dim > 3:
+                raise InputError(
+                    f"sides: got {self.sides} for a {self.dim}-axis norm, expected None "
+                    "(an exact cone): inscribed polytopes exist for 1 to 3 axes"
+                )
+
+    @property
+    def is_cone(self) -> bool:
+        """Whether the engine imposes the norm exactly as a second-order cone."""
+        return self.sides is None
+
+    @property
+    def label(self) -> str:
+        """Short name for reports, e.g. ``"speed norm (cone)"``."""
+        name = order_name(self.order)
+        if self.sides is None:
+            return f"{name} norm (cone)"
+        shape = {1: "interval", 2: f"{self.sides}-gon", 3: f"{self.sides}-gon globe"}
+        return f"{name} norm ({shape[self.dim]})"
+
+    @property
+    def inscribed_fraction(self) -> float:
+        """Radius of the largest ball inside the constraint set, over ``radius`` (1 for a cone)."""
+        if self.sides is None:
+            return 1.0
+        return float(_unit_polytope(self.sides, self.dim)[1].min())
+
+    def halfspaces(self) -> tuple[FloatArray, FloatArray]:
+        """``(A, b)`` of the inscribed polytope; shapes (m', d) and (m',).
+
+        Raises
+        ------
+        InputError
+            For a cone (``sides=None``): it has no finite set of half-spaces.
+        """
+        if self.sides is None:
+            raise InputError(
+                f"{self.label}: got sides=None (an exact cone), expected an integer "
+                "number of sides for a polytope"
+            )
+        A, b = _unit_polytope(self.sides, self.dim)
+        return A.copy(), self.radius * b
+
+    def relative_excess(self, values: FloatArray) -> tuple[float, float]:
+        """Largest norm of ``values`` (N, d) and its relative excess over the *ball*."""
+        by_axis = np.ascontiguousarray(values.T)  # contiguous rows: fast reductions
+        norm = float(np.sqrt((by_axis**2).sum(axis=0).max(initial=0.0)))
+        return norm, _relative(norm - self.radius, self.radius)
+
+
+DerivativeLimit = BoxLimit | CylinderLimit | NormLimit
+
+_VEHICLE_FIELDS: dict[str, tuple[int, str, str]] = {
+    "vmax": (1, "m/s", "speed: Euclidean norm of the velocity"),
+    "amax": (2, "m/s^2", "Euclidean norm of the acceleration"),
+    "jmax": (3, "m/s^3", "Euclidean norm of the jerk"),
+    "vmax_axis": (1, "m/s", "per-axis bound |v_i| on every velocity component"),
+    "amax_axis": (2, "m/s^2", "per-axis bound |a_i| on every acceleration component"),
+    "jmax_axis": (3, "m/s^3", "per-axis bound |j_i| on every jerk component"),
+}
+
+
+@dataclass(frozen=True)
+class VehicleLimits:
+    """The vehicle's limits: built once at the entry, passed down (DESIGN.md).
+
+    ``None`` leaves a limit out. Every value is in SI units and > 0.
+
+    Attributes
+    ----------
+    vmax
+        Speed, the Euclidean norm of the velocity, m/s.
+    amax
+        Euclidean norm of the acceleration, m/s^2.
+    jmax
+        Euclidean norm of the jerk, m/s^3.
+    vmax_axis, amax_axis, jmax_axis
+        Optional extra per-axis boxes ``|v_i|``, ``|a_i|``, ``|j_i| <= ...``.
+    """
+
+    vmax: float | None = None
+    amax: float | None = None
+    jmax: float | None = None
+    vmax_axis: float | None = None
+    amax_axis: float | None = None
+    jmax_axis: float | None = None
+
+    def __post_init__(self) -> None:
+        for name in _VEHICLE_FIELDS:
+            value = getattr(self, name)
+            if value is not None:
+                object.__setattr__(self, name, as_float(name, value, positive=True))
+
+    def norm(self, order: int) -> float | None:
+        """The norm bound on derivative ``order`` (1: vmax, 2: amax, 3: jmax; else None)."""
+        as_int("order", order, low=1, high=7)
+        return {1: self.vmax, 2: self.amax, 3: self.jmax}.get(order)
+
+    def axis(self, order: int) -> float | None:
+        """The per-axis bound on derivative ``order`` (``vmax_axis``, ...; else None)."""
+        as_int("order", order, low=1, high=7)
+        return {1: self.vmax_axis, 2: self.amax_axis, 3: self.jmax_axis}.get(order)
+
+    def derivative_limits(
+        self, dim: int, *, sides: int | None = None
+    ) -> tuple[DerivativeLimit, ...]:
+        """The limits for a ``dim``-axis trajectory, ordered by derivative order.
+
+        Parameters
+        ----------
+        dim
+            Number of axes, 1 to 3.
+        sides
+            ``None``: norms as exact cones (conic solver); an integer ``m``:
+            norms through the inscribed polytope of :class:`NormLimit`.
+        """
+        as_int("dim", dim, low=1, high=3)
+        limits: list[DerivativeLimit] = []
+        for order in (1, 2, 3):
+            radius, box = self.norm(order), self.axis(order)
+            if radius is not None:
+                limits.append(NormLimit(order, radius, sides, dim))
+            if box is not None:
+                limits.append(BoxLimit.symmetric(order, box, dim))
+        return tuple(limits)
+
+    def as_dict(self) -> dict[str, object]:
+        """``{name: {"value", "unit", "meaning"}}`` for every field (``value`` None if unset)."""
+        return {
+            name: {"value": getattr(self, name), "unit": unit, "meaning": meaning}
+            for name, (_, unit, meaning) in _VEHICLE_FIELDS.items()
+        }
 
 
 def vehicle_limits(

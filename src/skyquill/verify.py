@@ -63,7 +63,7 @@ class LimitCheck:
     order
         Derivative order.
     max_value
-        Largest per-axis magnitude (box) or horizontal norm (cylinder).
+        Largest per-axis magnitude (box), horizontal norm (cylinder) or norm (norm limit).
     relative_excess
         ``max(0, value - bound) / |bound|`` over all samples and axes.
     guaranteed

@@ -12,6 +12,7 @@ from hypothesis.extra import numpy as hnp
 
 from skyquill.errors import InputError, SkyquillError
 from skyquill.io.points import read_points_csv
+from skyquill.limits import VehicleLimits
 from skyquill.optimize.fit import FitOptions, fit_points
 
 EXAMPLES = Path(__file__).parents[2] / "examples"
@@ -100,3 +101,25 @@ def test_hostile_points_give_input_errors_or_verified_fits(points: np.ndarray) -
         assert str(exc)
         return
     assert fit.result.verification.max_excess <= 1e-9
+
+
+@pytest.mark.parametrize("sides", [None, 16])
+def test_vehicle_norms_hold_on_dense_samples(sides: int | None) -> None:
+    """``vehicle=``: speed, acceleration and jerk *norms* (3-D), cones or inscribed globe."""
+    s = np.linspace(0.0, 1.0, 200)
+    points = np.column_stack([np.cos(4 * s), np.sin(4 * s), 1.5 * s])
+    vehicle = VehicleLimits(vmax=1.0, amax=1.0, jmax=3.0)
+    fit = fit_points(points, options=FitOptions(coupled=sides), vehicle=vehicle)
+    assert (fit.result.n_cones > 0) == (sides is None)
+    assert fit.result.verification.max_excess <= 1e-9
+    traj = fit.result.trajectory
+    t = np.linspace(0.0, traj.duration, 20_000)
+    for order, bound in ((1, 1.0), (2, 1.0), (3, 3.0)):
+        assert np.linalg.norm(traj.evaluate(t, order), axis=1).max() <= bound * (1 + 1e-9)
+    labels = [c.label for c in fit.result.verification.checks]
+    assert labels[0] == ("speed norm (cone)" if sides is None else "speed norm (16-gon globe)")
+
+
+def test_vehicle_must_be_vehicle_limits() -> None:
+    with pytest.raises(InputError, match=r"vehicle: got dict, expected VehicleLimits"):
+        fit_points(np.eye(3), vehicle={"vmax": 1.0})  # type: ignore[arg-type]

@@ -24,6 +24,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from skyquill.errors import InfeasibleError
+from skyquill.limits import NormLimit
 from skyquill.optimize.problem import (
     Corridor,
     LineDeviation,
@@ -43,6 +44,31 @@ class InequalityFamily:
 
 
 @dataclass(frozen=True)
+class NormCones:
+    """Exact norm limits: ``||v_p|| <= radius_p`` on every derivative hull point ``p``.
+
+    Attributes
+    ----------
+    map
+        Shape (P d, M d): ``(map @ x).reshape(P, d)`` are the hull points
+        ``v_p`` (SI units, already scaled by ``alpha^n``).
+    radius
+        Shape (P,): the bound of each point's limit.
+    families
+        One per limit; ``rows`` slices the *points* ``0..P-1``.
+    """
+
+    map: sp.csr_array
+    radius: FloatArray
+    families: tuple[InequalityFamily, ...]
+
+    def norms(self, x: FloatArray) -> FloatArray:
+        """``||v_p||`` of the control points ``x = C.ravel()``, shape (P,)."""
+        v = (self.map @ x).reshape(self.radius.size, -1)
+        return np.asarray(np.sqrt((v**2).sum(axis=1)))
+
+
+@dataclass(frozen=True)
 class Assembled:
     """The problem as matrices (module docstring)."""
 
@@ -56,6 +82,7 @@ class Assembled:
     G_ineq: sp.csr_array  # (m_in, Md)
     h_ineq: FloatArray  # (m_in,)
     families: tuple[InequalityFamily, ...]
+    cones: NormCones | None = None  # exact norm limits (second-order cones)
 
     @property
     def separable(self) -> bool:
@@ -105,6 +132,7 @@ def assemble(problem: SmoothingProblem) -> Assembled:
         diagonal = max(diagonal, G_coupled.diagonal().max(initial=0.0))
     E, e = _equalities(problem)
     G_ineq, h_ineq, families = _inequalities(problem)
+    cones = _cones(problem)
     return Assembled(
         1.0 / diagonal if diagonal > 0 else 1.0,
         sp.csr_array(G_axis),
@@ -116,6 +144,7 @@ def assemble(problem: SmoothingProblem) -> Assembled:
         G_ineq,
         h_ineq,
         families,
+        cones,
     )
 
 
@@ -250,6 +279,8 @@ def _inequalities(
         start += blocks[-1].shape[0]
 
     for lim in problem.limits:
+        if isinstance(lim, NormLimit) and lim.is_cone:
+            continue  # held by _cones
         A, b = lim.halfspaces()
         add(
             f"limit: {lim.label}",
@@ -263,6 +294,29 @@ def _inequalities(
     if not blocks:
         return sp.csr_array((0, problem.n_ctrl * d)), np.zeros(0), ()
     return sp.csr_array(sp.vstack(blocks)), np.concatenate(rhs), tuple(families)
+
+
+def _cones(problem: SmoothingProblem) -> NormCones | None:
+    """Exact norm limits on hull points: by convexity of the ball, on the whole curve."""
+    basis, alpha, d = problem.basis, problem.alpha, problem.dim
+    maps: list[sp.csr_array] = []
+    radius: list[FloatArray] = []
+    families: list[InequalityFamily] = []
+    start = 0
+    for lim in problem.limits:
+        if not (isinstance(lim, NormLimit) and lim.is_cone):
+            continue
+        hull = basis.hull_map(lim.order, kind=problem.hull) * alpha**lim.order
+        # (Hull ⊗ I_d) x = vec(Hull C): the hull points, point-major.
+        maps.append(sp.csr_array(sp.kron(hull, sp.eye_array(d), format="csr")))
+        radius.append(np.full(hull.shape[0], lim.radius))
+        families.append(
+            InequalityFamily(f"limit: {lim.label}", slice(start, start + hull.shape[0]))
+        )
+        start += hull.shape[0]
+    if not maps:
+        return None
+    return NormCones(sp.csr_array(sp.vstack(maps)), np.concatenate(radius), tuple(families))
 
 
 def _corridor_label(i: int, cor: Corridor) -> str:

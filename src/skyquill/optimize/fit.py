@@ -19,7 +19,7 @@ from typing import Literal
 import numpy as np
 
 from skyquill.errors import InfeasibleError, InputError
-from skyquill.limits import DerivativeLimit, vehicle_limits
+from skyquill.limits import DerivativeLimit, VehicleLimits, vehicle_limits
 from skyquill.optimize.problem import Boundary, PointDeviation, SmoothingProblem
 from skyquill.optimize.solve import FitResult, solve
 from skyquill.optimize.timing import (
@@ -131,7 +131,11 @@ class PointFit:
 
 
 def fit_points(
-    points: FloatArray, times: FloatArray | None = None, options: FitOptions | None = None
+    points: FloatArray,
+    times: FloatArray | None = None,
+    options: FitOptions | None = None,
+    *,
+    vehicle: VehicleLimits | None = None,
 ) -> PointFit:
     """Fit a trajectory that starts and ends at rest at the first and last point.
 
@@ -143,19 +147,33 @@ def fit_points(
         Shape (N,), s, strictly increasing, or ``None`` to allocate them.
     options
         :class:`FitOptions`; defaults if ``None``.
+    vehicle
+        The vehicle's limits (DESIGN.md "One meaning per limit"). When given
+        they replace ``options.vmax / amax / jmax`` as the limits: norms held
+        exactly (second-order cones), or by the inscribed polytope with
+        ``options.coupled`` sides if that is set; per-axis boxes as boxes. The
+        timing allocation then plans with ``vehicle.vmax`` and
+        ``vehicle.amax`` where set (else the options' values).
     """
     opts = options or FitOptions()
     pts = as_array("points", points, ndim=2, max_abs=MAX_COORDINATE_M)
     if pts.shape[1] not in (2, 3) or pts.shape[0] < 2:
         raise InputError(f"points: got shape {pts.shape}, expected (N >= 2, 2 or 3)")
+    if vehicle is not None and not isinstance(vehicle, VehicleLimits):
+        raise InputError(f"vehicle: got {type(vehicle).__name__}, expected VehicleLimits")
     if times is None:
+        vmax = (vehicle.vmax if vehicle is not None else None) or opts.vmax
+        amax = (vehicle.amax if vehicle is not None else None) or opts.amax
         allocate = allocate_path_times if opts.timing == "path" else allocate_segment_times
-        t = allocate(pts, opts.vmax, opts.allocation_accel_fraction * opts.amax)
+        t = allocate(pts, vmax, opts.allocation_accel_fraction * amax)
     else:
         t = as_array("times", times, shape=(pts.shape[0],), max_abs=1e7)
         strictly_increasing("times", t)
         t = t - t[0]
-    limits = vehicle_limits(pts.shape[1], opts.vmax, opts.amax, opts.jmax, opts.coupled)
+    if vehicle is None:
+        limits = vehicle_limits(pts.shape[1], opts.vmax, opts.amax, opts.jmax, opts.coupled)
+    else:
+        limits = vehicle.derivative_limits(pts.shape[1], sides=opts.coupled)
     scale = 1.0
     for attempt in range(opts.max_stretches + 1):
         try:

@@ -19,7 +19,7 @@ import numpy as np
 import scipy.optimize
 
 from skyquill.errors import InputError
-from skyquill.limits import BoxLimit, CylinderLimit, DerivativeLimit
+from skyquill.limits import BoxLimit, CylinderLimit, DerivativeLimit, NormLimit
 from skyquill.spline import ClampedUniformBasis, HullKind, basis_for
 from skyquill.validation import FloatArray, as_array, as_float, as_int, strictly_increasing
 
@@ -279,7 +279,7 @@ class SmoothingProblem:
         self._check_terms("deviations", (PointDeviation, LineDeviation, PlaneDeviation))
         self._check_terms("interpolation", (Interpolation,))
         self._check_terms("boundary", (Boundary,))
-        self._check_terms("limits", (BoxLimit, CylinderLimit))
+        self._check_terms("limits", (BoxLimit, CylinderLimit, NormLimit))
         self._check_terms("corridors", (Corridor,))
         for order, sigma in self.smoothness.items():
             as_int("smoothness order", order, low=1, high=self.degree)
@@ -351,6 +351,11 @@ class SmoothingProblem:
     def alpha(self) -> float:
         """Spans per second (paper 003 eq. 5)."""
         return (self.n_ctrl - self.degree) / self.duration
+
+    @property
+    def has_cones(self) -> bool:
+        """Whether a limit is an exact norm (a conic program, solved by Clarabel)."""
+        return any(isinstance(lim, NormLimit) and lim.is_cone for lim in self.limits)
 
     @property
     def has_inequalities(self) -> bool:

@@ -12,6 +12,12 @@
   constraints; if a solver's tolerance still leaves it outside, the margin
   grows tenfold and the QP is solved again. A trajectory that violates a
   guaranteed limit is never returned.
+* With an exact norm limit (:class:`~skyquill.limits.NormLimit` with
+  ``sides=None``): the same, as a conic program with one second-order cone
+  per derivative hull point, solved by Clarabel whatever ``solver`` names
+  (the other backends take no cones). The margin shrinks each radius by the
+  same relative amount and the norms are checked against the untightened
+  radius.
 
 Paper 003 eq. (54) drops the factor ``-1/2`` of the stationarity condition
 of ``x'Gx + f'x``; solving the KKT system sidesteps the slip.
@@ -33,9 +39,16 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from skyquill.errors import InfeasibleError, InputError, SolverError
-from skyquill.optimize.assemble import Assembled, assemble, problem_cost
+from skyquill.optimize.assemble import Assembled, NormCones, assemble, problem_cost
 from skyquill.optimize.problem import SmoothingProblem
-from skyquill.solvers import BACKENDS, DEFAULT_BACKEND, QuadraticProgram, solve_qp
+from skyquill.solvers import (
+    BACKENDS,
+    CONIC_BACKENDS,
+    DEFAULT_BACKEND,
+    QuadraticProgram,
+    SecondOrderCones,
+    solve_qp,
+)
 from skyquill.trajectory import SplineTrajectory
 from skyquill.validation import FloatArray
 from skyquill.verify import Verification
@@ -57,7 +70,7 @@ class FitResult:
     trajectory
         The B-spline trajectory.
     method
-        ``"closed_form"`` or ``"qp"``.
+        ``"closed_form"`` or ``"qp"`` (also for the conic program of exact norm limits).
     solver
         ``"sparse-lu"`` or the QP backend's name.
     cost
@@ -71,7 +84,9 @@ class FitResult:
     problem
         The problem that was solved.
     n_variables, n_equalities, n_inequalities
-        Problem size.
+        Problem size (``n_inequalities``: linear rows).
+    n_cones
+        Second-order cones (one per hull point of an exact norm limit).
     """
 
     trajectory: SplineTrajectory
@@ -85,6 +100,7 @@ class FitResult:
     n_variables: int
     n_equalities: int
     n_inequalities: int
+    n_cones: int = 0
 
     @property
     def status(self) -> Literal["optimal"]:
@@ -146,6 +162,7 @@ def solve(problem: SmoothingProblem, solver: str = DEFAULT_BACKEND) -> FitResult
         n_variables=C.size,
         n_equalities=asm.E.shape[0] * problem.dim,
         n_inequalities=asm.G_ineq.shape[0],
+        n_cones=asm.cones.radius.size if asm.cones is not None else 0,
     )
 
 
@@ -249,7 +266,7 @@ def _to_qp(asm: Assembled, margin: float = 0.0) -> QuadraticProgram:
     """The QP of ``asm``, every inequality tightened by ``margin * max(|h|, 1e-3)``.
 
     The margin keeps a solver's feasibility tolerance from leaving the result
-    outside a limit it was asked to hold.
+    outside a limit it was asked to hold; cone radii shrink the same way.
     """
     d = asm.F.shape[1]
     return QuadraticProgram(
@@ -259,13 +276,49 @@ def _to_qp(asm: Assembled, margin: float = 0.0) -> QuadraticProgram:
         b_eq=asm.e.ravel(),
         G=sp.csc_array(asm.G_ineq),
         h=asm.h_ineq - margin * np.maximum(np.abs(asm.h_ineq), 1e-3),
+        cones=_second_order_cones(asm.cones, margin) if asm.cones is not None else None,
     )
+
+
+def _second_order_cones(
+    cones: NormCones, margin: float, points: slice | None = None
+) -> SecondOrderCones:
+    """Clarabel's ``b - A x in SOC(d + 1)`` per hull point: ``(r, -v_p)``, ``||v_p|| <= r``.
+
+    ``points`` keeps only those hull points (infeasibility diagnosis).
+    """
+    keep = points if points is not None else slice(0, cones.radius.size)
+    radius = cones.radius[keep]
+    P = radius.size
+    d = cones.map.shape[0] // cones.radius.size
+    rows = cones.map[keep.start * d : keep.stop * d].tocoo()
+    # Row j of point p goes to row p (d + 1) + 1 + j; row p (d + 1) is the radius.
+    A = sp.csc_array(
+        (rows.data, ((rows.row // d) * (d + 1) + 1 + rows.row % d, rows.col)),
+        shape=(P * (d + 1), cones.map.shape[1]),
+    )
+    b = np.zeros(P * (d + 1))
+    b[:: d + 1] = radius - margin * np.maximum(radius, 1e-3)
+    return SecondOrderCones(A, b, (d + 1,) * P)
+
+
+def _hull_excess(asm: Assembled, x: FloatArray) -> float:
+    """Largest relative excess over the untightened hull constraints (linear rows and cones)."""
+    scale = np.maximum(np.abs(asm.h_ineq), 1e-3)
+    excess = float(((asm.G_ineq @ x - asm.h_ineq) / scale).max(initial=0.0))
+    if asm.cones is not None:
+        r = asm.cones.radius
+        cone = (asm.cones.norms(x) - r) / np.maximum(r, 1e-3)
+        excess = max(excess, float(cone.max(initial=0.0)))
+    return excess
 
 
 def _solve_qp(problem: SmoothingProblem, solver: str) -> tuple[FloatArray, str, float, Assembled]:
     exact = assemble(problem)
-    scale = np.maximum(np.abs(exact.h_ineq), 1e-3)
-    backends = [solver, *(b for b in ("clarabel", "piqp") if b != solver)]
+    if exact.cones is not None:
+        backends = list(CONIC_BACKENDS)
+    else:
+        backends = [solver, *(b for b in ("clarabel", "piqp") if b != solver)]
     failures: list[str] = []
     for margin in _MARGINS:
         qp = _to_qp(exact, margin)
@@ -279,7 +332,7 @@ def _solve_qp(problem: SmoothingProblem, solver: str) -> tuple[FloatArray, str, 
         else:
             continue
         assert sol.x is not None
-        excess = float(((exact.G_ineq @ sol.x - exact.h_ineq) / scale).max(initial=0.0))
+        excess = _hull_excess(exact, sol.x)
         if excess <= GUARANTEE_RTOL:
             return sol.x.reshape(problem.n_ctrl, problem.dim), sol.solver, margin, exact
         log.info("hull excess %.3g at margin %.0e; tightening", excess, margin)
@@ -293,12 +346,24 @@ def _solve_qp(problem: SmoothingProblem, solver: str) -> tuple[FloatArray, str, 
 
 
 def _raise_infeasible(problem: SmoothingProblem, asm: Assembled, certain: bool = True) -> None:
-    """Find which constraint families cannot be met, then raise :class:`InfeasibleError`."""
+    """Find which constraint families cannot be met, then raise :class:`InfeasibleError`.
+
+    Linear families are tested by an LP (HiGHS); once a cone family is among
+    them, by Clarabel with a zero objective.
+    """
     d = problem.dim
     A_eq = sp.csr_array(sp.kron(asm.E, sp.eye_array(d)))
     b_eq = asm.e.ravel()
+    # (label, is_cone, rows): rows of G_ineq, or hull points of asm.cones.
+    families = [(f.label, False, f.rows) for f in asm.families]
+    if asm.cones is not None:
+        families += [(f.label, True, f.rows) for f in asm.cones.families]
 
-    def feasible(rows: list[slice]) -> bool:
+    def feasible(chosen: list[tuple[str, bool, slice]]) -> bool:
+        rows = [r for _, is_cone, r in chosen if not is_cone]
+        points = [r for _, is_cone, r in chosen if is_cone]
+        if points:
+            return _conic_feasible(asm, rows, points)
         G = sp.vstack([asm.G_ineq[r, :] for r in rows]) if rows else None
         h = np.concatenate([asm.h_ineq[r] for r in rows]) if rows else None
         # scipy accepts sparse A_ub / A_eq; its stubs only list dense arrays.
@@ -319,7 +384,7 @@ def _raise_infeasible(problem: SmoothingProblem, asm: Assembled, certain: bool =
             f"{prefix}: the boundary conditions and interpolated points contradict each other",
             ("equalities",),
         )
-    alone = [f.label for f in asm.families if not feasible([f.rows])]
+    alone = [f[0] for f in families if not feasible([f])]
     if alone:
         raise InfeasibleError(
             f"{prefix}: cannot be met together with the boundary conditions and interpolated "
@@ -329,6 +394,27 @@ def _raise_infeasible(problem: SmoothingProblem, asm: Assembled, certain: bool =
         )
     raise InfeasibleError(
         f"{prefix}: each constraint family is satisfiable alone but not all together: "
-        f"{'; '.join(f.label for f in asm.families)}",
-        tuple(f.label for f in asm.families),
+        f"{'; '.join(f[0] for f in families)}",
+        tuple(f[0] for f in families),
     )
+
+
+def _conic_feasible(asm: Assembled, rows: list[slice], points: list[slice]) -> bool:
+    """Whether the equalities, the linear ``rows`` and the cones on hull ``points`` can all hold."""
+    assert asm.cones is not None
+    n, d = asm.G_ineq.shape[1], asm.F.shape[1]
+    blocks = [_second_order_cones(asm.cones, 0.0, p) for p in points]
+    program = QuadraticProgram(
+        P=sp.csc_array((n, n)),
+        q=np.zeros(n),
+        A_eq=sp.csc_array(sp.kron(asm.E, sp.eye_array(d))),
+        b_eq=asm.e.ravel(),
+        G=sp.csc_array(sp.vstack([asm.G_ineq[r, :] for r in rows] or [sp.csr_array((0, n))])),
+        h=np.concatenate([asm.h_ineq[r] for r in rows] or [np.zeros(0)]),
+        cones=SecondOrderCones(
+            sp.csc_array(sp.vstack([c.A for c in blocks])),
+            np.concatenate([c.b for c in blocks]),
+            tuple(k for c in blocks for k in c.dims),
+        ),
+    )
+    return solve_qp(program, "clarabel", tol=1e-8).status == "optimal"

@@ -10,7 +10,7 @@ Clarabel stays the fallback when PIQP reports a failure.
 from __future__ import annotations
 
 from skyquill.errors import InputError
-from skyquill.solvers.base import QPBackend, QPSolution, QuadraticProgram
+from skyquill.solvers.base import QPBackend, QPSolution, QuadraticProgram, SecondOrderCones
 from skyquill.solvers.clarabel_backend import solve_clarabel
 from skyquill.solvers.osqp_backend import solve_osqp
 from skyquill.solvers.piqp_backend import solve_piqp
@@ -21,6 +21,8 @@ BACKENDS: dict[str, QPBackend] = {
     "osqp": solve_osqp,
 }
 DEFAULT_BACKEND = "piqp"
+#: Backends that accept :class:`SecondOrderCones` (the others would ignore them).
+CONIC_BACKENDS = ("clarabel",)
 
 
 def solve_qp(
@@ -29,7 +31,20 @@ def solve_qp(
     """Solve ``qp`` with the named backend."""
     if backend not in BACKENDS:
         raise InputError(f"solver: got {backend!r}, expected one of {sorted(BACKENDS)}")
+    if qp.cones is not None and backend not in CONIC_BACKENDS:
+        raise InputError(
+            f"solver: got {backend!r} for a program with second-order cones, expected one "
+            f"of {list(CONIC_BACKENDS)}"
+        )
     return BACKENDS[backend](qp, tol)
 
 
-__all__ = ["BACKENDS", "DEFAULT_BACKEND", "QPSolution", "QuadraticProgram", "solve_qp"]
+__all__ = [
+    "BACKENDS",
+    "CONIC_BACKENDS",
+    "DEFAULT_BACKEND",
+    "QPSolution",
+    "QuadraticProgram",
+    "SecondOrderCones",
+    "solve_qp",
+]

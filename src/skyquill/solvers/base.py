@@ -20,6 +20,28 @@ QPStatus = Literal["optimal", "infeasible", "failed"]
 
 
 @dataclass(frozen=True)
+class SecondOrderCones:
+    """``b - A x`` in a product of second-order cones (Clarabel's convention).
+
+    Consecutive blocks of rows of sizes ``dims`` each lie in
+    ``{(t, u) : ||u||_2 <= t}``.
+
+    Attributes
+    ----------
+    A
+        Shape (m, n), CSC.
+    b
+        Shape (m,).
+    dims
+        Block sizes (each >= 2), summing to ``m``.
+    """
+
+    A: sp.csc_array
+    b: FloatArray
+    dims: tuple[int, ...]
+
+
+@dataclass(frozen=True)
 class QuadraticProgram:
     """``min 1/2 x'Px + q'x  s.t.  A_eq x = b_eq,  G x <= h``.
 
@@ -33,6 +55,9 @@ class QuadraticProgram:
         Shapes (m_eq, n), (m_eq,).
     G, h
         Shapes (m_in, n), (m_in,).
+    cones
+        Optional second-order cone constraints (a conic program: only the
+        backends in ``skyquill.solvers.CONIC_BACKENDS`` take it).
     """
 
     P: sp.csc_array
@@ -41,6 +66,7 @@ class QuadraticProgram:
     b_eq: FloatArray
     G: sp.csc_array
     h: FloatArray
+    cones: SecondOrderCones | None = None
 
     @property
     def n(self) -> int:

@@ -1,4 +1,4 @@
-"""Clarabel (interior point, Rust) adapter."""
+"""Clarabel (interior point, Rust) adapter; the one backend that also takes second-order cones."""
 
 from __future__ import annotations
 
@@ -20,13 +20,18 @@ def solve_clarabel(qp: QuadraticProgram, tol: float) -> QPSolution:
     settings.tol_feas = tol
     settings.tol_ktratio = 1e-8
     settings.max_iter = 200
-    A = sp.csc_matrix(sp.vstack([qp.A_eq, qp.G]))
-    b = np.concatenate([qp.b_eq, qp.h])
+    blocks, rhs = [qp.A_eq, qp.G], [qp.b_eq, qp.h]
     cones = []
     if qp.b_eq.size:
         cones.append(clarabel.ZeroConeT(qp.b_eq.size))
     if qp.h.size:
         cones.append(clarabel.NonnegativeConeT(qp.h.size))
+    if qp.cones is not None:
+        blocks.append(qp.cones.A)
+        rhs.append(qp.cones.b)
+        cones.extend(clarabel.SecondOrderConeT(k) for k in qp.cones.dims)
+    A = sp.csc_matrix(sp.vstack(blocks))
+    b = np.concatenate(rhs)
     P = sp.csc_matrix(sp.triu(qp.P, format="csc"))
     result = clarabel.DefaultSolver(P, qp.q, A, b, cones, settings).solve()
     elapsed = time.perf_counter() - start

@@ -11,7 +11,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.axes import Axes
 
-from skyquill.limits import BoxLimit, CylinderLimit
+from skyquill.limits import BoxLimit, DerivativeLimit, NormLimit
 from skyquill.optimize.fit import PointFit
 
 AXES = "xyz"
@@ -56,12 +56,13 @@ def plot_fit(fit: PointFit, path: str | Path, title: str = "") -> None:
     plt.close(fig)
 
 
-def _draw_limit(
-    panel: Axes, t: np.ndarray, values: np.ndarray, lim: BoxLimit | CylinderLimit
-) -> None:
+def _draw_limit(panel: Axes, t: np.ndarray, values: np.ndarray, lim: DerivativeLimit) -> None:
     if isinstance(lim, BoxLimit):
         for bound in (lim.upper.max(), lim.lower.min()):
             panel.axhline(bound, color="k", ls="--", lw=0.8)
+    elif isinstance(lim, NormLimit):
+        panel.plot(t, np.linalg.norm(values, axis=1), color="k", lw=0.8, label="norm")
+        panel.axhline(lim.radius, color="k", ls="--", lw=0.8)
     else:
         panel.plot(t, np.hypot(values[:, 0], values[:, 1]), color="k", lw=0.8, label="|xy|")
         panel.axhline(lim.radius, color="k", ls="--", lw=0.8)
