@@ -39,6 +39,8 @@ def retimed_path(plan: SpeedPlan, z: float | None = None) -> RetimedPath:
     sig, t = _grid_times(plan)
     sd, sdd, _ = plan._derivs(sig)
     sd[0] = sd[-1] = 0.0  # rest at both ends, exactly
+    if plan.jmax is not None:  # b ~ s^(4/3) at a jerk-limited rest end: no acceleration there
+        sdd[0] = sdd[-1] = 0.0
     if plan._umap is None:
         u, ud, udd = sig.copy(), sd, sdd
     else:
@@ -60,32 +62,46 @@ def _exact_law(plan: SpeedPlan) -> PiecewisePolynomial:
 
 
 def _grid_times(plan: SpeedPlan) -> tuple[FloatArray, FloatArray]:
-    """The LP's grid and the time at each node, ``t = ∫ d sigma / sigma_dot``.
+    """Nodes on the LP's grid (subdivided to the control period) and their times.
 
-    The nodes are the profile's own knots: between them the rate is smooth, so
-    the quintic law through (parameter, rate, its derivative) at the nodes is
-    accurate to high order. (Through the walk's points at the control period,
-    which straddle the knots where the profile's third derivative jumps, it
-    was not: 9-13 % spurious jerk on the 10 m square's spiral.) Each
-    interval's time is Gauss-Legendre quadrature of ``1 / sigma_dot``; on the
-    first and last interval, where the rate vanishes at the rest end like a
-    power below 1, in a variable ``x`` with ``sigma - end ~ x^3``, which makes
-    the integrand smooth.
+    The nodes include the profile's own knots: between them the rate is
+    smooth, so the quintic law through (parameter, rate, its derivative) at the
+    nodes is accurate to high order. (Through the walk's points at the control
+    period, which straddle the knots where the profile's third derivative
+    jumps, it was not: 9-13 % spurious jerk on the 10 m square's spiral.) A
+    grid interval that takes longer than the control period (slow turns,
+    adaptive grids) is cut into equal parts that do not, so that no piece of
+    the law spans more of the path's own changes than the walk would.
     """
     sig = plan._sigma
-    lo, hi = sig[:-1], sig[1:]
+    steps = _times(plan, sig)
+    parts = np.maximum(1, np.ceil(steps / plan.control_period)).astype(int)
+    if np.any(parts > 1):
+        start = np.repeat(sig[:-1], parts)
+        width = np.repeat(np.diff(sig) / parts, parts)
+        within = np.arange(parts.sum()) - np.repeat(np.cumsum(parts) - parts, parts)
+        sig = np.append(start + width * within, sig[-1])
+        steps = _times(plan, sig)
+    return sig.copy(), np.concatenate([[0.0], np.cumsum(steps)])
+
+
+def _times(plan: SpeedPlan, nodes: FloatArray) -> FloatArray:
+    """Time between consecutive ``nodes``, ``∫ d sigma / sigma_dot`` (Gauss-Legendre).
+
+    On the first and last interval, where the rate vanishes at the rest end
+    like a power below 1, the integral is taken in a variable ``x`` with
+    ``sigma - end ~ x^3``, which makes the integrand smooth.
+    """
+    lo, hi = nodes[:-1], nodes[1:]
     x = 0.5 * (_GL_NODES + 1.0)  # on [0, 1]
     w = 0.5 * _GL_WEIGHTS
-    # sigma = lo + (hi - lo) * s(x), s(x) = x on interior intervals; x^3 from the rest start;
-    # 1 - (1 - x)^3 into the rest end.
     shape = np.tile(x, (lo.size, 1))
     slope = np.ones_like(shape)
     shape[0], slope[0] = x**3, 3.0 * x**2
     shape[-1], slope[-1] = 1.0 - (1.0 - x) ** 3, 3.0 * (1.0 - x) ** 2
     points = lo[:, None] + (hi - lo)[:, None] * shape
     rate = plan._derivs(points.ravel())[0].reshape(points.shape)
-    steps = (hi - lo) * (w[None, :] * slope / np.maximum(rate, 1e-300)).sum(axis=1)
-    return sig.copy(), np.concatenate([[0.0], np.cumsum(steps)])
+    return np.asarray((hi - lo) * (w[None, :] * slope / np.maximum(rate, 1e-300)).sum(axis=1))
 
 
 #: Gauss-Legendre rule of the time quadrature.
