@@ -10,7 +10,7 @@ from resegment_cases import limited_random, limited_spiral
 from skyquill.optimize import solve
 from skyquill.optimize.assemble import assemble, problem_cost
 from skyquill.optimize.resegment.polish import polish
-from skyquill.optimize.solve import FitResult
+from skyquill.optimize.solve import FitResult, _to_qp
 
 CASES = ["spiral-box", "spiral-cylinder", "random-1", "random-2", "random-90"]
 
@@ -30,7 +30,7 @@ def test_polished_point_meets_the_kkt_conditions_exactly(case: str) -> None:
     result = limited_result(case)
     asm = assemble(result.problem)
     x0 = result.trajectory.control_points.ravel()
-    out = polish(asm, x0, result.z, result.margin)
+    out = polish(_to_qp(asm, result.margin), x0, result.z)
     assert out is not None
     A_eq = sp.kron(asm.E, sp.eye_array(result.problem.dim))
     quad, f = 2.0 * (asm.hessian() @ out.x), asm.linear()
@@ -54,4 +54,4 @@ def test_dependent_active_rows_give_no_polished_point() -> None:
     asm = assemble(result.problem)
     x0 = result.trajectory.control_points.ravel()
     assert asm.G_ineq.shape[0] > x0.size
-    assert polish(asm, x0, np.ones(asm.G_ineq.shape[0]), result.margin) is None
+    assert polish(_to_qp(asm, result.margin), x0, np.ones(asm.G_ineq.shape[0])) is None

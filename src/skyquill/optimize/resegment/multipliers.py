@@ -16,11 +16,10 @@ import logging
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.sparse as sp
 
-from skyquill.optimize.assemble import assemble, problem_cost
+from skyquill.optimize.assemble import problem_cost
 from skyquill.optimize.resegment.polish import polish
-from skyquill.optimize.solve import FitResult
+from skyquill.optimize.solve import FitResult, _to_qp
 from skyquill.validation import FloatArray
 
 log = logging.getLogger(__name__)
@@ -62,25 +61,25 @@ class Multipliers:
 def multipliers(result: FitResult) -> Multipliers:
     """The multipliers of ``result``'s solve (polished on the QP route), with the residual."""
     problem = result.problem
-    asm = assemble(problem)
+    asm = result.assembled
+    # The QP the solve handed its backend (h tightened by the margin it needed).
+    qp = _to_qp(asm, result.margin)
     C, cost = result.trajectory.control_points, result.cost
-    d = C.shape[1]
     x, y, z = C.ravel(), result.y, result.z
     if result.method == "qp":
-        polished = polish(asm, x, z, result.margin)
+        polished = polish(qp, x, z)
         if polished is None:
             log.debug("no polished point; using the solver's point and duals")
         else:
             x, y, z = polished.x, polished.y, polished.z
             C = x.reshape(C.shape)
             cost = problem_cost(problem, C)["total"]
-    G = asm.G_ineq
-    orders = np.zeros(G.shape[0])
+    orders = np.zeros(qp.h.size)
     for fam, lim in zip(asm.families, problem.limits, strict=False):  # limits come first
         orders[fam.rows] = lim.order
-    A_eq = sp.kron(asm.E, sp.eye_array(d), format="csr")
-    quad, f = 2.0 * (asm.hessian() @ x), asm.linear()
+    quad = qp.P @ x
     # grad J ~ 0 in the interior: measure the residual against its two parts.
-    size = max(float(np.linalg.norm(quad)), float(np.linalg.norm(f)), 1e-300)
-    residual = float(np.linalg.norm(quad + f + A_eq.T @ y + G.T @ z)) / size
-    return Multipliers(C, y.reshape(-1, d), np.maximum(z, 0.0), orders, G @ x, residual, cost)
+    size = max(float(np.linalg.norm(quad)), float(np.linalg.norm(qp.q)), 1e-300)
+    residual = float(np.linalg.norm(quad + qp.q + qp.A_eq.T @ y + qp.G.T @ z)) / size
+    lam = y.reshape(-1, C.shape[1])
+    return Multipliers(C, lam, np.maximum(z, 0.0), orders, qp.G @ x, residual, cost)

@@ -26,8 +26,8 @@ import numpy as np
 import scipy.sparse as sp
 from numpy.typing import NDArray
 
-from skyquill.optimize.assemble import Assembled
 from skyquill.optimize.kkt import SingularKKTError, solve_equality_qp
+from skyquill.solvers import QuadraticProgram
 from skyquill.validation import FloatArray
 
 #: A row is active when its multiplier exceeds this fraction of the largest.
@@ -44,12 +44,12 @@ class Polished:
     Attributes
     ----------
     x
-        Control points, vectorised, shape (Md,).
+        Minimiser, shape (n,) (the control points, vectorised).
     y
-        Multipliers of the rows of ``kron(E, I_d)``, shape (m_eq d,).
+        Multipliers of the rows of ``A_eq``, shape (m_eq,).
     z
-        Multipliers of the rows of ``G_ineq``, shape (m_in,), ``>= 0``; zero
-        off the active set.
+        Multipliers of the rows of ``G``, shape (m_in,), ``>= 0``; zero off
+        the active set.
     """
 
     x: FloatArray
@@ -57,43 +57,38 @@ class Polished:
     z: FloatArray
 
 
-def polish(asm: Assembled, x0: FloatArray, z0: FloatArray, margin: float) -> Polished | None:
-    """Polish the QP point ``x0`` (Md,) with duals ``z0`` (m_in,) (module docstring).
+def polish(qp: QuadraticProgram, x0: FloatArray, z0: FloatArray) -> Polished | None:
+    """Polish the solution ``x0`` (n,) with inequality duals ``z0`` (m_in,) of ``qp``.
 
     Parameters
     ----------
-    asm
-        The assembled problem.
+    qp
+        The QP that was solved (with the solve's tightened ``h``:
+        :func:`skyquill.optimize.solve._to_qp`).
     x0
-        The solver's point, shape (Md,).
+        The solver's point, shape (n,).
     z0
         The solver's inequality multipliers, shape (m_in,).
-    margin
-        The tightening of the solve (:attr:`FitResult.margin`); the rows are
-        held at ``h - margin * max(|h|, 1e-3)``, the bounds the solver saw.
 
     Returns
     -------
     Polished or None
         ``None`` when there is no polished point (module docstring).
     """
-    d = asm.F.shape[1]
-    P, q = sp.csr_array(2.0 * asm.hessian()), asm.linear()
-    A_eq = sp.csr_array(sp.kron(asm.E, sp.eye_array(d), format="csr"))
-    G = asm.G_ineq
-    scale = np.maximum(np.abs(asm.h_ineq), 1e-3)
-    tightened = asm.h_ineq - margin * scale
-    m = A_eq.shape[0]
+    G, h = qp.G, qp.h
+    scale = np.maximum(np.abs(h), 1e-3)
+    m = qp.b_eq.size
     active = np.flatnonzero(z0 > _ACTIVE_DUAL_RTOL * float(z0.max(initial=0.0)))
     for _ in range(_ITERATIONS):
-        rows = sp.csr_array(sp.vstack([A_eq, G[active.tolist(), :]], format="csr"))
+        rows = sp.csr_array(sp.vstack([qp.A_eq, G[active.tolist(), :]], format="csr"))
         try:
-            sol = solve_equality_qp(P, q, rows, np.concatenate([asm.e.ravel(), tightened[active]]))
+            sol = solve_equality_qp(
+                sp.csr_array(qp.P), qp.q, rows, np.concatenate([qp.b_eq, h[active]])
+            )
         except SingularKKTError:
             return None
         z_active = sol.y[m:]
-        violated = np.flatnonzero((G @ sol.x - tightened) / scale > 1e-12)
-        violated = np.setdiff1d(violated, active)
+        violated = np.setdiff1d(np.flatnonzero((G @ sol.x - h) / scale > 1e-12), active)
         negative = z_active < -1e-9 * max(float(np.abs(z_active).max(initial=0.0)), 1e-300)
         if violated.size == 0 and not np.any(negative):
             return _accept(sol.x, x0, y=sol.y[:m], z=z_active, active=active, m_in=G.shape[0])
