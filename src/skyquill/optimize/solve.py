@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import logging
 import time
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 from functools import cached_property
 from typing import Literal
 
@@ -91,9 +91,6 @@ class FitResult:
     ``2 H x + f + A_eq' y + G_ineq' z = 0`` (the sign convention of
     :class:`skyquill.solvers.QPSolution`), to the backend's tolerance on the
     QP route.
-    assembled
-        ``assemble(problem)``, the matrices the multipliers belong to (kept
-        so that the re-segmentation gradient does not assemble again).
     """
 
     trajectory: SplineTrajectory
@@ -109,7 +106,6 @@ class FitResult:
     n_inequalities: int
     y: FloatArray
     z: FloatArray
-    assembled: Assembled = field(repr=False, compare=False)
 
     @property
     def status(self) -> Literal["optimal"]:
@@ -173,7 +169,6 @@ def solve(problem: SmoothingProblem, solver: str = DEFAULT_BACKEND) -> FitResult
         n_inequalities=asm.G_ineq.shape[0],
         y=y,
         z=z,
-        assembled=asm,
     )
 
 

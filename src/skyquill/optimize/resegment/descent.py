@@ -161,8 +161,8 @@ def resegment(
         Initial times, shape (N,), s, strictly increasing (shifted to start
         at 0).
     make_problem
-        ``times -> SmoothingProblem`` (module docstring: ``duration ==
-        times[-1]``, fixed ``n_ctrl``).
+        ``times -> SmoothingProblem`` (contract in :mod:`.problems`:
+        ``duration == times[-1]``, fixed ``n_ctrl``).
     mode
         ``"fixed"``: keep the total time; ``"free"``: let it move, priced by
         ``time_penalty``.

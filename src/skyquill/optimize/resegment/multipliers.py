@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from skyquill.optimize.assemble import problem_cost
+from skyquill.optimize.assemble import assemble, problem_cost
 from skyquill.optimize.resegment.polish import polish
 from skyquill.optimize.solve import FitResult, _to_qp
 from skyquill.validation import FloatArray
@@ -61,7 +61,9 @@ class Multipliers:
 def multipliers(result: FitResult) -> Multipliers:
     """The multipliers of ``result``'s solve (polished on the QP route), with the residual."""
     problem = result.problem
-    asm = result.assembled
+    # Assembled again rather than kept in FitResult: the matrices are 4-5x the
+    # size of the rest of a result, which missions pickle across processes.
+    asm = assemble(problem)
     # The QP the solve handed its backend (h tightened by the margin it needed).
     qp = _to_qp(asm, result.margin)
     C, cost = result.trajectory.control_points, result.cost
