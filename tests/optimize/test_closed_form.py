@@ -327,6 +327,11 @@ def test_closed_form_equals_solve_qp_on_assembled(make: object, backend: str) ->
     assert rel_diff(C, closed.trajectory.control_points) <= tol
     # The reported cost is evaluated term by term, not from the scaled QP.
     assert problem_cost(problem, C)["total"] == pytest.approx(closed.cost, rel=1e-8, abs=1e-12)
+    # The closed form's multipliers (from its KKT solve) are the backend's duals.
+    assert sol.y is not None
+    assert closed.y.shape == sol.y.shape == (closed.n_equalities,)
+    assert closed.z.shape == (0,)
+    assert rel_diff(sol.y, closed.y) <= 1e3 * tol
 
 
 # ------------------------------------------------------------------ cost terms

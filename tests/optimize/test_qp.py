@@ -17,6 +17,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 import pytest
+import scipy.sparse as sp
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from numpy.typing import NDArray
@@ -32,9 +33,11 @@ from skyquill.optimize import (
     SmoothingProblem,
     solve,
 )
+from skyquill.optimize.assemble import assemble
 from skyquill.spline import basis_for
 
 Array = NDArray[np.float64]
+BACKENDS = ["clarabel", "piqp", "osqp"]
 
 SETTINGS = settings(
     max_examples=25,
@@ -330,3 +333,32 @@ def test_input_limit_of_a_chain_of_integrators_holds() -> None:
     assert np.abs(snap).max() <= 0.5 * snap_free * (1 + 1e-9)
     assert result.verification.max_excess <= 1e-9
     assert result.trajectory.verify((limit,)).max_excess <= 1e-9
+
+
+# ------------------------------------------------------------------ duals
+def stationarity(result: FitResult) -> tuple[float, Array]:
+    """Relative residual of ``2 H x + f + A_eq' y + G' z = 0`` and the slack of the
+    QP that was solved (``h`` tightened by ``margin``, as in ``solve``)."""
+    asm = assemble(result.problem)
+    x = result.trajectory.control_points.ravel()
+    A_eq = sp.kron(asm.E, sp.eye_array(result.problem.dim))
+    quad, f = 2.0 * (asm.hessian() @ x), asm.linear()
+    residual = quad + f + A_eq.T @ result.y + asm.G_ineq.T @ result.z
+    size = max(float(np.linalg.norm(quad)), float(np.linalg.norm(f)), 1e-300)
+    tightened = asm.h_ineq - result.margin * np.maximum(np.abs(asm.h_ineq), 1e-3)
+    return float(np.linalg.norm(residual)) / size, tightened - asm.G_ineq @ x
+
+
+@settings(max_examples=10, deadline=None, derandomize=True)
+@given(spec=specs, kind=st.sampled_from(["box", "cyl8"]), backend=st.sampled_from(BACKENDS))
+def test_result_keeps_the_duals_of_the_solved_qp(spec: Spec, kind: str, backend: str) -> None:
+    """``FitResult.y``, ``.z`` satisfy the KKT conditions of the (tightened) QP whose
+    minimiser is the returned trajectory."""
+    result = solve(constrained(spec, kind), backend)
+    assert result.y.shape == (result.n_equalities,)
+    assert result.z.shape == (result.n_inequalities,)
+    residual, slack = stationarity(result)
+    assert residual <= 1e-6
+    z_scale = max(float(np.abs(result.z).max(initial=0.0)), 1.0)
+    assert result.z.min(initial=0.0) >= -1e-6 * z_scale
+    assert float(np.abs(result.z * slack).max(initial=0.0)) <= 1e-6 * z_scale * scale_of(slack)

@@ -184,3 +184,59 @@ def test_unknown_backend(name: str) -> None:
     qp = box_projection(np.zeros(1), -np.ones(1), np.ones(1))
     with pytest.raises(InputError, match=rf"solver: got '{name}', expected one of \['clarabel'"):
         solve_qp(qp, name)
+
+
+def kkt_qp(seed: int, n: int = 6, m_eq: int = 2, m_in: int = 8) -> tuple[QuadraticProgram, Array]:
+    """A strictly convex QP built from a chosen KKT point: half the inequalities active
+    with positive multipliers, the rest slack. Returns the QP and its minimiser."""
+    rng = np.random.default_rng(seed)
+    B = rng.normal(size=(n, n))
+    P = B.T @ B + 0.1 * np.eye(n)
+    A, G = rng.normal(size=(m_eq, n)), rng.normal(size=(m_in, n))
+    x, y = rng.normal(size=n), rng.normal(size=m_eq)
+    active = np.arange(m_in) < m_in // 2
+    z = np.where(active, rng.uniform(0.5, 2.0, m_in), 0.0)
+    slack = np.where(active, 0.0, rng.uniform(0.5, 2.0, m_in))
+    q = -(P @ x + A.T @ y + G.T @ z)
+    return make_qp(P, q, A=A, b=A @ x, G=G, h=G @ x + slack), x
+
+
+@pytest.mark.parametrize("backend", ALL)
+@pytest.mark.parametrize("seed", range(8))
+def test_duals_satisfy_the_kkt_conditions(backend: str, seed: int) -> None:
+    """``P x + q + A_eq' y + G' z = 0``, ``z >= 0``, ``z (h - G x) = 0`` (base docstring)."""
+    qp, x_ref = kkt_qp(seed)
+    sol = solve_qp(qp, backend)
+    assert sol.status == "optimal"
+    assert sol.x is not None and sol.y is not None and sol.z is not None
+    assert sol.y.shape == qp.b_eq.shape and sol.z.shape == qp.h.shape
+    x, y, z = sol.x, sol.y, sol.z
+    Px = qp.P @ x
+    residual = Px + qp.q + qp.A_eq.T @ y + qp.G.T @ z
+    scale = max(float(np.linalg.norm(Px)), float(np.linalg.norm(qp.q)), 1.0)
+    assert float(np.linalg.norm(residual)) <= 1e-6 * scale
+    assert z.min() >= -1e-6 * max(1.0, float(np.abs(z).max()))
+    slack = qp.h - qp.G @ x
+    assert float(np.abs(z * slack).max()) <= 1e-6 * scale
+    assert np.abs(x - x_ref).max() <= 1e-5
+
+
+@pytest.mark.parametrize("backend", ALL)
+def test_duals_of_a_known_projection(backend: str) -> None:
+    """Projection of ``z = (2, -3, 0.5)`` onto ``x <= 1``, ``sum x = 0``: closed form."""
+    point = np.array([2.0, -3.0, 0.5])
+    # Free entries: x_i - point_i + y = 0, so sum x = 1 - 2.5 - 2 y = 0 gives y = -0.75,
+    # x = (1, -2.25, 1.25); the bound row: 1 - 2 + y + z_0 = 0 gives z_0 = 1.75.
+    qp = make_qp(np.eye(3), -point, A=np.ones((1, 3)), b=np.zeros(1), G=np.eye(3)[:1], h=np.ones(1))
+    sol = solve_qp(qp, backend)
+    assert sol.x is not None and sol.y is not None and sol.z is not None
+    assert np.abs(sol.x - [1.0, -2.25, 1.25]).max() <= TOL[backend]
+    assert np.abs(sol.y - [-0.75]).max() <= 10 * TOL[backend]
+    assert np.abs(sol.z - [1.75]).max() <= 10 * TOL[backend]
+
+
+@pytest.mark.parametrize("backend", INTERIOR_POINT)
+def test_no_duals_unless_optimal(backend: str) -> None:
+    qp = make_qp(np.eye(1), np.zeros(1), G=np.array([[1.0], [-1.0]]), h=np.array([-1.0, -1.0]))
+    sol = solve_qp(qp, backend)
+    assert sol.y is None and sol.z is None

@@ -2,10 +2,11 @@
 
 * Only equalities (boundary conditions, interpolated points): the KKT system
   of the equality-constrained quadratic is solved by a sparse LU
-  factorisation (paper 003 eqs. 44-54, paper 000 eq. 43). Its matrix is
-  banded up to a permutation, so time and memory grow linearly with ``M``.
-  When every term acts on each axis alone the ``M``-sized system is factored
-  once and solved for all ``d`` axes together.
+  factorisation (paper 003 eqs. 44-54, paper 000 eq. 43;
+  :func:`skyquill.optimize.kkt.solve_equality_qp`). Its matrix is banded up
+  to a permutation, so time and memory grow linearly with ``M``. When every
+  term acts on each axis alone the ``M``-sized system is factored once and
+  solved for all ``d`` axes together.
 * With limits or corridors: a sparse QP through a backend adapter
   (:mod:`skyquill.solvers`). Every inequality is tightened by a tiny relative
   margin and the result is checked against the *untightened* hull
@@ -19,6 +20,10 @@
   same relative amount and the norms are checked against the untightened
   radius.
 
+Either way the result keeps the multipliers of the problem it solved
+(:attr:`FitResult.y`, :attr:`FitResult.z`); the re-segmentation gradient
+(:mod:`skyquill.optimize.resegment`) is built on them.
+
 Paper 003 eq. (54) drops the factor ``-1/2`` of the stationarity condition
 of ``x'Gx + f'x``; solving the KKT system sidesteps the slip.
 """
@@ -27,7 +32,6 @@ from __future__ import annotations
 
 import logging
 import time
-import warnings
 from dataclasses import dataclass, replace
 from functools import cached_property
 from typing import Literal
@@ -36,10 +40,11 @@ import numpy as np
 import scipy.linalg
 import scipy.optimize
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
+from numpy.typing import NDArray
 
 from skyquill.errors import InfeasibleError, InputError, SolverError
 from skyquill.optimize.assemble import Assembled, NormCones, assemble, problem_cost
+from skyquill.optimize.kkt import SingularKKTError, solve_equality_qp
 from skyquill.optimize.problem import SmoothingProblem
 from skyquill.solvers import (
     BACKENDS,
@@ -58,7 +63,6 @@ log = logging.getLogger(__name__)
 #: Hull constraints must hold to this relative tolerance (docs/architecture.md: 1e-9).
 GUARANTEE_RTOL = 1e-9
 _MARGINS = (1e-9, 1e-8, 1e-7, 1e-6, 1e-5)
-_DENSE_KKT = 300
 
 
 @dataclass(frozen=True)
@@ -87,6 +91,21 @@ class FitResult:
         Problem size (``n_inequalities``: linear rows).
     n_cones
         Second-order cones (one per hull point of an exact norm limit).
+    y
+        Equality multipliers, shape (n_equalities,), one per row of
+        ``A_eq = kron(E, I_d)`` of ``assemble(problem)`` (row ``i d + j``:
+        equality ``i`` on axis ``j``; ``x = C.ravel()``).
+    z
+        Inequality multipliers ``>= 0``, shape (n_inequalities,), one per row
+        of ``assemble(problem).G_ineq`` (empty for the closed form). They
+        belong to the QP that was solved, i.e. with ``h`` tightened by
+        ``margin``, whose minimiser is ``trajectory``.
+
+    With ``J(x) = x'Hx + f'x`` the assembled cost (``H = hessian()``,
+    ``f = linear()``; the QP's ``P = 2 H``, ``q = f``), the multipliers satisfy
+    ``2 H x + f + A_eq' y + G_ineq' z = 0`` (the sign convention of
+    :class:`skyquill.solvers.QPSolution`), to the backend's tolerance on the
+    QP route.
     """
 
     trajectory: SplineTrajectory
@@ -100,6 +119,8 @@ class FitResult:
     n_variables: int
     n_equalities: int
     n_inequalities: int
+    y: FloatArray
+    z: FloatArray
     n_cones: int = 0
 
     @property
@@ -141,11 +162,11 @@ def solve(problem: SmoothingProblem, solver: str = DEFAULT_BACKEND) -> FitResult
         raise InputError(f"solver: got {solver!r}, expected one of {sorted(BACKENDS)}")
     start = time.perf_counter()
     if problem.has_inequalities:
-        C, used, margin, asm = _solve_qp(problem, solver)
+        C, y, z, used, margin, asm = _solve_qp(problem, solver)
         method: Literal["closed_form", "qp"] = "qp"
     else:
         asm = assemble(problem)
-        C, used, margin = _closed_form(asm), "sparse-lu", 0.0
+        (C, y), z, used, margin = _closed_form(asm), np.zeros(0), "sparse-lu", 0.0
         method = "closed_form"
     elapsed = time.perf_counter() - start
     traj = SplineTrajectory(C, problem.degree, problem.duration)
@@ -162,30 +183,50 @@ def solve(problem: SmoothingProblem, solver: str = DEFAULT_BACKEND) -> FitResult
         n_variables=C.size,
         n_equalities=asm.E.shape[0] * problem.dim,
         n_inequalities=asm.G_ineq.shape[0],
+        y=y,
+        z=z,
         n_cones=asm.cones.radius.size if asm.cones is not None else 0,
     )
 
 
-def _closed_form(asm: Assembled) -> FloatArray:
+def _closed_form(asm: Assembled) -> tuple[FloatArray, FloatArray]:
     """Minimise the quadratic subject to the equalities by one sparse LU.
+
+    Returns the control points (M, d) and the multipliers ``y`` (m_eq d,) of
+    the rows of ``kron(E, I_d)`` (:attr:`FitResult.y`).
 
     Consistent but redundant equalities that assembly cannot see as exact
     repeats make the KKT matrix singular although the QP route would solve
     the problem. On a singular factorisation the dependent rows are dropped
-    and the system solved again; contradictory rows raise
-    :class:`InfeasibleError`, as on the QP route.
+    (their multipliers are 0) and the system solved again; contradictory rows
+    raise :class:`InfeasibleError`, as on the QP route.
     """
     try:
         return _closed_form_kkt(asm)
-    except SolverError:
-        reduced = _independent_equalities(asm)
-        if reduced is None:
-            raise
-        return _closed_form_kkt(reduced)
+    except SingularKKTError as exc:
+        keep = _independent_equalities(asm)
+        if keep is None:
+            raise _singular(exc) from exc
+        try:
+            C, y_kept = _closed_form_kkt(replace(asm, E=sp.csr_array(asm.E[keep]), e=asm.e[keep]))
+        except SingularKKTError as again:
+            raise _singular(again) from again
+        d = asm.F.shape[1]
+        y = np.zeros((asm.E.shape[0], d))
+        y[keep] = y_kept.reshape(-1, d)
+        return C, y.ravel()
 
 
-def _independent_equalities(asm: Assembled) -> Assembled | None:
-    """``asm`` with linearly dependent equality rows dropped; ``None`` if there are none.
+def _singular(exc: SingularKKTError) -> SolverError:
+    return SolverError(
+        "closed form: the KKT matrix is singular -- the equalities are redundant or "
+        "contradictory, or the cost does not determine every control point (add a "
+        f"deviation term or boundary conditions) ({exc})"
+    )
+
+
+def _independent_equalities(asm: Assembled) -> NDArray[np.intp] | None:
+    """Indices of a linearly independent subset of the equality rows; ``None`` if all are.
 
     Dense pivoted QR of ``E'``: only reached after a singular factorisation.
     """
@@ -206,60 +247,24 @@ def _independent_equalities(asm: Assembled) -> Assembled | None:
             "infeasible: the boundary conditions and interpolated points contradict each other",
             ("equalities",),
         )
-    return replace(asm, E=sp.csr_array(asm.E[keep]), e=asm.e[keep])
+    return keep
 
 
-def _closed_form_kkt(asm: Assembled) -> FloatArray:
+def _closed_form_kkt(asm: Assembled) -> tuple[FloatArray, FloatArray]:
+    """One KKT solve: control points (M, d) and equality multipliers (m_eq d,).
+
+    ``J = x'Hx + f'x``, so the QP has ``P = 2 H`` and ``q = f``. When every
+    term acts on each axis alone the ``M``-sized system is solved for all
+    ``d`` axes with one factorisation; row ``i`` of the multipliers (m_eq, d)
+    then belongs to rows ``i d .. i d + d - 1`` of ``kron(E, I_d)``.
+    """
     M, d = asm.F.shape
     if asm.separable:
-        G2 = 2.0 * asm.cost_scale * asm.G_axis
-        rhs = np.vstack([-asm.cost_scale * asm.F, asm.e])
-        return _lu_solve(G2, asm.E, rhs)[:M]
-    E = sp.csr_array(sp.kron(asm.E, sp.eye_array(d), format="csr"))
-    rhs = np.concatenate([-asm.cost_scale * asm.linear(), asm.e.ravel()])
-    x = _lu_solve(2.0 * asm.cost_scale * asm.hessian(), E, rhs[:, None])
-    return x[: M * d, 0].reshape(M, d)
-
-
-def _lu_solve(G2: sp.csr_array, E: sp.csr_array, rhs: FloatArray) -> FloatArray:
-    """Solve the KKT system ``[[G2, E'], [E, 0]] x = rhs``."""
-    n = G2.shape[0] + E.shape[0]
-    if n <= _DENSE_KKT:
-        K = np.zeros((n, n))
-        m = G2.shape[0]
-        K[:m, :m] = G2.toarray()
-        K[m:, :m] = E.toarray()
-        K[:m, m:] = K[m:, :m].T
-        return _factor_solve(K, rhs)
-    return _factor_solve(sp.block_array([[G2, E.T], [E, None]], format="csc"), rhs)
-
-
-def _factor_solve(K: FloatArray | sp.csc_array, rhs: FloatArray) -> FloatArray:
-    """Solve ``K x = rhs`` by sparse LU (SuperLU, COLAMD ordering).
-
-    With the scaling of :func:`assemble` the relative residual is ~1e-15 even
-    for snap at 100 spans/s (``alpha^7 = 1e14`` against point weights 1e4),
-    so no refinement step is needed. Below ``_DENSE_KKT`` unknowns LAPACK's
-    dense LU is faster than building SuperLU's structures (0.02 ms against
-    0.34 ms for 59 unknowns, ``make bench``).
-    """
-    try:
-        if isinstance(K, np.ndarray):
-            with warnings.catch_warnings():
-                # LAPACK's condition estimate: treat "ill-conditioned" as singular.
-                warnings.simplefilter("error", scipy.linalg.LinAlgWarning)
-                x = scipy.linalg.solve(K, rhs, check_finite=False)
-        else:
-            x = np.asarray(spla.splu(K).solve(rhs))
-    except (RuntimeError, np.linalg.LinAlgError, scipy.linalg.LinAlgWarning) as exc:
-        raise SolverError(
-            "closed form: the KKT matrix is singular -- the equalities are redundant or "
-            "contradictory, or the cost does not determine every control point (add a "
-            "deviation term or boundary conditions)"
-        ) from exc
-    if not np.all(np.isfinite(x)):
-        raise SolverError("closed form: the solution is not finite (ill-conditioned problem)")
-    return x
+        sol = solve_equality_qp(2.0 * asm.G_axis, asm.F, asm.E, asm.e)
+        return sol.x, sol.y.ravel()
+    A = sp.csr_array(sp.kron(asm.E, sp.eye_array(d), format="csr"))
+    sol = solve_equality_qp(2.0 * asm.hessian(), asm.linear(), A, asm.e.ravel())
+    return sol.x.reshape(M, d), sol.y
 
 
 def _to_qp(asm: Assembled, margin: float = 0.0) -> QuadraticProgram:
@@ -313,7 +318,10 @@ def _hull_excess(asm: Assembled, x: FloatArray) -> float:
     return excess
 
 
-def _solve_qp(problem: SmoothingProblem, solver: str) -> tuple[FloatArray, str, float, Assembled]:
+def _solve_qp(
+    problem: SmoothingProblem, solver: str
+) -> tuple[FloatArray, FloatArray, FloatArray, str, float, Assembled]:
+    """Control points, the duals ``y``, ``z`` of the same (tightened) QP, backend, margin."""
     exact = assemble(problem)
     if exact.cones is not None:
         backends = list(CONIC_BACKENDS)
@@ -331,10 +339,11 @@ def _solve_qp(problem: SmoothingProblem, solver: str) -> tuple[FloatArray, str, 
             failures.append(f"{backend}: {sol.message}")
         else:
             continue
-        assert sol.x is not None
+        assert sol.x is not None and sol.y is not None and sol.z is not None
         excess = _hull_excess(exact, sol.x)
         if excess <= GUARANTEE_RTOL:
-            return sol.x.reshape(problem.n_ctrl, problem.dim), sol.solver, margin, exact
+            C = sol.x.reshape(problem.n_ctrl, problem.dim)
+            return C, sol.y, sol.z, sol.solver, margin, exact
         log.info("hull excess %.3g at margin %.0e; tightening", excess, margin)
     if failures and len(failures) >= len(backends) * len(_MARGINS):
         # Backends fail this way on problems that are infeasible by a hair.

@@ -4,6 +4,14 @@ A :class:`QuadraticProgram` is ``min 1/2 x'Px + q'x  s.t.  A_eq x = b_eq,
 G x <= h``; a backend returns a typed :class:`QPSolution` whose ``status``
 is one of ``"optimal"``, ``"infeasible"`` or ``"failed"`` (qpsolvers'
 ``Solution`` and rotorpy's ``ExitStatus`` do the same).
+
+Duals, one sign convention for every backend (qpsolvers' ``Solution.y``,
+``Solution.z``): at an optimum ``x`` with equality multipliers ``y`` and
+inequality multipliers ``z >= 0``,
+
+    P x + q + A_eq' y + G' z = 0,      z * (h - G x) = 0.
+
+Each adapter converts its solver's own signs and row order to this.
 """
 
 from __future__ import annotations
@@ -95,6 +103,12 @@ class QPSolution:
         Wall time of the backend's setup and solve.
     message
         The backend's own status text.
+    y
+        Equality multipliers, shape (m_eq,), or ``None`` unless optimal
+        (module docstring: ``P x + q + A_eq' y + G' z = 0``).
+    z
+        Inequality multipliers, shape (m_in,), ``>= 0`` up to the solver's
+        tolerance, or ``None`` unless optimal.
     """
 
     status: QPStatus
@@ -102,6 +116,8 @@ class QPSolution:
     solver: str
     solve_time_s: float
     message: str = ""
+    y: FloatArray | None = None
+    z: FloatArray | None = None
 
 
 class QPBackend(Protocol):

@@ -37,7 +37,20 @@ def solve_clarabel(qp: QuadraticProgram, tol: float) -> QPSolution:
     elapsed = time.perf_counter() - start
     name = str(result.status).split(".")[-1]
     if name in ("Solved", "AlmostSolved"):
-        return QPSolution("optimal", np.asarray(result.x), "clarabel", elapsed, name)
+        # Clarabel: P x + q + A' z = 0 with z in the dual cone of each row block,
+        # zero cone (equalities) first, then the nonnegative cone (G x <= h), then
+        # the second-order cones, whose duals QPSolution does not carry.
+        z = np.asarray(result.z)
+        m_eq, m_in = qp.b_eq.size, qp.h.size
+        return QPSolution(
+            "optimal",
+            np.asarray(result.x),
+            "clarabel",
+            elapsed,
+            name,
+            z[:m_eq],
+            z[m_eq : m_eq + m_in],
+        )
     if "PrimalInfeasible" in name:
         return QPSolution("infeasible", None, "clarabel", elapsed, name)
     return QPSolution("failed", None, "clarabel", elapsed, name)

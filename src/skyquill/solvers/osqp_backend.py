@@ -38,7 +38,13 @@ def solve_osqp(qp: QuadraticProgram, tol: float) -> QPSolution:
     elapsed = time.perf_counter() - start
     name = str(result.info.status)
     if name.startswith("solved") and "inaccurate" not in name:
-        return QPSolution("optimal", np.asarray(result.x), "osqp", elapsed, name)
+        # OSQP: P x + q + A' y = 0 for l <= A x <= u, y > 0 where the upper bound
+        # is active; rows are [A_eq; G] (stacked_constraints).
+        y = np.asarray(result.y)
+        m_eq = qp.b_eq.size
+        return QPSolution(
+            "optimal", np.asarray(result.x), "osqp", elapsed, name, y[:m_eq], y[m_eq:]
+        )
     if name.startswith("primal infeasible"):
         return QPSolution("infeasible", None, "osqp", elapsed, name)
     return QPSolution("failed", None, "osqp", elapsed, name)

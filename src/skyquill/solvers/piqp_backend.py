@@ -32,7 +32,12 @@ def solve_piqp(qp: QuadraticProgram, tol: float) -> QPSolution:
     elapsed = time.perf_counter() - start
     name = str(status).split(".")[-1]
     if name == "PIQP_SOLVED":
-        return QPSolution("optimal", np.array(solver.result.x), "piqp", elapsed, name)
+        result = solver.result
+        # PIQP's stationarity is P x + c + A' y + G' (z_u - z_l) = 0 (two-sided
+        # rows; h_l = -inf here, so z_l = 0); no box constraints are passed.
+        y = np.array(result.y) if qp.b_eq.size else np.zeros(0)
+        z = np.array(result.z_u) - np.array(result.z_l) if qp.h.size else np.zeros(0)
+        return QPSolution("optimal", np.array(result.x), "piqp", elapsed, name, y, z)
     if name == "PIQP_PRIMAL_INFEASIBLE":
         return QPSolution("infeasible", None, "piqp", elapsed, name)
     return QPSolution("failed", None, "piqp", elapsed, name)

@@ -1,0 +1,98 @@
+"""The re-segmentation descent: monotone, keeps or prices the total time, validates."""
+
+from __future__ import annotations
+
+from typing import Literal
+
+import numpy as np
+import pytest
+from resegment_cases import limited_spiral, spiral
+
+from skyquill.errors import InputError
+from skyquill.optimize.resegment import point_fit_factory, resegment, time_gradient
+
+
+# ------------------------------------------------------------------ descent
+@pytest.mark.parametrize("step_rule", ["bb", "double"])
+def test_fixed_mode_descends_monotonically_and_keeps_total_time(
+    step_rule: Literal["bb", "double"],
+) -> None:
+    pts, times = spiral(30)
+    make = point_fit_factory(pts, 22)
+    out = resegment(pts, times, make, mode="fixed", max_iter=300, step_rule=step_rule)
+    assert out.status == "converged"
+    assert np.all(np.diff(out.history) <= 0.0)
+    assert out.history[-1] < 0.5 * out.history[0]
+    assert abs(out.total_time - times[-1]) <= 1e-12 * times[-1]
+    assert np.all(np.abs(out.total_time_history - times[-1]) <= 1e-12 * times[-1])
+    assert np.all(np.diff(out.times) > 0.0)
+    assert out.times[0] == 0.0
+    assert out.cost == out.history[-1]
+    assert out.n_solves >= out.iterations + 1
+    # At the end the projected gradient is small against where it started.
+    start = time_gradient(times, make).grad_segments
+    assert out.gradient_norm < 1e-3 * float(np.linalg.norm(start - start.mean()))
+
+
+def test_free_mode_with_penalty_converges_to_a_finite_time() -> None:
+    pts, times = spiral(30)
+    make = point_fit_factory(pts, 22)
+    rho = 20.0
+    out = resegment(pts, times, make, mode="free", time_penalty=rho, max_iter=500, tol=1e-8)
+    assert out.status == "converged"
+    assert np.all(np.diff(out.history) <= 0.0)
+    assert np.isfinite(out.total_time)
+    # Stationary along the scaling direction: rho D = 5 E_jerk (module docstring).
+    energy = out.result.cost_terms["smoothness"]
+    assert rho * out.total_time == pytest.approx(5.0 * energy, rel=1e-4)
+    # A larger price buys a shorter time.
+    dearer = resegment(pts, times, make, mode="free", time_penalty=4 * rho, max_iter=500)
+    assert dearer.total_time < out.total_time
+
+
+def test_free_mode_without_penalty_drifts_to_longer_times() -> None:
+    pts, times = spiral(20)
+    out = resegment(pts, times, point_fit_factory(pts, 16), mode="free", max_iter=40)
+    assert out.status == "max_iter"
+    assert np.all(np.diff(out.history) < 0.0)
+    assert out.total_time > 1.5 * times[-1]
+    assert out.total_time_history[-1] > out.total_time_history[-10]
+
+
+def test_qp_descent_stays_feasible_and_monotone() -> None:
+    pts, times, make = limited_spiral(24, 18, 8)
+    out = resegment(pts, times, make, mode="fixed", max_iter=15)
+    assert out.result.method == "qp"
+    assert np.all(np.diff(out.history) <= 0.0)
+    assert out.history[-1] < out.history[0]
+    assert out.result.verification.max_excess <= 1e-9
+
+
+def test_default_problem_and_two_points() -> None:
+    pts, times = spiral(12)
+    out = resegment(pts, times + 3.0, max_iter=5)  # shifted to start at 0
+    assert out.initial_times[0] == 0.0
+    assert out.history[-1] <= out.history[0]
+    two = resegment(pts[:2], np.array([0.0, 1.0]), mode="fixed")
+    assert two.status == "converged"
+    assert two.iterations == 0
+
+
+# ------------------------------------------------------------------ validation
+def test_rejects_bad_arguments() -> None:
+    pts, times = spiral(8)
+    make = point_fit_factory(pts, 14)
+    with pytest.raises(InputError, match="mode: got 'loose'"):
+        resegment(pts, times, make, mode="loose")  # type: ignore[arg-type]
+    with pytest.raises(InputError, match="step_rule: got 'newton'"):
+        resegment(pts, times, make, step_rule="newton")  # type: ignore[arg-type]
+    with pytest.raises(InputError, match="time_penalty: got -1"):
+        resegment(pts, times, make, mode="free", time_penalty=-1.0)
+    with pytest.raises(InputError, match="times: got times\\[2\\]"):
+        resegment(pts, times[[0, 1, 3, 2, 4, 5, 6, 7]], make)
+    with pytest.raises(InputError, match="times: got an array of shape"):
+        resegment(pts, times[:5], make)
+    with pytest.raises(InputError, match="times: got 1 time\\(s\\), expected at least 2"):
+        resegment(pts[:1], times[:1])
+    with pytest.raises(InputError, match="times: got times\\[0\\] = 1, expected 0"):
+        time_gradient(times + 1.0, make)

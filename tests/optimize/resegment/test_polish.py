@@ -1,0 +1,57 @@
+"""Polishing a QP solution: the exact minimiser on the active set of the solver's duals."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+from resegment_cases import limited_random, limited_spiral
+
+from skyquill.optimize import solve
+from skyquill.optimize.assemble import assemble, problem_cost
+from skyquill.optimize.resegment.polish import polish
+from skyquill.optimize.solve import FitResult, _to_qp
+
+CASES = ["spiral-box", "spiral-cylinder", "random-1", "random-2", "random-90"]
+
+
+def limited_result(case: str) -> FitResult:
+    """A solve with active limits: the spiral (PIQP) or a random problem (Clarabel)."""
+    kind, detail = case.split("-")
+    if kind == "spiral":
+        _, times, make = limited_spiral(24, 18, None if detail == "box" else 8)
+        return solve(make(times))
+    times, make = limited_random(int(detail), 2, 0.66)
+    return solve(make(times), "clarabel")
+
+
+@pytest.mark.parametrize("case", CASES)
+def test_polished_point_meets_the_kkt_conditions_exactly(case: str) -> None:
+    result = limited_result(case)
+    asm = assemble(result.problem)
+    x0 = result.trajectory.control_points.ravel()
+    out = polish(_to_qp(asm, result.margin), x0, result.z)
+    assert out is not None
+    A_eq = sp.kron(asm.E, sp.eye_array(result.problem.dim))
+    quad, f = 2.0 * (asm.hessian() @ out.x), asm.linear()
+    residual = quad + f + A_eq.T @ out.y + asm.G_ineq.T @ out.z
+    assert np.linalg.norm(residual) <= 1e-12 * max(np.linalg.norm(quad), np.linalg.norm(f))
+    scale = np.maximum(np.abs(asm.h_ineq), 1e-3)
+    tightened = asm.h_ineq - result.margin * scale
+    slack = (tightened - asm.G_ineq @ out.x) / scale
+    assert slack.min() >= -1e-12
+    assert out.z.min() >= 0.0
+    assert np.all(slack[out.z > 0.0] <= 1e-12)
+    # Close to the solver's point, and no costlier.
+    assert np.abs(out.x - x0).max() <= 1e-5 * max(1.0, float(np.abs(x0).max()))
+    cost = problem_cost(result.problem, out.x.reshape(x0.size // result.problem.dim, -1))
+    assert cost["total"] <= result.cost * (1.0 + 1e-12)
+
+
+def test_dependent_active_rows_give_no_polished_point() -> None:
+    """Every row declared active: more rows than unknowns, no LICQ, no polished point."""
+    result = limited_result(CASES[0])
+    asm = assemble(result.problem)
+    x0 = result.trajectory.control_points.ravel()
+    assert asm.G_ineq.shape[0] > x0.size
+    assert polish(_to_qp(asm, result.margin), x0, np.ones(asm.G_ineq.shape[0])) is None
