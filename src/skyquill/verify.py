@@ -115,6 +115,10 @@ class Verification:
         """JSON-ready dictionary."""
         return asdict(self)
 
+    def excess(self, order: int) -> float:
+        """Largest relative excess over the limits on derivative ``order`` (0 if none)."""
+        return max((c.relative_excess for c in self.checks if c.order == order), default=0.0)
+
     def limits_report(self) -> list[dict[str, Any]]:
         """Per limit: label, largest value, relative excess, guaranteed (for summary.json)."""
         return [

@@ -38,7 +38,12 @@ def test_cover_writes_summary_trajectory_and_plot(tmp_path: Path, pattern: str) 
     header = (out / "trajectory.csv").read_text().splitlines()[0].split(",")
     assert header == [*TRAJECTORY_COLUMNS, "yaw", "pen"]
     table = np.loadtxt(out / "trajectory.csv", delimiter=",", skiprows=1)
-    assert table.shape[0] == summary["trajectory_rows"]
+    drone = summary["plan"]["drones"][0]
+    assert table.shape[0] == drone["rows"]
+    assert np.all(np.isfinite(table))
+    # The dense check ran on the trajectory.json written, within the LP's 2 %.
+    assert drone["verification"]["max_excess"] <= 0.02
+    assert not summary["plan"]["limits_guaranteed"]
     steps = np.diff(table[:, 0])
     assert np.allclose(steps[:-1], 0.02, atol=1e-6) and 0.0 < steps[-1] <= 0.02 + 1e-6
     assert table[-1, 0] == pytest.approx(summary["duration_s"], abs=0.02)

@@ -42,6 +42,22 @@ PLANS: list[tuple[str, Callable[[Path], list[str]], float]] = [
     ("write-text", lambda _: ["write", "Hi", "--size", "0.3", "--vmax", "1.0"], 1.0),
     ("write-two-drones", lambda _: ["write", "一大", "--drones", "2", "--vmax", "1.0"], 1.0),
     ("paint", lambda tmp: ["paint", str(_dots(tmp))], 0.5),
+    *(
+        (
+            f"cover-{pattern}-{region}",
+            lambda _, p=pattern, r=region: [
+                "cover",
+                str(EXAMPLES / "coverage" / f"{r}.geojson"),
+                "--pattern",
+                p,
+                "--vmax",
+                "3",
+            ],
+            3.0,
+        )
+        for pattern in ("spiral", "zigzag", "zigzag-stop")
+        for region in ("square_10m", "l_field")
+    ),
 ]
 
 READERS: dict[str, Callable[[list[Path]], list[Trajectory]]] = {
@@ -55,8 +71,10 @@ READERS: dict[str, Callable[[list[Path]], list[Trajectory]]] = {
 #: rounding of the files (Skybrush's cubic approximation: 1 mm); sampled formats to the
 #: Hermite interpolation between 100 Hz rows.
 TOLERANCE_M = {"crazyswarm": 1e-6, "skyc": 1.2e-3, "px4": 1e-3, "csv": 1e-3, "json": 1e-3}
-#: Refitting a trajectory that is not a B-spline (paint's straight legs) adds its deviation.
-REFIT_TOLERANCE_M = 0.02
+#: Refitting a trajectory that is not a B-spline (paint's straight legs, coverage's retimed
+#: paths) inside the plan's limits adds its deviation: a coverage path that runs at its jerk
+#: limit (up to the LP's 2 % over it) is followed a few cm behind (3.3 cm on the L field).
+REFIT_TOLERANCE_M = 0.05
 
 
 def _dots(tmp: Path) -> Path:
@@ -67,7 +85,9 @@ def _dots(tmp: Path) -> Path:
 
 def _distance(reference: Trajectory, back: Trajectory) -> float:
     t = np.linspace(0.0, reference.duration, 4001)
-    return float(np.linalg.norm(reference.evaluate(t) - back.evaluate(t), axis=1).max())
+    # A file's own clock may end a rounding error (%.9g) before the plan's.
+    here = np.minimum(t, back.duration)
+    return float(np.linalg.norm(reference.evaluate(t) - back.evaluate(here), axis=1).max())
 
 
 @pytest.mark.slow

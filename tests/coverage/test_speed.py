@@ -28,6 +28,23 @@ def _bang_bang_time(length: float, vmax: float, amax: float) -> float:
     return 2.0 * vmax / amax + (length - d_acc) / vmax
 
 
+def _walk_check(plan: SpeedPlan, period: float) -> float:
+    """Largest relative excess of the §2.2 walk's setpoints at ``period``, by finite differences.
+
+    The walk is the paper's interpolation (the delivered trajectory is the
+    retimed path, :meth:`SpeedPlan.verify`); its positions are differenced here,
+    padded with rest before and after so that a start with acceleration shows
+    up as jerk.
+    """
+    sp = plan.setpoints(period)
+    p = np.concatenate([np.repeat(sp.p[:1], 3, axis=0), sp.p, np.repeat(sp.p[-1:], 3, axis=0)])
+    speed = np.linalg.norm(np.diff(p, axis=0), axis=1).max() / period / plan.vmax
+    ratios = [speed, (np.abs(np.diff(p, n=2, axis=0)) / period**2 / plan.amax).max()]
+    if plan.jmax is not None:
+        ratios.append((np.abs(np.diff(p, n=3, axis=0)) / period**3 / plan.jmax).max())
+    return max(0.0, float(max(ratios)) - 1.0)
+
+
 def _s_curve_time(length: float, vmax: float, amax: float, jmax: float) -> float:
     # Only the case used below: vmax = amax**2 / jmax (triangular acc profile).
     assert np.isclose(vmax, amax**2 / jmax)
@@ -85,19 +102,18 @@ def test_jerk_line_matches_s_curve_and_verifies() -> None:
     # Conservative (end caps + grid): ~1.3 % slower than the analytic S-curve.
     assert exact <= plan.duration <= exact * 1.02
     ver = plan.verify()
-    assert ver.jerk_excess <= 0.02
+    assert ver.excess(3) <= 0.02
     assert ver.max_excess <= 0.02
 
 
 def test_jerk_circle_excess_within_two_percent() -> None:
     plan = plan_speed(_circle(), 1.0, 2.0, 3.0, n=1000)
     fine = plan.verify()
-    ctrl = plan.verify(plan.control_period)
-    assert fine.max_jerk is not None
+    ctrl = _walk_check(plan, plan.control_period)
     assert fine.max_excess <= 0.02, fine
-    assert ctrl.max_excess <= 0.02, ctrl
+    assert ctrl <= 0.02, ctrl
     # The jerk limit binds: measured jerk reaches the limit.
-    assert np.max(fine.max_jerk / 3.0) > 0.95
+    assert np.max(np.asarray(fine.max_jerk) / 3.0) > 0.95
 
 
 def test_pseudo_jerk_iteration_converges_monotonically() -> None:
@@ -196,8 +212,8 @@ def test_square_spiral_within_two_percent() -> None:
     assert plan.excess_estimate <= 0.02
     assert plan.grid == "uniform"
     assert 30.0 < plan.duration < 31.0  # 30.69 s; converged value ~30.4-30.5 s
-    ctrl = plan.verify(plan.control_period)  # the Taylor walk at the control period
-    assert ctrl.max_excess <= 0.02, ctrl
+    ctrl = _walk_check(plan, plan.control_period)  # the Taylor walk at the control period
+    assert ctrl <= 0.02, ctrl
 
 
 def test_adaptive_grid_on_square_spiral() -> None:
