@@ -46,11 +46,14 @@ from threadpoolctl import threadpool_limits
 from skyquill.coverage.plan import CoverageOptions, CoveragePlan, plan_coverage, plan_tuned
 from skyquill.coverage.regions import region_from_vertices
 from skyquill.errors import SkyquillError
+from skyquill.limits import VehicleLimits
 
 RESULTS = Path(__file__).resolve().parent / "results"
 PAPER = {"spiral_s": 29.3, "zigzag_s": 34.7}
 GOAL = {"spiral_s": 25.0, "coverage": 0.97}
-LIMITS = CoverageOptions(width=2.0, vmax=3.0, amax=5.0, jmax=3.0)
+LIMITS = CoverageOptions(
+    width=2.0, limits=VehicleLimits(vmax=3.0, amax_axis=5.0, jmax_axis=3.0)
+)  # paper 001 §4: per axis
 SQUARE = region_from_vertices([[0, 0], [10, 0], [10, 10], [0, 10]])
 SHAPES = {
     "square 10 m": SQUARE,

@@ -396,6 +396,27 @@ class VehicleLimits:
                 limits.append(BoxLimit.symmetric(order, box, dim))
         return tuple(limits)
 
+    def timing_bounds(self) -> tuple[float, float]:
+        """Speed and acceleration a time allocation may plan with, m/s and m/s^2.
+
+        The norms where given, else the per-axis bounds (a move along an axis
+        reaches them; a diagonal one could go faster, so this is cautious).
+
+        Raises
+        ------
+        InputError
+            When neither a speed nor an acceleration bound of either kind is set.
+        """
+        vmax = self.vmax if self.vmax is not None else self.vmax_axis
+        amax = self.amax if self.amax is not None else self.amax_axis
+        if vmax is None or amax is None:
+            raise InputError(
+                f"limits: got vmax={self.vmax}, vmax_axis={self.vmax_axis}, amax={self.amax}, "
+                f"amax_axis={self.amax_axis}; expected a speed and an acceleration bound to "
+                "time the motion"
+            )
+        return vmax, amax
+
     def as_dict(self) -> dict[str, object]:
         """``{name: {"value", "unit", "meaning"}}`` for every field (``value`` None if unset)."""
         return {

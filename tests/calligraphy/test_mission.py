@@ -18,6 +18,7 @@ from skyquill.calligraphy.mission import (
 from skyquill.calligraphy.show import layout, plan_show
 from skyquill.errors import InfeasibleError, InputError, SkyquillError
 from skyquill.geometry import polyline_distance
+from skyquill.limits import VehicleLimits
 from skyquill.strokes import Strokes, hanzi_strokes, text_strokes
 from skyquill.trajectory import SplineTrajectory
 
@@ -113,8 +114,9 @@ def test_text_and_hanzi_are_written_faithfully() -> None:
         assert mission.fit.verification.max_excess <= 1e-9
 
 
-def test_coupled_limits() -> None:
-    mission = plan_writing(H, options=WritingOptions(coupled=8, vmax=0.8, amax=1.0, jmax=5.0))
+def test_polytope_norm_limits() -> None:
+    limits = VehicleLimits(0.8, 1.0, 5.0)
+    mission = plan_writing(H, options=WritingOptions(limits=limits, norm_sides=8))
     check = mission.fit.verification
     assert check.max_excess <= 1e-9 and mission.faithful
 

@@ -13,15 +13,18 @@ from shapely.geometry import MultiPoint, Polygon
 from skyquill.coverage.plan import CoverageOptions, plan_coverage, tune_coverage
 from skyquill.coverage.regions import region_from_vertices
 from skyquill.errors import InfeasibleError, InputError
+from skyquill.limits import VehicleLimits
 
 SQUARE = region_from_vertices([[0, 0], [10, 0], [10, 10], [0, 10]])
 TRIANGLE = region_from_vertices([[0, 0], [20, 0], [10, 17.32]])
 #: Paper 001 §4: the zigzag takes 34.7 s on the 10 m square (v 3, a 5, j 3, swath 2 m).
 PAPER_ZIGZAG_S = 34.7
+#: Paper 001 §4: v 3 m/s, a 5 m/s^2 and j 3 m/s^3 per axis.
+PAPER_LIMITS = VehicleLimits(vmax=3.0, amax_axis=5.0, jmax_axis=3.0)
 
 
 def test_stop_and_go_zigzag_reproduces_the_papers_baseline() -> None:
-    plan = plan_coverage(SQUARE, CoverageOptions(pattern="zigzag-stop"))
+    plan = plan_coverage(SQUARE, CoverageOptions(pattern="zigzag-stop", limits=PAPER_LIMITS))
     # 34.43 s: five 8 m rows and four 2 m steps, each rest to rest. The paper's
     # 34.7 s is within 1 %: its zigzag stops at every corner too.
     assert plan.duration == pytest.approx(34.43, abs=0.02)
@@ -72,15 +75,15 @@ def test_an_unreachable_coverage_target_is_infeasible() -> None:
     [
         ({"width": 0.0}, "width"),
         ({"width": -1.0}, "width"),
-        ({"vmax": 0.0}, "vmax"),
-        ({"amax": -5.0}, "amax"),
-        ({"jmax": float("nan")}, "jmax"),
+        ({"limits": VehicleLimits(amax=5.0, jmax=3.0)}, r"^limits.vmax: got None"),
+        ({"limits": VehicleLimits(3.0, 5.0, jmax_axis=3.0)}, "both as norms"),
+        ({"limits": (3.0, 5.0, 3.0)}, "expected VehicleLimits"),
         ({"pattern": "snake"}, "pattern"),
         ({"contours": "wavy"}, "contours"),
         ({"epsilon": 1.5}, "epsilon"),
         ({"delta": 0.0}, "delta"),
-        ({"limit_norm_sides": 2}, r"^limit_norm_sides: got 2"),
-        ({"limit_norm_sides": 7}, r"^limit_norm_sides: got 7, expected an even integer"),
+        ({"norm_sides": 2}, r"^norm_sides: got 2"),
+        ({"norm_sides": 7}, r"^norm_sides: got 7, expected an even integer"),
     ],
 )
 def test_bad_options_are_named(options: dict[str, object], match: str) -> None:
@@ -180,7 +183,7 @@ FINITE_REGIONS = {
 def test_every_setpoint_is_finite(name: str, pattern: str) -> None:
     # The last row (u = 1) had NaN acceleration and jerk on most regions.
     region = region_from_vertices(FINITE_REGIONS[name])
-    options = CoverageOptions(width=2.0, vmax=3.0, amax=5.0, jmax=3.0, pattern=pattern)
+    options = CoverageOptions(width=2.0, limits=PAPER_LIMITS, pattern=pattern)
     sp = plan_coverage(region, options).samples()
     for x in (sp.t, sp.p, sp.v, sp.a, sp.j):
         assert np.all(np.isfinite(x)), name
@@ -190,7 +193,7 @@ def test_every_setpoint_is_finite(name: str, pattern: str) -> None:
 @pytest.mark.parametrize("pattern", ["spiral", "zigzag", "zigzag-stop"])
 def test_norm_limits_hold_as_norms(pattern: str) -> None:
     region = region_from_vertices(FINITE_REGIONS["triangle"])
-    options = CoverageOptions(pattern=pattern, limit_norm_sides=16)  # type: ignore[arg-type]
+    options = CoverageOptions(pattern=pattern, norm_sides=16)  # type: ignore[arg-type]
     plan = plan_coverage(region, options)
     assert plan.limits["max_excess"] <= 0.02
     sp = plan.samples()
@@ -199,6 +202,6 @@ def test_norm_limits_hold_as_norms(pattern: str) -> None:
     if plan.speed_plan is not None:
         assert plan.speed_plan.norm_sides == 16
     # Per axis (the default) the same path may exceed the norms but not the axes.
-    box = plan_coverage(region, CoverageOptions(pattern=pattern))  # type: ignore[arg-type]
+    box = plan_coverage(region, CoverageOptions(pattern=pattern, limits=PAPER_LIMITS))  # type: ignore[arg-type]
     assert box.limits["max_excess"] <= 0.02
     assert box.duration <= plan.duration

@@ -31,20 +31,22 @@ def test_spiral_fit_is_faithful_and_within_limits() -> None:
     assert np.allclose(rest, 0.0, atol=1e-9)
 
 
-def test_coupled_limits_hold_on_the_norm() -> None:
+def test_polytope_norms_hold_on_the_norm() -> None:
     points, _ = read_points_csv(EXAMPLES / "segments.csv")
-    fit = fit_points(points, options=FitOptions(coupled=8, vmax=1.5, amax=1.0, jmax=3.0))
+    limits = VehicleLimits(vmax=1.5, amax=1.0, jmax=3.0)
+    fit = fit_points(points, options=FitOptions(limits=limits, norm_sides=8))
     traj = fit.result.trajectory
     t = traj.dense_times()
     for order, bound in ((1, 1.5), (2, 1.0), (3, 3.0)):
         d = traj.evaluate(t, order)
-        assert np.hypot(d[:, 0], d[:, 1]).max() <= bound * (1 + 1e-9)
-        assert np.abs(d[:, 2]).max() <= bound * (1 + 1e-9)
+        assert np.linalg.norm(d, axis=1).max() <= bound * (1 + 1e-9)
 
 
 def test_given_times_too_fast_are_stretched_and_reported() -> None:
     line = np.column_stack([np.linspace(0, 2.0, 21), np.zeros(21)])
-    fit = fit_points(line, np.linspace(0, 0.5, 21), FitOptions(vmax=1.0, amax=2.0, jmax=10.0))
+    fit = fit_points(
+        line, np.linspace(0, 0.5, 21), FitOptions(limits=VehicleLimits(1.0, 2.0, 10.0))
+    )
     assert fit.time_scale > 1.0
     assert fit.result.verification.max_excess <= 1e-9
     assert fit.times[-1] == pytest.approx(0.5 * fit.time_scale)
@@ -105,11 +107,11 @@ def test_hostile_points_give_input_errors_or_verified_fits(points: np.ndarray) -
 
 @pytest.mark.parametrize("sides", [None, 16])
 def test_vehicle_norms_hold_on_dense_samples(sides: int | None) -> None:
-    """``vehicle=``: speed, acceleration and jerk *norms* (3-D), cones or inscribed globe."""
+    """Speed, acceleration and jerk *norms* (3-D), cones or inscribed globe."""
     s = np.linspace(0.0, 1.0, 200)
     points = np.column_stack([np.cos(4 * s), np.sin(4 * s), 1.5 * s])
     vehicle = VehicleLimits(vmax=1.0, amax=1.0, jmax=3.0)
-    fit = fit_points(points, options=FitOptions(coupled=sides), vehicle=vehicle)
+    fit = fit_points(points, options=FitOptions(limits=vehicle, norm_sides=sides))
     assert (fit.result.n_cones > 0) == (sides is None)
     assert fit.result.verification.max_excess <= 1e-9
     traj = fit.result.trajectory
@@ -120,6 +122,8 @@ def test_vehicle_norms_hold_on_dense_samples(sides: int | None) -> None:
     assert labels[0] == ("speed norm (cone)" if sides is None else "speed norm (16-gon globe)")
 
 
-def test_vehicle_must_be_vehicle_limits() -> None:
-    with pytest.raises(InputError, match=r"vehicle: got dict, expected VehicleLimits"):
-        fit_points(np.eye(3), vehicle={"vmax": 1.0})  # type: ignore[arg-type]
+def test_limits_must_be_vehicle_limits() -> None:
+    with pytest.raises(InputError, match=r"limits: got dict, expected VehicleLimits"):
+        FitOptions(limits={"vmax": 1.0})  # type: ignore[arg-type]
+    with pytest.raises(InputError, match=r"expected a speed and an acceleration bound"):
+        FitOptions(limits=VehicleLimits(jmax=1.0))

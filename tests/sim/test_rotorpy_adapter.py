@@ -10,6 +10,7 @@ import pytest
 pytest.importorskip("rotorpy")
 
 from skyquill.errors import InputError, SolverError
+from skyquill.limits import VehicleLimits
 from skyquill.optimize.fit import FitOptions, fit_points
 from skyquill.sim.controllers import CascadePID, RPTController
 from skyquill.sim.rotorpy_adapter import ATTITUDE_GAINS, RotorPyTrajectory, fly_rotorpy
@@ -18,7 +19,7 @@ from skyquill.validation import FloatArray
 
 G = 9.81
 RADIUS_M = 0.25
-OPTIONS = FitOptions(vmax=1.0, amax=1.0, jmax=5.0)
+OPTIONS = FitOptions(limits=VehicleLimits(1.0, 1.0, 5.0))
 
 
 def writing_circle(dim: int = 3) -> SplineTrajectory:

@@ -35,7 +35,7 @@ import numpy as np
 from skyquill.calligraphy.board import Board
 from skyquill.errors import InfeasibleError, InputError
 from skyquill.geometry import polyline_distance
-from skyquill.limits import DerivativeLimit, vehicle_limits
+from skyquill.limits import DerivativeLimit, VehicleLimits
 from skyquill.optimize import Boundary, PointDeviation, SmoothingProblem, resegment, solve
 from skyquill.optimize.solve import FitResult
 from skyquill.optimize.timing import allocate_path_times
@@ -63,10 +63,12 @@ class WritingOptions:
     ----------
     size_m
         The strokes' larger side is scaled to this (paper 000: 0.5 m boards).
-    vmax, amax, jmax
-        Limits, m/s, m/s^2, m/s^3 (per axis, or norms if ``coupled``).
-    coupled
-        ``None`` or the sides of the inscribed horizontal polygon.
+    limits
+        The vehicle's limits (``vmax`` the speed, ``amax`` and ``jmax`` the
+        norms; per-axis boxes only as ``*_axis``).
+    norm_sides
+        ``None``: norms held exactly (second-order cones); an integer ``m``: by
+        the inscribed polytope with ``m`` sides.
     tolerance_m
         Fidelity tolerance; ``None``: 1 % of ``size_m``.
     turning_threshold_m
@@ -102,10 +104,8 @@ class WritingOptions:
     """
 
     size_m: float = 0.5
-    vmax: float = 1.0
-    amax: float = 2.0
-    jmax: float = 10.0
-    coupled: int | None = None
+    limits: VehicleLimits = field(default_factory=lambda: VehicleLimits(1.0, 2.0, 10.0))
+    norm_sides: int | None = None
     tolerance_m: float | None = None
     turning_threshold_m: float | None = None
     data_weight: float = 1e4
@@ -121,15 +121,18 @@ class WritingOptions:
     max_stretches: int = 8
 
     def __post_init__(self) -> None:
-        for name in ("size_m", "vmax", "amax", "jmax", "knot_interval", "stretch_factor"):
+        if not isinstance(self.limits, VehicleLimits):
+            raise InputError(f"limits: got {type(self.limits).__name__}, expected VehicleLimits")
+        self.limits.timing_bounds()  # the route is timed with a speed and an acceleration
+        for name in ("size_m", "knot_interval", "stretch_factor"):
             as_float(name, getattr(self, name), positive=True)
         for name in ("data_weight", "turning_weight", "transit_weight", "brush_length_m"):
             as_float(name, getattr(self, name), nonneg=True)
         for name in ("tolerance_m", "turning_threshold_m"):
             if getattr(self, name) is not None:
                 as_float(name, getattr(self, name), positive=True)
-        if self.coupled is not None:
-            as_int("coupled", self.coupled, low=3, high=1024)
+        if self.norm_sides is not None:
+            as_int("norm_sides", self.norm_sides, low=3, high=1024)
         as_int("degree", self.degree, low=3, high=7)
         as_int("max_stretches", self.max_stretches, low=0)
         as_int("resegment_iterations", self.resegment_iterations, low=0)
@@ -145,9 +148,9 @@ class WritingOptions:
         """Fidelity tolerance, m."""
         return self.tolerance_m if self.tolerance_m is not None else 0.01 * self.size_m
 
-    def limits(self) -> tuple[DerivativeLimit, ...]:
-        """The vehicle limits in 3-D."""
-        return vehicle_limits(3, self.vmax, self.amax, self.jmax, self.coupled)
+    def derivative_limits(self) -> tuple[DerivativeLimit, ...]:
+        """The vehicle limits in 3-D, as the engine imposes them."""
+        return self.limits.derivative_limits(3, sides=self.norm_sides)
 
 
 @dataclass(frozen=True)
@@ -344,7 +347,8 @@ def plan_writing(
     scaled = strokes.scaled(opts.size_m)
     strokes_world = tuple(board.to_world(path) for path in scaled.paths)
     points, roles = _route(strokes_world, board, home_pos)
-    times = allocate_path_times(points, opts.vmax, 0.5 * opts.amax)
+    vmax, amax = opts.limits.timing_bounds()
+    times = allocate_path_times(points, vmax, 0.5 * amax)
     threshold = opts.turning_threshold_m or 0.25 * opts.tolerance
     corners = _turning_samples(strokes_world, board, points, roles, threshold)
     samples = _Samples(points, roles, corners, strokes_world)
@@ -518,7 +522,7 @@ def _problem(
         smoothness={3: 1.0},
         deviations=tuple(deviations),
         boundary=Boundary.rest(points[0], points[-1], 3),
-        limits=opts.limits(),
+        limits=opts.derivative_limits(),
     )
 
 

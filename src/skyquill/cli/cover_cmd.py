@@ -7,7 +7,9 @@ from typing import Annotated
 
 import typer
 
-from skyquill.cli.main import OutDir, app, console, user_errors
+from skyquill.cli.main import OutDir, Vmax, app, console, user_errors
+from skyquill.errors import InputError
+from skyquill.limits import VehicleLimits
 
 
 @app.command()
@@ -17,9 +19,23 @@ def cover(
     ],
     out: OutDir,
     width: Annotated[float, typer.Option(help="Coverage diameter (swath), m.")] = 2.0,
-    vmax: Annotated[float, typer.Option(help="Speed limit, m/s.")] = 3.0,
-    amax: Annotated[float, typer.Option(help="Per-axis acceleration limit, m/s^2.")] = 5.0,
-    jmax: Annotated[float, typer.Option(help="Per-axis jerk limit, m/s^3.")] = 3.0,
+    vmax: Vmax = 3.0,
+    amax: Annotated[
+        float | None,
+        typer.Option(help="Acceleration limit: its norm, m/s^2 (default 5, or --amax-axis)."),
+    ] = None,
+    jmax: Annotated[
+        float | None,
+        typer.Option(help="Jerk limit: its norm, m/s^3 (default 3, or --jmax-axis)."),
+    ] = None,
+    amax_axis: Annotated[
+        float | None,
+        typer.Option(help="Per-axis acceleration limit instead of the norm (paper 001), m/s^2."),
+    ] = None,
+    jmax_axis: Annotated[
+        float | None,
+        typer.Option(help="Per-axis jerk limit instead of the norm (paper 001), m/s^3."),
+    ] = None,
     pattern: Annotated[str, typer.Option(help="spiral, zigzag or zigzag-stop.")] = "spiral",
     contours: Annotated[str, typer.Option(help="Spiral rings: offset or homothetic.")] = "offset",
     drift: Annotated[str, typer.Option(help="Spiral laps: step or lap (paper eq. 4).")] = "step",
@@ -51,9 +67,7 @@ def cover(
         shape = load_region(region)
         options = CoverageOptions(
             width=width,
-            vmax=vmax,
-            amax=amax,
-            jmax=jmax,
+            limits=_limits(vmax, amax, jmax, amax_axis, jmax_axis),
             pattern=pattern,  # type: ignore[arg-type]  # checked by CoverageOptions
             contours=contours,  # type: ignore[arg-type]
             drift=drift,  # type: ignore[arg-type]
@@ -87,3 +101,22 @@ def cover(
         f"planned in {plan.planning_time:.2f} s -> {out}",
         highlight=False,
     )
+
+
+def _limits(
+    vmax: float,
+    amax: float | None,
+    jmax: float | None,
+    amax_axis: float | None,
+    jmax_axis: float | None,
+) -> VehicleLimits:
+    """Norms by default (5 m/s^2, 3 m/s^3); per axis when ``--amax-axis/--jmax-axis`` are given."""
+    per_axis = amax_axis is not None or jmax_axis is not None
+    if per_axis and (amax is not None or jmax is not None):
+        raise InputError(
+            "--amax/--jmax and --amax-axis/--jmax-axis: got both, expected the norms or the "
+            "per-axis limits"
+        )
+    if per_axis:
+        return VehicleLimits(vmax=vmax, amax_axis=amax_axis, jmax_axis=jmax_axis)
+    return VehicleLimits(vmax, 5.0 if amax is None else amax, 3.0 if jmax is None else jmax)

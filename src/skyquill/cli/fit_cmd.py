@@ -7,7 +7,21 @@ from typing import Annotated, Any
 
 import typer
 
-from skyquill.cli.main import OutDir, app, console, positive_rate, user_errors
+from skyquill.cli.main import (
+    Amax,
+    AmaxAxis,
+    Jmax,
+    JmaxAxis,
+    NormSides,
+    OutDir,
+    Vmax,
+    VmaxAxis,
+    app,
+    console,
+    limits_from_flags,
+    positive_rate,
+    user_errors,
+)
 from skyquill.errors import InputError
 from skyquill.io.plan_dir import write_plan
 from skyquill.io.points import read_points_csv
@@ -16,7 +30,7 @@ from skyquill.optimize.fit import FitOptions, PointFit, fit_points
 from skyquill.validation import FloatArray
 
 
-def fit_summary(fit: PointFit, rate: float) -> dict[str, Any]:
+def fit_summary(fit: PointFit, options: FitOptions, rate: float) -> dict[str, Any]:
     """The ``summary.json`` of a fit (SI units)."""
     r, check = fit.result, fit.result.verification
     return {
@@ -39,6 +53,10 @@ def fit_summary(fit: PointFit, rate: float) -> dict[str, Any]:
         "n_points": int(fit.points.shape[0]),
         "rate_hz": rate,
         "limits": check.limits_report(),
+        "vehicle_limits": options.limits.as_dict(),
+        "norms_held_by": "second-order cones (exact)"
+        if options.norm_sides is None
+        else f"inscribed polytope of {options.norm_sides} sides",
         "dense_samples": check.n_samples,
     }
 
@@ -62,7 +80,7 @@ def run_fit(
             [PlannedTrajectory(fit.result.trajectory.in_3d(), limits=fit.limits)],
             rate=rate,
             guaranteed=True,
-            summary=fit_summary(fit, rate),
+            summary=fit_summary(fit, options, rate),
             plot=lambda path: plot_fit(fit, path, title),
         )
     console.print(
@@ -78,17 +96,13 @@ def run_fit(
 def fit(
     points_csv: Annotated[Path, typer.Argument(help="CSV with columns x,y[,z][,t] in m and s.")],
     out: OutDir,
-    vmax: Annotated[
-        float, typer.Option(help="Speed limit per axis (or norm if coupled), m/s.")
-    ] = 1.0,
-    amax: Annotated[float, typer.Option(help="Acceleration limit, m/s^2.")] = 2.0,
-    jmax: Annotated[float, typer.Option(help="Jerk limit, m/s^3.")] = 10.0,
-    coupled: Annotated[
-        int | None,
-        typer.Option(
-            help="Couple the horizontal axes: sides of the polygon inscribed in the norm limit."
-        ),
-    ] = None,
+    vmax: Vmax = 1.0,
+    amax: Amax = 2.0,
+    jmax: Jmax = 10.0,
+    vmax_axis: VmaxAxis = None,
+    amax_axis: AmaxAxis = None,
+    jmax_axis: JmaxAxis = None,
+    norm_sides: NormSides = None,
     degree: Annotated[int, typer.Option(help="Spline degree (3 to 7).")] = 5,
     weight: Annotated[float, typer.Option(help="Weight of the point deviation.")] = 1e4,
     rate: Annotated[float, typer.Option(help="Sample rate of trajectory.csv, Hz.")] = 100.0,
@@ -107,10 +121,8 @@ def fit(
     """Fit a smooth trajectory to POINTS_CSV that starts and ends at rest."""
     with user_errors():
         options = FitOptions(
-            vmax=vmax,
-            amax=amax,
-            jmax=jmax,
-            coupled=coupled,
+            limits=limits_from_flags(vmax, amax, jmax, vmax_axis, amax_axis, jmax_axis),
+            norm_sides=norm_sides,
             degree=degree,
             weight=weight,
             knot_interval=knot_interval,

@@ -21,6 +21,7 @@ import typer
 from rich.console import Console
 
 from skyquill.errors import InputError, SkyquillError
+from skyquill.limits import VehicleLimits
 from skyquill.validation import FloatArray
 
 app = typer.Typer(
@@ -32,6 +33,30 @@ console = Console(stderr=True)
 EXAMPLES = Path(__file__).resolve().parents[3] / "examples"
 
 OutDir = Annotated[Path, typer.Option("--out", help="Output directory (created).")]
+
+# One meaning per limit in every command (docs/architecture.md): the norms, and
+# per-axis boxes only under their own names.
+Vmax = Annotated[float, typer.Option(help="Speed limit: the norm of the velocity, m/s.")]
+Amax = Annotated[
+    float, typer.Option(help="Acceleration limit: the norm of the acceleration, m/s^2.")
+]
+Jmax = Annotated[float, typer.Option(help="Jerk limit: the norm of the jerk, m/s^3.")]
+VmaxAxis = Annotated[
+    float | None, typer.Option(help="Optional per-axis bound on |vx|, |vy|, |vz|, m/s.")
+]
+AmaxAxis = Annotated[
+    float | None, typer.Option(help="Optional per-axis bound on |ax|, |ay|, |az|, m/s^2.")
+]
+JmaxAxis = Annotated[
+    float | None, typer.Option(help="Optional per-axis bound on |jx|, |jy|, |jz|, m/s^3.")
+]
+NormSides = Annotated[
+    int | None,
+    typer.Option(
+        help="Hold the norms by an inscribed polytope of this many sides (a QP) instead of "
+        "exactly (second-order cones)."
+    ),
+]
 
 
 @app.callback()
@@ -55,6 +80,18 @@ def positive_rate(rate: float) -> float:
     if not rate > 0:
         raise InputError(f"--rate: got {rate:g}, expected a positive number of Hz")
     return rate
+
+
+def limits_from_flags(
+    vmax: float,
+    amax: float,
+    jmax: float,
+    vmax_axis: float | None = None,
+    amax_axis: float | None = None,
+    jmax_axis: float | None = None,
+) -> VehicleLimits:
+    """The one :class:`VehicleLimits` of a command's ``--vmax/--amax/--jmax[-axis]`` flags."""
+    return VehicleLimits(vmax, amax, jmax, vmax_axis, amax_axis, jmax_axis)
 
 
 def parse_vector3(option: str, text: str, unit: str) -> FloatArray:

@@ -8,7 +8,21 @@ from typing import Annotated, Any
 import numpy as np
 import typer
 
-from skyquill.cli.main import OutDir, app, console, positive_rate, user_errors
+from skyquill.cli.main import (
+    Amax,
+    AmaxAxis,
+    Jmax,
+    JmaxAxis,
+    NormSides,
+    OutDir,
+    Vmax,
+    VmaxAxis,
+    app,
+    console,
+    limits_from_flags,
+    positive_rate,
+    user_errors,
+)
 from skyquill.errors import InputError
 from skyquill.io.atomic import write_json
 from skyquill.io.plan_dir import trajectory_names, write_plan
@@ -50,10 +64,13 @@ def write(
     ] = None,
     font: Annotated[str, typer.Option(help="Hershey font for Latin text.")] = "futural",
     size: Annotated[float, typer.Option(help="Larger side of each drone's writing, m.")] = 0.5,
-    vmax: Annotated[float, typer.Option(help="Speed limit, m/s.")] = 1.0,
-    amax: Annotated[float, typer.Option(help="Acceleration limit, m/s^2.")] = 2.0,
-    jmax: Annotated[float, typer.Option(help="Jerk limit, m/s^3.")] = 10.0,
-    coupled: Annotated[int | None, typer.Option(help="Sides of the coupled polygon.")] = None,
+    vmax: Vmax = 1.0,
+    amax: Amax = 2.0,
+    jmax: Jmax = 10.0,
+    vmax_axis: VmaxAxis = None,
+    amax_axis: AmaxAxis = None,
+    jmax_axis: JmaxAxis = None,
+    norm_sides: NormSides = None,
     drones: Annotated[int, typer.Option(help="Drones writing at once, boards side by side.")] = 1,
     rate: Annotated[float, typer.Option(help="Sample rate of the CSVs, Hz.")] = 100.0,
     fly: Annotated[bool, typer.Option(help="Also fly each drone in simulation (RPT).")] = False,
@@ -76,10 +93,8 @@ def write(
         rate = positive_rate(rate)
         options = WritingOptions(
             size_m=size,
-            vmax=vmax,
-            amax=amax,
-            jmax=jmax,
-            coupled=coupled,
+            limits=limits_from_flags(vmax, amax, jmax, vmax_axis, amax_axis, jmax_axis),
+            norm_sides=norm_sides,
             tilt_compensation=tilt_compensation,
         )
         if drones != 1:

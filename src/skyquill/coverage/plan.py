@@ -19,7 +19,7 @@ from __future__ import annotations
 import itertools
 import math
 import time
-from dataclasses import asdict, dataclass, replace
+from dataclasses import asdict, dataclass, field, replace
 from typing import Any, Literal
 
 import numpy as np
@@ -38,7 +38,7 @@ from skyquill.coverage.paths import (
 from skyquill.coverage.regions import check_width, coverage_fraction
 from skyquill.coverage.speed import SpeedPlan, plan_speed
 from skyquill.errors import InfeasibleError, InputError
-from skyquill.limits import BoxLimit, CylinderLimit, DerivativeLimit
+from skyquill.limits import BoxLimit, CylinderLimit, DerivativeLimit, VehicleLimits
 from skyquill.optimize.legs import LegLimits, stop_and_go
 from skyquill.trajectory import Samples, Trajectory, concatenate
 from skyquill.validation import as_float, as_int
@@ -72,11 +72,10 @@ class CoverageOptions:
     ----------
     width : float
         Coverage diameter (swath), m.
-    vmax : float
-        Speed limit, m/s.
-    amax, jmax : float
-        Acceleration (m/s^2) and jerk (m/s^3) limits: per axis, or Euclidean
-        norms with ``limit_norm_sides``.
+    limits : VehicleLimits
+        ``vmax`` is the speed; acceleration and jerk are held either as norms
+        (``amax``, ``jmax``: the default) or per axis (``amax_axis``,
+        ``jmax_axis``: paper 001's limits), both the same kind.
     pattern : {"spiral", "zigzag", "zigzag-stop"}
     contours : {"offset", "homothetic"}
         Spiral rings: true inward offsets, or the paper's shrink (eq. 1-3).
@@ -99,17 +98,15 @@ class CoverageOptions:
         Flight height written to the setpoints, m.
     grid : int or None
         Speed-LP grid points; ``None`` picks them from the path length.
-    limit_norm_sides : int or None
-        None: ``amax`` and ``jmax`` hold per axis.  An even ``m >= 4``: they
-        are norm limits, held in the speed LP by the inscribed regular
-        ``m``-gon (``norm_sides`` of :func:`~skyquill.coverage.speed.plan_speed`;
-        16 is within 2 % of the circle) and measured as norms in ``limits``.
+    norm_sides : int
+        The acceleration and jerk norms are held in the speed LP by the
+        inscribed regular polygon of this many sides (even, >= 4;
+        ``norm_sides`` of :func:`~skyquill.coverage.speed.plan_speed`; 16 is
+        within 2 % of the circle) and measured as norms.
     """
 
     width: float = 2.0
-    vmax: float = 3.0
-    amax: float = 5.0
-    jmax: float = 3.0
+    limits: VehicleLimits = field(default_factory=lambda: VehicleLimits(3.0, 5.0, 3.0))
     pattern: Pattern = "spiral"
     contours: ContourMode = "offset"
     drift: DriftMode = "step"
@@ -119,11 +116,12 @@ class CoverageOptions:
     rate: float = 50.0
     altitude: float = 2.0
     grid: int | None = None
-    limit_norm_sides: int | None = None
+    norm_sides: int = 16
 
     def __post_init__(self) -> None:
-        for name in ("width", "vmax", "amax", "jmax", "delta", "rate"):
+        for name in ("width", "delta", "rate"):
             as_float(name, getattr(self, name), positive=True)
+        _check_limits(self.limits)
         as_float("altitude", self.altitude)
         if self.pattern not in PATTERNS:
             raise InputError(f"pattern: got {self.pattern!r}, expected one of {PATTERNS}")
@@ -135,12 +133,57 @@ class CoverageOptions:
             raise InputError(f"epsilon: got {self.epsilon!r}, expected a value in (0, 1]")
         if self.grid is not None:
             as_int("grid", self.grid, low=3, high=20_000)
-        if self.limit_norm_sides is not None:
-            sides = as_int("limit_norm_sides", self.limit_norm_sides, low=4, high=1024)
-            if sides % 2:
-                raise InputError(
-                    f"limit_norm_sides: got {sides}, expected an even integer from 4 to 1024"
-                )
+        sides = as_int("norm_sides", self.norm_sides, low=4, high=1024)
+        if sides % 2:
+            raise InputError(f"norm_sides: got {sides}, expected an even integer from 4 to 1024")
+
+    @property
+    def per_axis(self) -> bool:
+        """Whether acceleration and jerk are per-axis bounds (else norms)."""
+        return self.limits.amax is None
+
+    @property
+    def vmax(self) -> float:
+        """Speed limit, m/s."""
+        assert self.limits.vmax is not None  # checked at construction
+        return self.limits.vmax
+
+    @property
+    def amax(self) -> float:
+        """Acceleration limit (the norm, or per axis), m/s^2."""
+        value = self.limits.amax_axis if self.per_axis else self.limits.amax
+        assert value is not None  # checked at construction
+        return value
+
+    @property
+    def jmax(self) -> float:
+        """Jerk limit (the norm, or per axis), m/s^3."""
+        value = self.limits.jmax_axis if self.per_axis else self.limits.jmax
+        assert value is not None  # checked at construction
+        return value
+
+    @property
+    def limit_norm_sides(self) -> int | None:
+        """The LP's polygon for the norms, or None when the limits are per axis."""
+        return None if self.per_axis else self.norm_sides
+
+
+def _check_limits(limits: VehicleLimits) -> None:
+    """The limits the speed LP can hold: a speed, and acceleration and jerk of one kind."""
+    if not isinstance(limits, VehicleLimits):
+        raise InputError(f"limits: got {type(limits).__name__}, expected VehicleLimits")
+    if limits.vmax is None:
+        raise InputError("limits.vmax: got None, expected the speed limit (m/s)")
+    norms = (limits.amax is not None, limits.jmax is not None)
+    axes = (limits.amax_axis is not None, limits.jmax_axis is not None)
+    if not (norms == (True, True) and axes == (False, False)) and not (
+        norms == (False, False) and axes == (True, True)
+    ):
+        raise InputError(
+            f"limits: got amax={limits.amax}, jmax={limits.jmax}, amax_axis="
+            f"{limits.amax_axis}, jmax_axis={limits.jmax_axis}; expected the acceleration and "
+            "the jerk both as norms (amax, jmax) or both per axis (amax_axis, jmax_axis)"
+        )
 
 
 @dataclass(frozen=True, eq=False)

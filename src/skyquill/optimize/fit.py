@@ -13,13 +13,13 @@ problem solved again; the factor used is reported, never hidden.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Literal
 
 import numpy as np
 
 from skyquill.errors import InfeasibleError, InputError
-from skyquill.limits import DerivativeLimit, VehicleLimits, vehicle_limits
+from skyquill.limits import DerivativeLimit, VehicleLimits
 from skyquill.optimize.problem import Boundary, PointDeviation, SmoothingProblem
 from skyquill.optimize.solve import FitResult, solve
 from skyquill.optimize.timing import (
@@ -40,11 +40,14 @@ class FitOptions:
 
     Attributes
     ----------
-    vmax, amax, jmax
-        Speed, acceleration and jerk limits (m/s, m/s^2, m/s^3).
-    coupled
-        ``None`` for per-axis limits, else the number of sides of the
-        horizontal polygon inscribed in the norm limit.
+    limits
+        The vehicle's limits (``vmax`` is the speed, ``amax`` and ``jmax`` the
+        norms; per-axis boxes only as ``*_axis``), held on the whole trajectory
+        through the convex hull.
+    norm_sides
+        ``None``: the norms are held exactly (second-order cones on every hull
+        point, Clarabel); an integer ``m``: by the inscribed polytope of
+        :class:`~skyquill.limits.NormLimit` with ``m`` sides (a QP).
     degree
         Spline degree (5: continuous jerk).
     weight
@@ -61,7 +64,7 @@ class FitOptions:
         ``"segments"`` (rest to rest between consecutive points, paper 003
         §3.5: sparse waypoint plans, flown through every corner).
     allocation_accel_fraction
-        The allocation plans with this fraction of ``amax``. It knows
+        The allocation plans with this fraction of the acceleration bound. It knows
         nothing of jerk, and at full ``amax`` the jerk-limited fit cannot
         brake in time at the ends and cuts the last turn (spiral example: max
         deviation 51 mm at 1.0, 10 mm at 0.5, 7 mm at 0.35 for 19% more time).
@@ -69,10 +72,8 @@ class FitOptions:
         Timing stretch on infeasibility.
     """
 
-    vmax: float = 1.0
-    amax: float = 2.0
-    jmax: float = 10.0
-    coupled: int | None = None
+    limits: VehicleLimits = field(default_factory=lambda: VehicleLimits(1.0, 2.0, 10.0))
+    norm_sides: int | None = None
     degree: int = 5
     weight: float = 1e4
     knot_interval: float = 0.1
@@ -84,10 +85,13 @@ class FitOptions:
     max_stretches: int = 10
 
     def __post_init__(self) -> None:
-        for name in ("vmax", "amax", "jmax", "weight", "knot_interval"):
+        if not isinstance(self.limits, VehicleLimits):
+            raise InputError(f"limits: got {type(self.limits).__name__}, expected VehicleLimits")
+        self.limits.timing_bounds()  # the allocation needs a speed and an acceleration
+        for name in ("weight", "knot_interval"):
             as_float(name, getattr(self, name), positive=True)
-        if self.coupled is not None:
-            as_int("coupled", self.coupled, low=3, high=1024)
+        if self.norm_sides is not None:
+            as_int("norm_sides", self.norm_sides, low=3, high=1024)
         as_int("degree", self.degree, low=3, high=7)
         if as_float("stretch_factor", self.stretch_factor) <= 1.0:
             raise InputError(f"stretch_factor: got {self.stretch_factor:g}, expected > 1")
@@ -134,8 +138,6 @@ def fit_points(
     points: FloatArray,
     times: FloatArray | None = None,
     options: FitOptions | None = None,
-    *,
-    vehicle: VehicleLimits | None = None,
 ) -> PointFit:
     """Fit a trajectory that starts and ends at rest at the first and last point.
 
@@ -147,33 +149,20 @@ def fit_points(
         Shape (N,), s, strictly increasing, or ``None`` to allocate them.
     options
         :class:`FitOptions`; defaults if ``None``.
-    vehicle
-        The vehicle's limits (DESIGN.md "One meaning per limit"). When given
-        they replace ``options.vmax / amax / jmax`` as the limits: norms held
-        exactly (second-order cones), or by the inscribed polytope with
-        ``options.coupled`` sides if that is set; per-axis boxes as boxes. The
-        timing allocation then plans with ``vehicle.vmax`` and
-        ``vehicle.amax`` where set (else the options' values).
     """
     opts = options or FitOptions()
     pts = as_array("points", points, ndim=2, max_abs=MAX_COORDINATE_M)
     if pts.shape[1] not in (2, 3) or pts.shape[0] < 2:
         raise InputError(f"points: got shape {pts.shape}, expected (N >= 2, 2 or 3)")
-    if vehicle is not None and not isinstance(vehicle, VehicleLimits):
-        raise InputError(f"vehicle: got {type(vehicle).__name__}, expected VehicleLimits")
     if times is None:
-        vmax = (vehicle.vmax if vehicle is not None else None) or opts.vmax
-        amax = (vehicle.amax if vehicle is not None else None) or opts.amax
+        vmax, amax = opts.limits.timing_bounds()
         allocate = allocate_path_times if opts.timing == "path" else allocate_segment_times
         t = allocate(pts, vmax, opts.allocation_accel_fraction * amax)
     else:
         t = as_array("times", times, shape=(pts.shape[0],), max_abs=1e7)
         strictly_increasing("times", t)
         t = t - t[0]
-    if vehicle is None:
-        limits = vehicle_limits(pts.shape[1], opts.vmax, opts.amax, opts.jmax, opts.coupled)
-    else:
-        limits = vehicle.derivative_limits(pts.shape[1], sides=opts.coupled)
+    limits = opts.limits.derivative_limits(pts.shape[1], sides=opts.norm_sides)
     scale = 1.0
     for attempt in range(opts.max_stretches + 1):
         try:

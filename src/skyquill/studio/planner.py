@@ -29,6 +29,7 @@ from skyquill.calligraphy.board import Board
 from skyquill.calligraphy.mission import Mission, WritingOptions
 from skyquill.calligraphy.show import Show, plan_show
 from skyquill.errors import InfeasibleError, InputError, SolverError
+from skyquill.limits import VehicleLimits
 from skyquill.strokes import Strokes
 from skyquill.studio.models import DownloadFile, DronePlan, LimitCheck, Limits, PlanRequest
 from skyquill.studio.models import PlanResult as PlanResultModel
@@ -125,7 +126,7 @@ def run_plan(
     progress(0.02, "reading the input")
     parts = parts_of(request)
     options = WritingOptions(
-        size_m=request.size_m, vmax=request.vmax, amax=request.amax, jmax=request.jmax
+        size_m=request.size_m, limits=VehicleLimits(request.vmax, request.amax, request.jmax)
     )
     show = _plan_show(parts, options, request, progress)
     first_board = show.missions[0].board
@@ -183,8 +184,8 @@ def _plan_show(
         # Drones are planned in order (workers=1): the one that failed is the next.
         raise InfeasibleError(
             f"limits: could not plan drone {planned + 1}'s flight within speed "
-            f"{options.vmax:g} m/s, acceleration {options.amax:g} m/s^2 and jerk "
-            f"{options.jmax:g} m/s^3 ({exc}); expected looser limits or a smaller drawing"
+            f"{request.vmax:g} m/s, acceleration {request.amax:g} m/s^2 and jerk "
+            f"{request.jmax:g} m/s^3 ({exc}); expected looser limits or a smaller drawing"
         ) from exc
 
 

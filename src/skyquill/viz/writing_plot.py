@@ -93,7 +93,8 @@ def _derivatives(axes: np.ndarray, mission: Mission) -> None:
         values = traj.evaluate(t, order)
         for i, axis in enumerate("xyz"):
             ax.plot(t, values[:, i], lw=0.8, label=axis)
-        for lim in mission.options.limits():
+        ax.plot(t, np.linalg.norm(values, axis=1), lw=1.0, color="k", label="norm")
+        for lim in mission.options.derivative_limits():
             if lim.order == order:
                 bound = lim.upper.max() if isinstance(lim, BoxLimit) else lim.radius
                 ax.axhline(bound, color="k", ls="--", lw=0.8)
