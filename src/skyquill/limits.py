@@ -396,6 +396,16 @@ class VehicleLimits:
                 limits.append(BoxLimit.symmetric(order, box, dim))
         return tuple(limits)
 
+    def describe(self) -> str:
+        """One line for messages: ``"speed 1 m/s, acceleration 2 m/s^2, jerk 10 m/s^3"``."""
+        parts = []
+        for name, (order, unit, _) in _VEHICLE_FIELDS.items():
+            value = getattr(self, name)
+            if value is not None:
+                kind = order_name(order) + (" per axis" if name.endswith("_axis") else "")
+                parts.append(f"{kind} {value:g} {unit}")
+        return ", ".join(parts) if parts else "no limits"
+
     def timing_bounds(self) -> tuple[float, float]:
         """Speed and acceleration a time allocation may plan with, m/s and m/s^2.
 

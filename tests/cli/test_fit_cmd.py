@@ -35,7 +35,7 @@ def test_fit_writes_trajectory_plot_and_summary(tmp_path: Path) -> None:
             str(EXAMPLES / "segments.csv"),
             "--out",
             str(out),
-            "--coupled",
+            "--norm-sides",
             "8",
             "--vmax",
             "1.5",
@@ -99,7 +99,8 @@ def test_timing_choices(tmp_path: Path) -> None:
     )
     assert seg.exit_code == 0
     s = json.loads((tmp_path / "s" / "summary.json").read_text())
-    assert s["max_deviation_m"] < 1e-3
+    # Through every corner to 1.5 mm (the jerk norm, not a per-axis box, binds there).
+    assert s["max_deviation_m"] < 2e-3
 
 
 @pytest.mark.parametrize(

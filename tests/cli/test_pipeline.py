@@ -106,7 +106,10 @@ def test_plan_flies_exports_and_reads_back(
         table = np.loadtxt(plan / entry["csv"], delimiter=",", skiprows=1, ndmin=2)
         assert np.all(np.isfinite(table))
         speed = np.linalg.norm(table[:, 4:7], axis=1)
-        assert speed.max() <= vmax * np.sqrt(3) * (1 + 1e-9)  # per-axis boxes until norms
+        # --vmax is the speed: guaranteed by the hull (fit, write, paint's legs); within the
+        # speed LP's measured excess, at most 2 %, for coverage.
+        allowed = 1.02 if label.startswith("cover") else 1 + 1e-9
+        assert speed.max() <= vmax * allowed
         assert entry["verification"]["csv_max_difference_m"] < 1e-6
 
     flown = runner.invoke(app, ["fly", str(plan), "--out", str(tmp_path / "fly"), "--rate", "200"])

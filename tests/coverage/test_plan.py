@@ -54,7 +54,7 @@ def test_every_pattern_plans_a_rest_to_rest_flight_inside_the_region(pattern: st
         "pattern",
     ):
         assert key in summary
-    assert len(summary["max_acc"]) == 2 and len(summary["max_jerk"]) == 2
+    assert len(summary["max_acc"]) == 3 and len(summary["max_jerk"]) == 3  # x, y, z (at height)
 
 
 @pytest.mark.parametrize("pattern", ["spiral", "zigzag", "zigzag-stop"])

@@ -70,10 +70,8 @@ def test_bad_points_are_named(points: np.ndarray, times: np.ndarray | None, mess
 @pytest.mark.parametrize(
     ("kwargs", "message"),
     [
-        ({"vmax": -1.0}, "vmax: got -1, expected a number > 0"),
-        ({"jmax": 0.0}, "jmax: got 0, expected a number > 0"),
         ({"degree": 8}, "degree: got 8, expected an integer from 3 to 7"),
-        ({"coupled": 2}, "coupled: got 2, expected an integer from 3 to 1024"),
+        ({"norm_sides": 2}, "norm_sides: got 2, expected an integer from 3 to 1024"),
         ({"weight": float("nan")}, "weight: got nan, expected a finite number"),
     ],
 )
@@ -120,6 +118,13 @@ def test_vehicle_norms_hold_on_dense_samples(sides: int | None) -> None:
         assert np.linalg.norm(traj.evaluate(t, order), axis=1).max() <= bound * (1 + 1e-9)
     labels = [c.label for c in fit.result.verification.checks]
     assert labels[0] == ("speed norm (cone)" if sides is None else "speed norm (16-gon globe)")
+
+
+def test_bad_limits_are_named() -> None:
+    with pytest.raises(InputError, match="vmax: got -1, expected a number > 0"):
+        FitOptions(limits=VehicleLimits(vmax=-1.0, amax=1.0))
+    with pytest.raises(InputError, match="jmax: got 0, expected a number > 0"):
+        FitOptions(limits=VehicleLimits(vmax=1.0, amax=1.0, jmax=0.0))
 
 
 def test_limits_must_be_vehicle_limits() -> None:

@@ -101,6 +101,10 @@ class WritingOptions:
         writing time to get the swung tip within 5 mm, and ~1 s of planning.
     stretch_factor, max_stretches
         Timing stretch when infeasible or unfaithful.
+    best_effort
+        Return the last plan even when its pen-down path is beyond the
+        tolerance (``Mission.faithful`` is then False); by default that is an
+        :class:`~skyquill.errors.InfeasibleError` with the measured deviation.
     """
 
     size_m: float = 0.5
@@ -119,6 +123,7 @@ class WritingOptions:
     tilt_compensation: bool = False
     stretch_factor: float = 1.25
     max_stretches: int = 8
+    best_effort: bool = False
 
     def __post_init__(self) -> None:
         if not isinstance(self.limits, VehicleLimits):
@@ -371,6 +376,15 @@ def plan_writing(
         if deviation.max_m <= opts.tolerance or last:
             break
         scale *= opts.stretch_factor  # slower: less tracking error and less brush swing
+    if deviation.max_m > opts.tolerance and not opts.best_effort:
+        raise InfeasibleError(
+            f"strokes: the pen-down path stays {1e3 * deviation.max_m:.3g} mm from the input "
+            f"after {opts.max_stretches} stretches ({scale:.3g}x slower) within "
+            f"{opts.limits.describe()}, expected within the "
+            f"tolerance of {1e3 * opts.tolerance:.3g} mm (1 % of the size unless tolerance_m "
+            "is given); a larger size, looser limits or best_effort",
+            ("fidelity",),
+        )
     if not compensate and opts.resegment != "off" and opts.resegment_iterations > 0:
         fit, windows, deviation, _ = _resegment(
             samples, scaled_times, (fit, windows, deviation), opts

@@ -71,6 +71,10 @@ def write(
     amax_axis: AmaxAxis = None,
     jmax_axis: JmaxAxis = None,
     norm_sides: NormSides = None,
+    best_effort: Annotated[
+        bool,
+        typer.Option(help="Write the plan even if the path is beyond the 1 % tolerance."),
+    ] = False,
     drones: Annotated[int, typer.Option(help="Drones writing at once, boards side by side.")] = 1,
     rate: Annotated[float, typer.Option(help="Sample rate of the CSVs, Hz.")] = 100.0,
     fly: Annotated[bool, typer.Option(help="Also fly each drone in simulation (RPT).")] = False,
@@ -95,6 +99,7 @@ def write(
             size_m=size,
             limits=limits_from_flags(vmax, amax, jmax, vmax_axis, amax_axis, jmax_axis),
             norm_sides=norm_sides,
+            best_effort=best_effort,
             tilt_compensation=tilt_compensation,
         )
         if drones != 1:

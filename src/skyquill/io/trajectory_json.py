@@ -27,7 +27,7 @@ import numpy as np
 
 from skyquill.errors import InputError
 from skyquill.io.atomic import write_text
-from skyquill.limits import BoxLimit, CylinderLimit, DerivativeLimit
+from skyquill.limits import BoxLimit, CylinderLimit, DerivativeLimit, NormLimit
 from skyquill.trajectory import Trajectory
 from skyquill.trajectory.codec import decode, encode
 from skyquill.validation import as_array
@@ -126,7 +126,7 @@ def _planned(data: object) -> PlannedTrajectory:
 
 
 #: The limit shapes ``trajectory.json`` stores, by class name.
-LIMIT_TYPES: dict[str, type] = {cls.__name__: cls for cls in (BoxLimit, CylinderLimit)}
+LIMIT_TYPES: dict[str, type] = {cls.__name__: cls for cls in (BoxLimit, CylinderLimit, NormLimit)}
 
 
 def _encode_limit(limit: DerivativeLimit) -> dict[str, Any]:
