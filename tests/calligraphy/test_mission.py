@@ -205,8 +205,7 @@ def test_random_strokes_through_the_whole_pipeline(paths: list[list[tuple[float,
 def test_tilt_compensation_puts_the_swung_tip_on_the_strokes() -> None:
     """The brush hangs along the thrust axis; compensated, the *swung* tip stays in tolerance."""
     from skyquill.calligraphy.mission import swung_tip
-    from skyquill.sim import Board as SimBoard
-    from skyquill.sim import Quadrotor, simulate
+    from skyquill.sim import ContactBoard, Quadrotor, simulate
 
     strokes = hanzi_strokes("一")
     plain = plan_writing(strokes, options=WritingOptions(resegment="off"))
@@ -219,7 +218,7 @@ def test_tilt_compensation_puts_the_swung_tip_on_the_strokes() -> None:
         flight = simulate(
             mission.vehicle_trajectory(),
             Quadrotor(),
-            board=SimBoard(height_m=1.002, extent=(-0.1, 0.6, -0.1, 0.6)),
+            board=ContactBoard(height_m=1.002, extent=(-0.1, 0.6, -0.1, 0.6)),
         )
         ink = np.vstack(flight.ink)
         ink_gaps.append(polyline_distance(ink, mission.strokes_world[0]).max())

@@ -9,8 +9,8 @@ import pytest
 
 from skyquill.errors import InputError
 from skyquill.sim import (
-    Board,
     CascadePID,
+    ContactBoard,
     Disturbances,
     Quadrotor,
     RPTController,
@@ -173,7 +173,7 @@ def test_ink_follows_the_planned_tip_path(writing: SplineTrajectory) -> None:
     traj = writing
     vehicle = Quadrotor()
     # The tip hangs brush_length below the vehicle; put the board 2 mm above it.
-    board = Board(height_m=1.0 - vehicle.brush_length_m + 0.002)
+    board = ContactBoard(height_m=1.0 - vehicle.brush_length_m + 0.002)
     flight = simulate(traj, vehicle, board=board)
     assert len(flight.ink) >= 1
     ink = np.vstack(flight.ink)
@@ -187,14 +187,14 @@ def test_ink_follows_the_planned_tip_path(writing: SplineTrajectory) -> None:
     assert gap.max() < 3e-3
     com_gap = np.min(np.linalg.norm(ink[:, None, :2] - traj.evaluate(t)[None, :, :2], axis=2), 1)
     assert com_gap.max() > 0.01  # the swing is real and must be planned for
-    free = simulate(traj, vehicle, board=Board(height_m=board.height_m, enabled=False))
+    free = simulate(traj, vehicle, board=ContactBoard(height_m=board.height_m, enabled=False))
     assert len(free.ink) >= 1
     # The contact pushes back: the vehicle flies a little higher than without it.
     assert flight.p[:, 2].mean() > free.p[:, 2].mean()
 
 
 def test_no_contact_no_ink(writing: SplineTrajectory) -> None:
-    flight = simulate(writing, board=Board(height_m=0.0))
+    flight = simulate(writing, board=ContactBoard(height_m=0.0))
     assert flight.ink == ()
 
 
@@ -207,7 +207,7 @@ def test_no_contact_no_ink(writing: SplineTrajectory) -> None:
         (lambda: Quadrotor(max_tilt_rad=2.0), "max_tilt_rad: got 2, expected < pi/2"),
         (lambda: Disturbances(wind_mps=[1, 2]), r"wind_mps: got an array of shape \(2,\)"),
         (lambda: Disturbances(gust_std_mps=-1), "gust_std_mps: got -1"),
-        (lambda: Board(height_m=float("nan")), "height_m: got nan, expected a finite"),
+        (lambda: ContactBoard(height_m=float("nan")), "height_m: got nan, expected a finite"),
         (lambda: RPTController(lag_s=-0.1), "lag_s: got -0.1"),
     ],
 )

@@ -44,7 +44,7 @@ from skyquill.trajectory import SplineTrajectory
 from skyquill.validation import FloatArray, as_array, as_float, as_int
 
 if TYPE_CHECKING:  # the simulator is imported only to fly
-    from skyquill.sim import Board as SimBoard
+    from skyquill.sim import ContactBoard
 
 #: Spacing of the samples that hold lifts and transits near their straight lines, m.
 TRANSIT_SPACING_M = 0.01
@@ -609,19 +609,19 @@ PRESS_M = 0.002
 BOARD_MARGIN_M = 0.1
 
 
-def contact_board(mission: Mission) -> SimBoard | None:
+def contact_board(mission: Mission) -> ContactBoard | None:
     """The simulator's board under a horizontal writing board (``None`` for a wall).
 
     The plan touches the surface; the simulated board sits :data:`PRESS_M`
     higher so that the brush presses into it and tracking errors do not lift
     it off. The simulator's contact model is a horizontal slab only.
     """
-    from skyquill.sim import Board as SimBoard
+    from skyquill.sim import ContactBoard
 
     if mission.board.kind != "horizontal":
         return None
     corner, size, margin = mission.board.origin, mission.options.size_m, BOARD_MARGIN_M
-    return SimBoard(
+    return ContactBoard(
         height_m=float(corner[2]) + PRESS_M,
         extent=(corner[0] - margin, corner[0] + size + margin,
                 corner[1] - margin, corner[1] + size + margin),

@@ -18,16 +18,16 @@ from typing import Any
 import numpy as np
 
 from skyquill.painting.mission import ContactModel, G
-from skyquill.sim.contact import Board
+from skyquill.sim.contact import ContactBoard
 from skyquill.validation import FloatArray
 
 
 @dataclass(frozen=True)
-class WallBumper(Board):
+class WallBumper(ContactBoard):
     """A vertical wall ``y = wall_y_m`` with a spring-damper bumper, as a simulator contact.
 
-    It reuses :class:`~skyquill.sim.contact.Board`'s stiffness and damping fields and replaces
-    the horizontal board's force by one along ``-y`` (only pushing, never pulling).
+    It reuses :class:`~skyquill.sim.contact.ContactBoard`'s stiffness and damping fields and
+    replaces the horizontal board's force by one along ``-y`` (only pushing, never pulling).
     """
 
     wall_y_m: float = 0.0

@@ -1,6 +1,6 @@
 """Closed-loop flight simulation: quadrotor model, outer-loop controllers, disturbances."""
 
-from skyquill.sim.contact import Board
+from skyquill.sim.contact import ContactBoard
 from skyquill.sim.controllers import CascadePID, OuterLoop, RPTAxisGains, RPTController
 from skyquill.sim.disturbances import Disturbances
 from skyquill.sim.result import Flight
@@ -8,8 +8,8 @@ from skyquill.sim.simulate import simulate
 from skyquill.sim.vehicle import Quadrotor
 
 __all__ = [
-    "Board",
     "CascadePID",
+    "ContactBoard",
     "Disturbances",
     "Flight",
     "OuterLoop",

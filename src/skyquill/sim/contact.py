@@ -16,7 +16,7 @@ from skyquill.validation import FloatArray, as_float
 
 
 @dataclass(frozen=True)
-class Board:
+class ContactBoard:
     """A horizontal board at ``height_m`` (the paper's set-up).
 
     Attributes

@@ -9,7 +9,7 @@ from collections import deque
 import numpy as np
 
 from skyquill.errors import InputError
-from skyquill.sim.contact import Board
+from skyquill.sim.contact import ContactBoard
 from skyquill.sim.controllers import OuterLoop, RPTController
 from skyquill.sim.disturbances import Disturbances, WindField
 from skyquill.sim.result import Flight
@@ -39,7 +39,7 @@ def simulate(
     rng: np.random.Generator | None = None,
     *,
     rate_hz: float = 500.0,
-    board: Board | None = None,
+    board: ContactBoard | None = None,
     conversion: Conversion = "exact",
 ) -> Flight:
     """Fly ``trajectory`` with ``controller`` on ``vehicle`` and record everything.
@@ -100,7 +100,7 @@ def _fly(
     dist: Disturbances,
     *,
     rng: np.random.Generator,
-    board: Board | None,
+    board: ContactBoard | None,
     conversion: Conversion,
 ) -> Flight:
     start = time.perf_counter()

@@ -113,7 +113,7 @@ class Limits(BaseModel):
     jmax: float
 
 
-class LimitCheck(BaseModel):
+class LimitReport(BaseModel):
     """One limit as the dense verification found it."""
 
     label: str
@@ -149,7 +149,7 @@ class DronePlan(BaseModel):
     duration_s: float
     planning_time_s: float
     deviation_max_m: float
-    checks: list[LimitCheck]
+    checks: list[LimitReport]
     flight_rmse_m: float | None = None
     ink_max_deviation_m: float | None = None
 

@@ -31,7 +31,7 @@ from skyquill.calligraphy.show import Show, plan_show
 from skyquill.errors import InfeasibleError, InputError, SolverError
 from skyquill.limits import VehicleLimits
 from skyquill.strokes import Strokes
-from skyquill.studio.models import DownloadFile, DronePlan, LimitCheck, Limits, PlanRequest
+from skyquill.studio.models import DownloadFile, DronePlan, LimitReport, Limits, PlanRequest
 from skyquill.studio.models import PlanResult as PlanResultModel
 from skyquill.validation import FloatArray
 
@@ -224,7 +224,7 @@ def _drone_plan(
         "duration_s": traj.duration,
         "planning_time_s": mission.planning_time_s,
         "deviation_max_m": mission.deviation.max_m,
-        "checks": [LimitCheck.model_validate(c) for c in check.limits_report()],
+        "checks": [LimitReport.model_validate(c) for c in check.limits_report()],
     }
     if flight is not None:
         fields |= _flight_fields(mission, flight, t)
