@@ -115,8 +115,9 @@ def write(
                 scheduler=scheduler,
                 board_kind=_board_kind(board, fly),
                 lift_m=lift,
+                fly=fly,
             )
-        summary = write_outputs(show, out, rate, fly)
+        summary = write_outputs(show, out, rate)
     console.print(
         f"[green]done[/] {out}: {summary['duration_s']:.1f} s of flight, planned in "
         f"{summary['planning_time_s']:.2f} s, deviation {1e3 * summary['deviation']['max_m']:.2f}"
@@ -133,13 +134,13 @@ def _board_kind(name: str, fly: bool) -> Any:
     return name
 
 
-def write_outputs(show: Any, out: Path, rate: float, fly: bool) -> dict[str, Any]:
+def write_outputs(show: Any, out: Path, rate: float) -> dict[str, Any]:
     """The plan directory: trajectories, ``input_strokes.json``, ``plot.png``, ``summary.json``."""
     from skyquill.viz.writing_plot import plot_missions
 
     missions = list(show.missions)
     names = trajectory_names(len(missions))
-    per_drone = []
+    per_drone: list[dict[str, Any]] = []
     planned = []
     strokes_json: list[Any] = []
     for mission, (name, _) in zip(missions, names, strict=True):
@@ -147,7 +148,8 @@ def write_outputs(show: Any, out: Path, rate: float, fly: bool) -> dict[str, Any
         limits = mission.fit.problem.limits
         planned.append(PlannedTrajectory(vehicle, tuple(mission.pen_windows), limits))
         strokes_json.append([(s + mission.brush_offset).tolist() for s in mission.strokes_world])
-        per_drone.append(_drone_summary(mission, name, fly, vehicle))
+        flight = show.flights[len(per_drone)] if show.flights else None
+        per_drone.append(_drone_summary(mission, name, flight))
     firsts = np.cumsum([0] + [len(s) for s in strokes_json]).tolist()
     payload: dict[str, Any] = {
         "strokes": [stroke for drone in strokes_json for stroke in drone],
@@ -168,7 +170,7 @@ def write_outputs(show: Any, out: Path, rate: float, fly: bool) -> dict[str, Any
     )
 
 
-def _drone_summary(mission: Any, name: str, fly: bool, vehicle: Any) -> dict[str, Any]:
+def _drone_summary(mission: Any, name: str, flight: Any) -> dict[str, Any]:
     check = mission.fit.verification
     entry: dict[str, Any] = {
         "file": name,
@@ -185,28 +187,12 @@ def _drone_summary(mission: Any, name: str, fly: bool, vehicle: Any) -> dict[str
         "strokes": len(mission.strokes_world),
         "time_scale": mission.time_scale,
     }
-    if fly:
-        entry["flight"] = _fly(mission, vehicle)
+    if flight is not None:  # flown by plan_show(fly=True): RPT over the contact board
+        from skyquill.calligraphy.show import ink_deviation
+
+        ink = ink_deviation(flight, mission)
+        entry["flight"] = flight.summary() | {"ink_max_deviation_m": ink}
     return entry
-
-
-def _fly(mission: Any, vehicle: Any) -> dict[str, Any]:
-    """Fly the vehicle trajectory with RPT over the board; compare the ink with the input."""
-    from skyquill.calligraphy.mission import contact_board
-    from skyquill.geometry import polyline_distance
-    from skyquill.sim import Quadrotor, simulate
-
-    board = contact_board(mission)
-    flight = simulate(
-        vehicle, Quadrotor(brush_length_m=mission.options.brush_length_m), board=board
-    )
-    ink = np.vstack(flight.ink) if flight.ink else np.zeros((0, 3))
-    gap = (
-        np.min([polyline_distance(ink, s) for s in mission.strokes_world], axis=0)
-        if len(ink)
-        else np.zeros(0)
-    )
-    return flight.summary() | {"ink_max_deviation_m": float(gap.max(initial=0.0))}
 
 
 def _merge(drones: list[dict[str, Any]]) -> dict[str, Any]:
@@ -232,10 +218,9 @@ def demo(out: OutDir = Path("out/demo")) -> None:
     from skyquill.strokes import hanzi_strokes
 
     with user_errors():
-        with console.status("planning 永 (eternity: the eight strokes of calligraphy)"):
-            show = plan_show([hanzi_strokes("永")], WritingOptions())
-        with console.status("flying it in closed loop"):
-            summary = write_outputs(show, out, 100.0, fly=True)
+        with console.status("planning 永 (the eight strokes of calligraphy), flying it"):
+            show = plan_show([hanzi_strokes("永")], WritingOptions(), fly=True)
+        summary = write_outputs(show, out, 100.0)
     flight = summary["drones"][0]["flight"]
     console.print(
         f"[green]done[/] wrote 永 in {summary['duration_s']:.1f} s of flight "

@@ -27,7 +27,7 @@ import numpy as np
 
 from skyquill.calligraphy.board import Board
 from skyquill.calligraphy.mission import Mission, WritingOptions
-from skyquill.calligraphy.show import Show, plan_show
+from skyquill.calligraphy.show import Show, ink_deviation, plan_show
 from skyquill.errors import InfeasibleError, InputError, SolverError
 from skyquill.limits import VehicleLimits
 from skyquill.strokes import Strokes
@@ -242,18 +242,8 @@ def _flight_fields(mission: Mission, flight: Flight, t: FloatArray) -> dict[str,
         "flight": _round(board.to_board(tip)),
         "ink": [_round(board.to_board(_decimate(s))[:, :2]) for s in ink],
         "flight_rmse_m": flight.rmse_m,
-        "ink_max_deviation_m": _ink_deviation(ink, mission.strokes_world),
+        "ink_max_deviation_m": ink_deviation(flight, mission),
     }
-
-
-def _ink_deviation(ink: Sequence[FloatArray], strokes: Sequence[FloatArray]) -> float:
-    """Largest distance from the simulated ink to the nearest input stroke, m."""
-    if not ink:
-        return 0.0
-    from skyquill.geometry import polyline_distance
-
-    points = np.vstack(ink)
-    return float(np.min([polyline_distance(points, s) for s in strokes], axis=0).max())
 
 
 def _decimate(points: FloatArray) -> FloatArray:
