@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from skyquill.limits import DerivativeLimit
+from skyquill.limits import DerivativeLimit, VehicleLimits
 from skyquill.optimize.legs import LegLimits, stop_and_go
 from skyquill.painting.mission import MissionConfig, MissionResult
 from skyquill.trajectory import PiecewisePolynomial
@@ -45,8 +45,6 @@ class PaintingFlight:
 
 def painting_flight(result: MissionResult, config: MissionConfig | None = None) -> PaintingFlight:
     """The trajectory of ``result``'s recorded path under ``config``'s speeds and limits."""
-    from skyquill.limits import vehicle_limits
-
     cfg = config or MissionConfig()
     speeds = {
         "transit": cfg.transit_speed_mps,
@@ -65,9 +63,8 @@ def painting_flight(result: MissionResult, config: MissionConfig | None = None) 
         if kind == "approach" and touched[k]
     )
     # Straight legs: the speed, acceleration and jerk along each are the norms.
-    limits = vehicle_limits(
-        3, max(speeds.values()), cfg.max_acceleration_mps2, cfg.max_jerk_mps3, coupled_sides=None
-    )
+    vehicle = VehicleLimits(max(speeds.values()), cfg.max_acceleration_mps2, cfg.max_jerk_mps3)
+    limits = vehicle.derivative_limits(3)
     return PaintingFlight(flown.trajectory, windows, limits)
 
 

@@ -29,6 +29,9 @@ from skyquill.calligraphy.board import Board
 from skyquill.calligraphy.mission import Mission, WritingOptions
 from skyquill.calligraphy.show import Show, ink_deviation, plan_show
 from skyquill.errors import InfeasibleError, InputError, SolverError
+from skyquill.export import EXPORTERS, ExportOptions
+from skyquill.io.plan_dir import write_plan
+from skyquill.io.trajectory_json import PlannedTrajectory
 from skyquill.limits import VehicleLimits
 from skyquill.strokes import Strokes
 from skyquill.studio.models import DownloadFile, DronePlan, LimitReport, Limits, PlanRequest
@@ -42,6 +45,11 @@ if TYPE_CHECKING:
 SEPARATION_M = 1.0
 #: Rate of the setpoint CSVs, Hz (``skyquill write``'s default).
 CSV_RATE_HZ = 100.0
+#: The registry's formats the studio offers for download (besides the setpoints): the
+#: name of each format's download.
+STUDIO_FORMATS = {"crazyswarm": "crazyswarm", "skyc": "show"}
+#: Content types of the downloads, by suffix.
+CONTENT_TYPES = {".csv": "text/csv", ".skyc": "application/zip", ".json": "application/json"}
 #: Rate of the curves sent to the page, Hz, and the most samples per drone.
 VIEW_RATE_HZ = 50.0
 MAX_VIEW_SAMPLES = 3_000
@@ -136,7 +144,7 @@ def run_plan(
         for mission, part, flight in zip(show.missions, parts, flights, strict=True)
     ]
     progress(0.92, "writing the files")
-    files, notes = _exports(show.missions, show.homes)
+    files, notes = _exports(show.missions)
     result = PlanResultModel(
         source="text" if request.text is not None else "strokes",
         board=request.board,
@@ -252,75 +260,81 @@ def _decimate(points: FloatArray) -> FloatArray:
     return np.vstack([points[::step], points[-1:]])
 
 
-def _exports(
-    missions: Sequence[Mission], homes: Sequence[FloatArray]
-) -> tuple[dict[str, StudioFile], list[str]]:
-    """Setpoint CSV(s), Crazyswarm CSV(s) and the ``.skyc`` show, generated in a temp dir."""
-    from skyquill.io.crazyswarm import write_crazyswarm
-    from skyquill.io.points import write_trajectory_csv
-    from skyquill.io.skyc import write_skyc
+def _exports(missions: Sequence[Mission]) -> tuple[dict[str, StudioFile], list[str]]:
+    """The plan's setpoint CSV(s) and summary, and the studio's formats from the registry.
 
-    vehicles = [m.vehicle_trajectory() for m in missions]
-    notes: list[str] = []
+    Everything is written through the same writer and exporters as the command
+    line (a plan directory in a temporary folder, then
+    :data:`~skyquill.export.EXPORTERS`), kept in memory, and checked as written.
+    """
+    planned = [
+        (
+            f"drone_{i}",
+            PlannedTrajectory(m.vehicle_trajectory(), tuple(m.pen_windows), m.fit.problem.limits),
+        )
+        for i, m in enumerate(missions, start=1)
+    ]
     with tempfile.TemporaryDirectory(prefix="skyquill-studio-") as tmp:
         out = Path(tmp)
-        setpoints: list[Path] = []
-        swarm: list[Path] = []
-        for i, (mission, vehicle) in enumerate(zip(missions, vehicles, strict=True), start=1):
-            csv = out / f"setpoints_{i}.csv"
-            write_trajectory_csv(csv, vehicle, CSV_RATE_HZ, pen=mission.pen)
-            setpoints.append(csv)
-            export = write_crazyswarm(vehicle, out / f"crazyswarm_{i}.csv")
-            swarm.extend(export.files)
-            notes.append(f"drone {i}: {export.message.replace(str(out) + '/', '')}")
-        skyc = write_skyc(
-            vehicles, out / "show.skyc", homes=np.array(homes), title="skyquill studio"
+        summary = write_plan(
+            out / "plan",
+            [p for _, p in planned],
+            rate=CSV_RATE_HZ,
+            guaranteed=True,
+            summary={"drones": [_drone_summary(m) for m in missions]},
         )
-        notes.append(skyc.message)
+        setpoints = [
+            (f"setpoints_{i}.csv", (out / "plan" / d["csv"]).read_bytes())
+            for i, d in enumerate(summary["plan"]["drones"], start=1)
+        ]
         files = [
             _bundle(
                 setpoints,
                 "setpoints",
                 f"setpoints at {CSV_RATE_HZ:g} Hz: t, x, y, z, velocity, acceleration, jerk, "
                 "yaw, pen (SI, z up)",
-            ),
-            _bundle(
-                swarm, "crazyswarm", "Crazyswarm2 polynomial trajectory (uav_trajectories CSV)"
-            ),
-            StudioFile("show.skyc", skyc.path.read_bytes(), "application/zip", "Skybrush show"),
+            )
         ]
-    files.append(_summary(missions))
+        notes = []
+        for name, stem in STUDIO_FORMATS.items():
+            exporter = EXPORTERS[name]
+            report = exporter(planned, out / f"{name}{exporter.suffix}", ExportOptions(CSV_RATE_HZ))
+            notes.append(report.message.replace(str(out) + "/", ""))
+            parts = [(f.name, f.read_bytes()) for f in report.files]
+            files.append(_bundle(parts, stem, exporter.help))
+        data = json.dumps(summary, indent=2, allow_nan=False).encode()
+    files.append(
+        StudioFile("summary.json", data, "application/json", "what was planned and checked")
+    )
     return {f.name: f for f in files}, notes
 
 
-def _bundle(paths: Sequence[Path], stem: str, description: str) -> StudioFile:
-    """One CSV as ``<stem>.csv``, or several in ``<stem>.zip``."""
-    if len(paths) == 1:
-        return StudioFile(f"{stem}.csv", paths[0].read_bytes(), "text/csv", description)
+def _bundle(parts: Sequence[tuple[str, bytes]], stem: str, description: str) -> StudioFile:
+    """One file as ``<stem><suffix>``, or several in ``<stem>.zip``."""
+    if len(parts) == 1:
+        name, data = parts[0]
+        suffix = Path(name).suffix
+        kind = {".csv": "text/csv", ".skyc": "application/zip"}.get(
+            suffix, "application/octet-stream"
+        )
+        return StudioFile(f"{stem}{suffix}", data, kind, description)
     buffer = io.BytesIO()
     with zipfile.ZipFile(buffer, "w", compression=zipfile.ZIP_DEFLATED) as archive:
-        for p in paths:
-            archive.writestr(p.name, p.read_bytes())
+        for name, data in parts:
+            archive.writestr(name, data)
     note = " (one file per drone and upload, in a zip)"
     return StudioFile(f"{stem}.zip", buffer.getvalue(), "application/zip", description + note)
 
 
-def _summary(missions: Sequence[Mission]) -> StudioFile:
-    """``summary.json``: each drone's verification, deviation and timing."""
-    drones = [
-        {
-            "duration_s": m.trajectory.duration,
-            "planning_time_s": m.planning_time_s,
-            "limits": [
-                {k: (float(v) if isinstance(v, np.floating) else v) for k, v in c.items()}
-                for c in m.fit.verification.limits_report()
-            ],
-            "max_excess": float(m.fit.verification.max_excess),
-            "deviation": m.deviation.as_dict(),
-            "faithful": m.faithful,
-            "time_scale": m.time_scale,
-        }
-        for m in missions
-    ]
-    data = json.dumps({"drones": drones}, indent=2, allow_nan=False).encode()
-    return StudioFile("summary.json", data, "application/json", "verification and timing")
+def _drone_summary(mission: Mission) -> dict[str, Any]:
+    """A drone's verification, deviation and timing (beside the plan's own check)."""
+    check = mission.fit.verification
+    return {
+        "duration_s": mission.trajectory.duration,
+        "planning_time_s": mission.planning_time_s,
+        "limits": check.limits_report(),
+        "max_excess": float(check.max_excess),
+        "deviation": mission.deviation.as_dict(),
+        "faithful": mission.faithful,
+        "time_scale": mission.time_scale,
+    }
