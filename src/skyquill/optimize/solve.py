@@ -330,9 +330,7 @@ def _hull_excess(asm: Assembled, x: FloatArray) -> float:
 
 def _solve_qp(
     problem: SmoothingProblem, solver: str
-) -> tuple[
-    FloatArray, tuple[FloatArray, FloatArray, FloatArray | None], str, float, Assembled
-]:
+) -> tuple[FloatArray, tuple[FloatArray, FloatArray, FloatArray | None], str, float, Assembled]:
     """Control points, the duals ``(y, z, cone_z)`` of the same (tightened) QP, backend, margin."""
     exact = assemble(problem)
     if exact.cones is not None:

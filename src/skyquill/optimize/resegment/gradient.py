@@ -150,7 +150,7 @@ def _lagrangian_gradient(
         # Limit rows alpha^n (Hull (x) A) x - b: d/dalpha = (n / alpha) (G x).
         g_alpha += float(np.sum(mult.mu * mult.order * mult.Gx)) / alpha
         # Cone rows (0, alpha^n (Hull (x) I_d) x): the same, with the cone duals.
-        g_alpha += float(np.sum(mult.cone_z * mult.cone_order * mult.cone_Ax)) / alpha
+        g_alpha += float(np.sum(mult.cone_z * mult.cone_order * mult.cone_values)) / alpha
     for order, sigma in problem.smoothness.items():
         if sigma:
             D = basis.derivative_map(order) @ C

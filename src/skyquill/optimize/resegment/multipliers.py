@@ -57,7 +57,7 @@ class Multipliers:
         ``cones.A`` (:attr:`FitResult.cone_z`; empty without cones).
     cone_order
         Derivative order of each cone row, shape (m_c,).
-    cone_Ax
+    cone_values
         ``cones.A @ x``, shape (m_c,): ``(0, v_p)`` per hull point.
     residual
         Relative stationarity residual (:attr:`TimeGradient.stationarity_residual`).
@@ -72,7 +72,7 @@ class Multipliers:
     Gx: FloatArray
     cone_z: FloatArray
     cone_order: FloatArray
-    cone_Ax: FloatArray
+    cone_values: FloatArray
     residual: float
     cost: float
 
@@ -108,7 +108,7 @@ def multipliers(result: FitResult) -> Multipliers:
     size = max(float(np.linalg.norm(quad)), float(np.linalg.norm(qp.q)), 1e-300)
     residual = float(np.linalg.norm(stationarity)) / size
     lam = y.reshape(-1, C.shape[1])
-    cone_Ax = A_c @ x if A_c is not None else np.zeros(0)
+    cone_values = A_c @ x if A_c is not None else np.zeros(0)
     return Multipliers(
         C,
         lam,
@@ -117,7 +117,7 @@ def multipliers(result: FitResult) -> Multipliers:
         qp.G @ x,
         cone_z,
         cone_orders,
-        cone_Ax,
+        cone_values,
         residual,
         cost,
     )

@@ -145,7 +145,9 @@ def polish(
     on_cone = _active(lam)
     for _ in range(_ITERATIONS):
         try:
-            x, y, z_active, lam_active = _newton(qp, cones, x0, lam, active, on_cone)
+            x, y, z_active, lam_active = _newton(
+                qp, cones, x0, lam=lam, active=active, on_cone=on_cone
+            )
         except SingularKKTError:
             return None
         violated = np.setdiff1d(np.flatnonzero((G @ x - h) / scale > 1e-12), active)
@@ -157,8 +159,17 @@ def polish(
             big = max(float(np.abs(lam_active).max(initial=0.0)), 1e-300)
             cone_negative = lam_active < -1e-9 * big
         if not (violated.size or negative.any() or cone_violated.size or cone_negative.any()):
-            return _accept(x, x0, y=y, z=z_active, active=active, m_in=G.shape[0], cones=cones,
-                           lam=lam_active, on_cone=on_cone)
+            return _accept(
+                x,
+                x0,
+                y=y,
+                z=z_active,
+                active=active,
+                m_in=G.shape[0],
+                cones=cones,
+                lam=lam_active,
+                on_cone=on_cone,
+            )
         active = np.union1d(active[~negative], violated)
         if cones is not None:
             lam = np.zeros(cones.r.size)
@@ -176,6 +187,7 @@ def _newton(
     qp: QuadraticProgram,
     cones: _Cones | None,
     x: FloatArray,
+    *,
     lam: FloatArray,
     active: NDArray[np.intp],
     on_cone: NDArray[np.intp],
