@@ -152,12 +152,7 @@ def polish(
             return None
         violated = np.setdiff1d(np.flatnonzero((G @ x - h) / scale > 1e-12), active)
         negative = z_active < -1e-9 * max(float(np.abs(z_active).max(initial=0.0)), 1e-300)
-        cone_violated, cone_negative = np.zeros(0, np.intp), np.zeros(0, bool)
-        if cones is not None:
-            excess = (np.linalg.norm(cones.v(x), axis=1) - cones.r) / np.maximum(cones.r, 1e-3)
-            cone_violated = np.setdiff1d(np.flatnonzero(excess > 1e-12), on_cone)
-            big = max(float(np.abs(lam_active).max(initial=0.0)), 1e-300)
-            cone_negative = lam_active < -1e-9 * big
+        cone_violated, cone_negative = _cone_changes(cones, x, on_cone, lam_active)
         if not (violated.size or negative.any() or cone_violated.size or cone_negative.any()):
             return _accept(
                 x,
@@ -176,6 +171,17 @@ def polish(
             lam[on_cone[~cone_negative]] = lam_active[~cone_negative]
             on_cone = np.union1d(on_cone[~cone_negative], cone_violated)
     return None
+
+
+def _cone_changes(
+    cones: _Cones | None, x: FloatArray, on_cone: NDArray[np.intp], lam: FloatArray
+) -> tuple[NDArray[np.intp], NDArray[np.bool_]]:
+    """Cones ``x`` violates off ``on_cone``, and which of ``on_cone`` have ``lam < 0``."""
+    if cones is None:
+        return np.zeros(0, np.intp), np.zeros(0, bool)
+    excess = (np.linalg.norm(cones.v(x), axis=1) - cones.r) / np.maximum(cones.r, 1e-3)
+    violated = np.setdiff1d(np.flatnonzero(excess > 1e-12), on_cone)
+    return violated, lam < -1e-9 * max(float(np.abs(lam).max(initial=0.0)), 1e-300)
 
 
 def _active(duals: FloatArray) -> NDArray[np.intp]:
