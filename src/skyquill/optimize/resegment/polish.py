@@ -44,10 +44,14 @@ _ACTIVE_DUAL_RTOL = 1e-6
 _ITERATIONS = 10
 #: Newton steps per active set (quadratic convergence: 2-4 in practice).
 _NEWTON_STEPS = 12
-#: Newton has converged when a step moves the point by less than this (relative),
-#: or when steps below ``_NEWTON_STALL`` stop shrinking (rounding level).
-_NEWTON_RTOL = 1e-13
+#: Newton has converged when a step moves the point by less than this (relative):
+#: it converges quadratically, so the point after a step of ``delta`` is off by
+#: ~``delta^2``. Or when steps below ``_NEWTON_STALL`` stop shrinking (rounding level).
+_NEWTON_RTOL = 1e-9
 _NEWTON_STALL = 1e-9
+#: A row (cone) with a positive multiplier is held only if its slack at the
+#: solver's point is at most this, relative to its bound (radius).
+_TIGHT = 1e-5
 #: The polished point may move this far (relative) from the solver's.
 _MAX_MOVE = 1e-3
 
@@ -137,16 +141,28 @@ def polish(
     G, h = qp.G, qp.h
     scale = np.maximum(np.abs(h), 1e-3)
     cones = _Cones.of(qp.cones)
+    # Only rows tight at the solver's point: when no row is active the duals are all
+    # ~0 and a relative threshold alone would hold every row (more rows than unknowns).
     active = _active(z0)
+    active = active[(h[active] - G[active.tolist(), :] @ x0) / scale[active] <= _TIGHT]
     lam = np.zeros(0)
     if cones is not None:
         assert cone_z0 is not None, "polish: cone duals are required with cones"
         lam = np.maximum(cones.lam(cone_z0), 0.0)
     on_cone = _active(lam)
+    if cones is not None:
+        # Clarabel leaves lambda ~1e-3 of the largest on cones 1e-3 (relative) inside
+        # their radius next to the active ones (the interior-point path's centring):
+        # held on their spheres they come back with lambda < 0, one active-set pass
+        # each. A cone counts only if it is also tight at the solver's point.
+        slack = 1.0 - np.linalg.norm(cones.v(x0), axis=1) / cones.r
+        on_cone = on_cone[slack[on_cone] <= _TIGHT]
+    x = x0
     for _ in range(_ITERATIONS):
         try:
+            # Warm start: the last active set's minimiser is near the next one's.
             x, y, z_active, lam_active = _newton(
-                qp, cones, x0, lam=lam, active=active, on_cone=on_cone
+                qp, cones, x, lam=lam, active=active, on_cone=on_cone
             )
         except SingularKKTError:
             return None
