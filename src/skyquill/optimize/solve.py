@@ -21,7 +21,7 @@
   radius.
 
 Either way the result keeps the multipliers of the problem it solved
-(:attr:`FitResult.y`, :attr:`FitResult.z`); the re-segmentation gradient
+(:attr:`FitResult.y`, :attr:`FitResult.z`, :attr:`FitResult.cone_z`); the re-segmentation gradient
 (:mod:`skyquill.optimize.resegment`) is built on them.
 
 Paper 003 eq. (54) drops the factor ``-1/2`` of the stationarity condition

@@ -6,9 +6,12 @@ off by up to 7e-5 relative (1e-5 with Clarabel) against central differences
 of the exact optimal cost, on the random limited problems of
 ``tests/optimize/resegment``; the gradient is first-order in that error
 where the cost is only second-order. So the rows with a positive multiplier
-are held at their (tightened) bounds and the equality-constrained QP is
-solved exactly by one KKT solve (:func:`skyquill.optimize.kkt.solve_equality_qp`),
-which also gives the multipliers: the gradient error drops to ~1e-10.
+that are also tight at the solver's point (slack at most ``_TIGHT`` of the
+bound: interior-point duals of nearby inactive rows are small but not zero,
+and when nothing is active all of them are) are held at their (tightened)
+bounds and the equality-constrained QP is solved exactly by one KKT solve
+(:func:`skyquill.optimize.kkt.solve_equality_qp`), which also gives the
+multipliers: the gradient error drops to ~1e-10.
 
 Active second-order cones ``||v_p|| <= r_p`` (exact norm limits, ``v_p =
 M_p x``) are held as the curved equalities ``1/2 (||M_p x||^2 - r_p^2) = 0``
