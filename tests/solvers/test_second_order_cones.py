@@ -84,3 +84,30 @@ def test_backends_without_cones_refuse_them(backend: str) -> None:
     """They would silently drop the cones, so the dispatcher says no."""
     with pytest.raises(InputError, match=rf"solver: got '{backend}' for a program with "):
         solve_qp(ball_projection(np.ones(2), 1.0), backend)
+
+
+@pytest.mark.parametrize("z", [[3.0, 4.0], [0.1, -2.0, 0.3], [0.2, 0.1]])
+def test_clarabel_cone_duals_close_the_stationarity_condition(z: list[float]) -> None:
+    """``P x + q + G'z + A_c' z_c = 0`` (QPSolution's convention) against the closed form.
+
+    Projection onto the unit ball, ``A_c = [0; -I]``: outside, ``z_c = (||z|| - 1,
+    (1/||z|| - 1) z)``; inside, ``z_c = 0``.
+    """
+    zz = np.array(z)
+    qp = ball_projection(zz, 1.0, extra_rows=1)
+    sol = solve_qp(qp, "clarabel")
+    assert sol.x is not None and sol.z is not None and sol.cone_z is not None
+    assert qp.cones is not None
+    assert sol.cone_z.shape == (zz.size + 1,)
+    residual = qp.P @ sol.x + qp.q + qp.G.T @ sol.z + qp.cones.A.T @ sol.cone_z
+    assert np.linalg.norm(residual) <= 1e-8
+    norm = float(np.linalg.norm(zz))
+    expected = np.concatenate([[norm - 1.0], (1.0 / norm - 1.0) * zz]) if norm > 1.0 else 0 * zz
+    # As in the projection test: x (hence z_c = x - z) is flat-accurate to ~1e-6 on the sphere.
+    np.testing.assert_allclose(sol.cone_z, np.resize(expected, zz.size + 1), atol=1e-5)
+
+
+def test_no_cone_duals_without_cones() -> None:
+    qp = ball_projection(np.array([3.0, 4.0]), 1.0)
+    plain = QuadraticProgram(qp.P, qp.q, qp.A_eq, qp.b_eq, qp.G, qp.h)
+    assert solve_qp(plain, "clarabel").cone_z is None

@@ -21,7 +21,7 @@
   radius.
 
 Either way the result keeps the multipliers of the problem it solved
-(:attr:`FitResult.y`, :attr:`FitResult.z`); the re-segmentation gradient
+(:attr:`FitResult.y`, :attr:`FitResult.z`, :attr:`FitResult.cone_z`); the re-segmentation gradient
 (:mod:`skyquill.optimize.resegment`) is built on them.
 
 Paper 003 eq. (54) drops the factor ``-1/2`` of the stationarity condition
@@ -103,9 +103,16 @@ class FitResult:
 
     With ``J(x) = x'Hx + f'x`` the assembled cost (``H = hessian()``,
     ``f = linear()``; the QP's ``P = 2 H``, ``q = f``), the multipliers satisfy
-    ``2 H x + f + A_eq' y + G_ineq' z = 0`` (the sign convention of
-    :class:`skyquill.solvers.QPSolution`), to the backend's tolerance on the
+    ``2 H x + f + A_eq' y + G_ineq' z + A_c' cone_z = 0`` (the sign convention
+    of :class:`skyquill.solvers.QPSolution`), to the backend's tolerance on the
     QP route.
+    cone_z
+        Second-order cone multipliers, shape (n_cones (d + 1),), or ``None``
+        without exact norm limits: one block ``(z_0, z_1..z_d)`` per hull point,
+        ``||(z_1..z_d)|| <= z_0``, for the rows ``A_c`` of
+        ``_to_qp(assemble(problem), margin).cones`` (Clarabel's ``b_c - A_c x in
+        SOC(d + 1)`` with ``A_c x = (0, v_p)``, ``b_c = (r_p, 0)``). At an active
+        cone ``z_1..z_d = (z_0 / r_p) v_p``.
     """
 
     trajectory: SplineTrajectory
@@ -122,6 +129,7 @@ class FitResult:
     y: FloatArray
     z: FloatArray
     n_cones: int = 0
+    cone_z: FloatArray | None = None
 
     @property
     def status(self) -> Literal["optimal"]:
@@ -162,11 +170,12 @@ def solve(problem: SmoothingProblem, solver: str = DEFAULT_BACKEND) -> FitResult
         raise InputError(f"solver: got {solver!r}, expected one of {sorted(BACKENDS)}")
     start = time.perf_counter()
     if problem.has_inequalities:
-        C, y, z, used, margin, asm = _solve_qp(problem, solver)
+        C, (y, z, cone_z), used, margin, asm = _solve_qp(problem, solver)
         method: Literal["closed_form", "qp"] = "qp"
     else:
         asm = assemble(problem)
         (C, y), z, used, margin = _closed_form(asm), np.zeros(0), "sparse-lu", 0.0
+        cone_z = None
         method = "closed_form"
     elapsed = time.perf_counter() - start
     traj = SplineTrajectory(C, problem.degree, problem.duration)
@@ -186,6 +195,7 @@ def solve(problem: SmoothingProblem, solver: str = DEFAULT_BACKEND) -> FitResult
         y=y,
         z=z,
         n_cones=asm.cones.radius.size if asm.cones is not None else 0,
+        cone_z=cone_z,
     )
 
 
@@ -320,8 +330,8 @@ def _hull_excess(asm: Assembled, x: FloatArray) -> float:
 
 def _solve_qp(
     problem: SmoothingProblem, solver: str
-) -> tuple[FloatArray, FloatArray, FloatArray, str, float, Assembled]:
-    """Control points, the duals ``y``, ``z`` of the same (tightened) QP, backend, margin."""
+) -> tuple[FloatArray, tuple[FloatArray, FloatArray, FloatArray | None], str, float, Assembled]:
+    """Control points, the duals ``(y, z, cone_z)`` of the same (tightened) QP, backend, margin."""
     exact = assemble(problem)
     if exact.cones is not None:
         backends = list(CONIC_BACKENDS)
@@ -343,7 +353,7 @@ def _solve_qp(
         excess = _hull_excess(exact, sol.x)
         if excess <= GUARANTEE_RTOL:
             C = sol.x.reshape(problem.n_ctrl, problem.dim)
-            return C, sol.y, sol.z, sol.solver, margin, exact
+            return C, (sol.y, sol.z, sol.cone_z), sol.solver, margin, exact
         log.info("hull excess %.3g at margin %.0e; tightening", excess, margin)
     if failures and len(failures) >= len(backends) * len(_MARGINS):
         # Backends fail this way on problems that are infeasible by a hair.

@@ -11,6 +11,15 @@ inequality multipliers ``z >= 0``,
 
     P x + q + A_eq' y + G' z = 0,      z * (h - G x) = 0.
 
+With second-order cones ``b_c - A_c x in K`` (:class:`SecondOrderCones`,
+Clarabel's form) the cone multipliers ``z_c`` (in the dual cone, which is
+``K`` itself) add ``A_c' z_c`` to stationarity,
+
+    P x + q + A_eq' y + G' z + A_c' z_c = 0,      z_c' (b_c - A_c x) = 0,
+
+i.e. the Lagrangian is ``1/2 x'Px + q'x + y'(A_eq x - b_eq) + z'(G x - h) +
+z_c'(A_c x - b_c)``.
+
 Each adapter converts its solver's own signs and row order to this.
 """
 
@@ -109,6 +118,11 @@ class QPSolution:
     z
         Inequality multipliers, shape (m_in,), ``>= 0`` up to the solver's
         tolerance, or ``None`` unless optimal.
+    cone_z
+        Second-order cone multipliers, shape (m_c,), one per row of
+        ``qp.cones.A`` in its row order, each block in the cone (module
+        docstring: ``... + A_c' z_c = 0``); ``None`` without cones or unless
+        optimal.
     """
 
     status: QPStatus
@@ -118,6 +132,7 @@ class QPSolution:
     message: str = ""
     y: FloatArray | None = None
     z: FloatArray | None = None
+    cone_z: FloatArray | None = None
 
 
 class QPBackend(Protocol):

@@ -39,7 +39,7 @@ def solve_clarabel(qp: QuadraticProgram, tol: float) -> QPSolution:
     if name in ("Solved", "AlmostSolved"):
         # Clarabel: P x + q + A' z = 0 with z in the dual cone of each row block,
         # zero cone (equalities) first, then the nonnegative cone (G x <= h), then
-        # the second-order cones, whose duals QPSolution does not carry.
+        # the second-order cones: already the signs of QPSolution.
         z = np.asarray(result.z)
         m_eq, m_in = qp.b_eq.size, qp.h.size
         return QPSolution(
@@ -50,6 +50,7 @@ def solve_clarabel(qp: QuadraticProgram, tol: float) -> QPSolution:
             name,
             z[:m_eq],
             z[m_eq : m_eq + m_in],
+            z[m_eq + m_in :] if qp.cones is not None else None,
         )
     if "PrimalInfeasible" in name:
         return QPSolution("infeasible", None, "clarabel", elapsed, name)

@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 from numpy.typing import NDArray
 
 from skyquill.io.points import read_points_csv
-from skyquill.limits import BoxLimit, vehicle_limits
+from skyquill.limits import BoxLimit, DerivativeLimit, NormLimit, vehicle_limits
 from skyquill.optimize import (
     Boundary,
     Interpolation,
@@ -127,3 +127,19 @@ def limited_random(seed: int, dim: int, fraction: float) -> tuple[Array, Factory
     acc = float(np.abs(free.trajectory.sample(500.0).a).max())
     limit = BoxLimit.symmetric(2, fraction * acc, dim)
     return times, point_fit_factory(pts, 14, degree=4, weight=100.0, limits=(limit,))
+
+
+def norm_limited_random(
+    seed: int, dim: int, order: int, fraction: float, extra: tuple[DerivativeLimit, ...] = ()
+) -> tuple[Array, Factory]:
+    """Seven random points, degree 4, an exact norm limit (a cone) on derivative ``order``
+    at ``fraction`` of the free fit's peak norm, then the ``extra`` limits."""
+    rng = np.random.default_rng(seed)
+    n = 7
+    pts = np.cumsum(rng.normal(0.0, 0.5, (n, dim)), axis=0)
+    times = np.concatenate([[0.0], np.cumsum(rng.uniform(0.5, 1.5, n - 1))])
+    free = solve(point_fit_factory(pts, 14, degree=4, weight=100.0)(times))
+    sample = free.trajectory.sample(500.0)
+    peak = float(np.linalg.norm((sample.v, sample.a)[order - 1], axis=1).max())
+    limits = (NormLimit(order, fraction * peak, dim=dim), *extra)
+    return times, point_fit_factory(pts, 14, degree=4, weight=100.0, limits=limits)

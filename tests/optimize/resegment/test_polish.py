@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 import scipy.sparse as sp
@@ -49,9 +51,22 @@ def test_polished_point_meets_the_kkt_conditions_exactly(case: str) -> None:
 
 
 def test_dependent_active_rows_give_no_polished_point() -> None:
-    """Every row declared active: more rows than unknowns, no LICQ, no polished point."""
+    """Every active row twice: dependent rows, no LICQ, no polished point."""
     result = limited_result(CASES[0])
-    asm = assemble(result.problem)
+    qp = _to_qp(assemble(result.problem), result.margin)
     x0 = result.trajectory.control_points.ravel()
-    assert asm.G_ineq.shape[0] > x0.size
-    assert polish(_to_qp(asm, result.margin), x0, np.ones(asm.G_ineq.shape[0])) is None
+    twice = replace(qp, G=sp.csc_array(sp.vstack([qp.G, qp.G])), h=np.concatenate([qp.h, qp.h]))
+    assert polish(qp, x0, result.z) is not None
+    assert polish(twice, x0, np.concatenate([result.z, result.z])) is None
+
+
+def test_only_tight_rows_are_held() -> None:
+    """All multipliers ~0 (nothing active) and equal: a relative threshold alone would hold
+    every row (more rows than unknowns); rows with slack at the solver's point are not held."""
+    result = limited_result(CASES[0])
+    qp = _to_qp(assemble(result.problem), result.margin)
+    x0 = result.trajectory.control_points.ravel()
+    assert qp.G.shape[0] > x0.size
+    out = polish(qp, x0, np.full(qp.G.shape[0], 1e-12))
+    assert out is not None
+    assert np.count_nonzero(out.z) < x0.size

@@ -20,6 +20,10 @@ derivative in ``theta`` of the Lagrangian
   ``d/dalpha = n v alpha^(-n-1)`` -- zero for rest-to-rest conditions;
 * derivative limits ``alpha^n (Hull (x) A) x <= b``: ``d/dalpha =
   (n / alpha) (G x)_r`` on each active row;
+* exact norm limits, Clarabel's cones ``b_c - A_c x in SOC(d + 1)`` with
+  ``A_c x = (0, v_p)``, ``v_p = alpha^n (Hull (x) I_d) x`` and ``b_c`` (the
+  radius) fixed: the same, ``d/dalpha = (n / alpha) z_c' (A_c x)``, which is
+  ``(n / alpha) z_0 r_p`` on an active cone;
 * line, plane and corridor windows map to whole knot spans: piecewise
   constant in ``alpha``, derivative zero (almost everywhere).
 
@@ -85,8 +89,17 @@ def time_gradient(
     grad_T = np.cumsum(grad_t[::-1])[::-1][1:].copy()
     if mult is None:
         return TimeGradient(result.cost, grad_t, grad_T, result, 0, 0.0, result.cost)
-    n_active = int(np.count_nonzero(mult.mu > _ACTIVE_DUAL_RTOL * mult.mu.max(initial=0.0)))
-    return TimeGradient(result.cost, grad_t, grad_T, result, n_active, mult.residual, mult.cost)
+    n_active = _n_active(mult.mu)
+    # Cone blocks (z_0, z_1..z_d): z_0 >= ||z_1..z_d||, positive when the cone is active.
+    n_cones = _n_active(mult.cone_z[:: result.problem.dim + 1])
+    return TimeGradient(
+        result.cost, grad_t, grad_T, result, n_active, mult.residual, mult.cost, n_cones
+    )
+
+
+def _n_active(duals: FloatArray) -> int:
+    """Number of multipliers above ``_ACTIVE_DUAL_RTOL`` of the largest."""
+    return int(np.count_nonzero(duals > _ACTIVE_DUAL_RTOL * duals.max(initial=0.0)))
 
 
 def _needs_multipliers(result: FitResult) -> bool:
@@ -136,6 +149,8 @@ def _lagrangian_gradient(
         g_alpha += boundary
         # Limit rows alpha^n (Hull (x) A) x - b: d/dalpha = (n / alpha) (G x).
         g_alpha += float(np.sum(mult.mu * mult.order * mult.Gx)) / alpha
+        # Cone rows (0, alpha^n (Hull (x) I_d) x): the same, with the cone duals.
+        g_alpha += float(np.sum(mult.cone_z * mult.cone_order * mult.cone_values)) / alpha
     for order, sigma in problem.smoothness.items():
         if sigma:
             D = basis.derivative_map(order) @ C

@@ -30,7 +30,8 @@ class TimeGradient:
     n_active
         Number of inequality rows with a positive multiplier.
     stationarity_residual
-        Relative residual ``||grad J + E'Lambda + G'mu||`` against the larger
+        Relative residual ``||grad J + E'Lambda + G'mu + A_c' z_c||`` (``z_c``:
+        cone multipliers, :attr:`FitResult.cone_z`) against the larger
         of the two parts of ``grad J = 2 H x + f`` (0 when no multiplier was
         needed) at the point the gradient was taken.
     polished_cost
@@ -38,6 +39,9 @@ class TimeGradient:
         set of the solver's duals (:mod:`.polish`), of which the gradient is
         the exact derivative; equal to ``cost`` on the closed-form route. The
         QP backends' ``cost`` can lie above it by ~1e-8 relative.
+    n_active_cones
+        Number of second-order cones (hull points of exact norm limits) with
+        a positive multiplier.
     """
 
     cost: float
@@ -47,6 +51,7 @@ class TimeGradient:
     n_active: int
     stationarity_residual: float
     polished_cost: float
+    n_active_cones: int = 0
 
 
 @dataclass(frozen=True)
