@@ -36,6 +36,7 @@ RESULTS = ROOT / "bench" / "results"
 #: The last landed revision before the one-trajectory work (issue 12).
 BASE = "6d58cd5"
 
+PER_AXIS = ("--amax-axis", "5", "--jmax-axis", "3")
 #: (name, arguments after ``skyquill``, note). ``{out}`` is a fresh folder.
 JOBS: tuple[tuple[str, list[str], str], ...] = (
     ("fit spiral", ["fit", "examples/spiral.csv", "--timing", "path", "--out", "{out}"], ""),
@@ -51,10 +52,9 @@ JOBS: tuple[tuple[str, list[str], str], ...] = (
     ),
     (
         "cover square, per axis",
-        ["cover", "examples/coverage/square_10m.geojson", "--out", "{out}", "--amax-axis", "5",
-         "--jmax-axis", "3"],
+        [*("cover", "examples/coverage/square_10m.geojson", "--out", "{out}"), *PER_AXIS],
         "the same limits as before (the old code gets --amax 5 --jmax 3: per axis there)",
-    ),  # fmt: skip
+    ),
     ("paint", ["paint", "examples/painting/paper_140.csv", "--out", "{out}"], ""),
 )
 #: The ``skyquill`` console script, run from whichever tree ``PYTHONPATH`` names.
