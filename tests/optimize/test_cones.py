@@ -125,6 +125,23 @@ def test_cone_problem_ignores_a_qp_only_solver_name() -> None:
     assert fit.verification.max_excess <= 1e-9
 
 
+def test_norms_that_do_not_bind_are_solved_as_a_qp_with_the_same_optimum() -> None:
+    """Loose balls: the box relaxation's optimum meets them, so no conic solve is needed."""
+    points = noisy_curve("helix", n=200)
+    free = solve(problem(points, 8.0))
+    loose = tuple(NormLimit(k, 2.0 * v) for k, v in peak_norms(free).items())
+    fit = solve(problem(points, 8.0, loose))
+    assert fit.solver == "piqp" and fit.n_cones > 0
+    assert fit.cone_z is not None and not np.any(fit.cone_z)
+    np.testing.assert_allclose(
+        fit.trajectory.control_points, free.trajectory.control_points, atol=1e-6
+    )
+    assert fit.verification.max_excess == 0.0
+    # Binding balls: the conic program (Clarabel) decides.
+    tight = tuple(NormLimit(k, 0.7 * v) for k, v in peak_norms(free).items())
+    assert solve(problem(points, 8.0, tight)).solver == "clarabel"
+
+
 def test_infeasible_cone_names_its_family() -> None:
     """A 1 m rise in 1 s cannot keep the speed under 0.5 m/s: the speed cone is named."""
     start, end = np.zeros(3), np.array([0.0, 0.0, 1.0])
