@@ -51,6 +51,9 @@ bench: $(STAMP)
 	$(BIN)/python bench/coverage_lp.py
 	$(BIN)/python bench/coverage.py
 	$(BIN)/python bench/painting.py
+	$(BIN)/python bench/cones.py
+	$(BIN)/python bench/resegment_cones.py
+	$(BIN)/python bench/regression.py
 
 clean:
 	rm -rf $(VENV) out .pytest_cache .mypy_cache .ruff_cache

@@ -37,6 +37,12 @@ RESULTS = ROOT / "bench" / "results"
 BASE = "6d58cd5"
 
 PER_AXIS = ("--amax-axis", "5", "--jmax-axis", "3")
+#: A job given as Python code (the same in both trees: ``plan_writing``'s defaults).
+PLAN_ALL = (
+    "from skyquill.calligraphy.mission import plan_writing",
+    "from skyquill.strokes import bundled_hanzi, hanzi_strokes",
+    "[plan_writing(hanzi_strokes(c)) for c in bundled_hanzi()]",
+)
 #: (name, arguments after ``skyquill``, note). ``{out}`` is a fresh folder.
 JOBS: tuple[tuple[str, list[str], str], ...] = (
     ("fit spiral", ["fit", "examples/spiral.csv", "--timing", "path", "--out", "{out}"], ""),
@@ -56,6 +62,11 @@ JOBS: tuple[tuple[str, list[str], str], ...] = (
         "the same limits as before (the old code gets --amax 5 --jmax 3: per axis there)",
     ),
     ("paint", ["paint", "examples/painting/paper_140.csv", "--out", "{out}"], ""),
+    (
+        "plan the 57 bundled characters",
+        ["python:" + "; ".join(PLAN_ALL)],
+        "plan_writing with its defaults, in one process (no files): the calligraphy bench's work",
+    ),
 )
 #: The ``skyquill`` console script, run from whichever tree ``PYTHONPATH`` names.
 ENTRY = "from skyquill.cli.main import app; app(prog_name='skyquill')"
@@ -75,7 +86,10 @@ def export_base(rev: str, into: Path) -> Path:
 def run_job(src: Path, args: list[str], out: Path) -> float:
     """Wall time of one command, s (it must succeed)."""
     env = os.environ | {"PYTHONPATH": str(src)}
-    command = [sys.executable, "-c", ENTRY, *(a.format(out=out) for a in args)]
+    if args[0].startswith("python:"):
+        command = [sys.executable, "-c", args[0].removeprefix("python:")]
+    else:
+        command = [sys.executable, "-c", ENTRY, *(a.format(out=out) for a in args)]
     start = time.perf_counter()
     subprocess.run(command, cwd=ROOT, env=env, check=True, capture_output=True)
     return time.perf_counter() - start
