@@ -1,0 +1,76 @@
+"""The export registry: every format writes, reads itself back as its consumer does, reports."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy.interpolate import make_interp_spline
+
+from skyquill.errors import InputError
+from skyquill.export import EXPORTERS, ExportOptions, exporter
+from skyquill.export.refit import as_spline
+from skyquill.io.trajectory_json import PlannedTrajectory
+from skyquill.limits import VehicleLimits
+from skyquill.trajectory import RetimedPath, SplineTrajectory, Trajectory
+from skyquill.verify import verify
+
+LIMITS = VehicleLimits(2.0, 4.0, 20.0).derivative_limits(3)
+#: Exact formats to float rounding; Skybrush's cubic approximation to 1 mm; sampled formats
+#: to the interpolation between their 100 Hz rows.
+TOLERANCE_M = {"crazyswarm": 1e-6, "skyc": 1.1e-3, "px4": 1e-3, "csv": 1e-3, "json": 1e-3}
+
+
+def _spline() -> SplineTrajectory:
+    ctrl = np.random.default_rng(1).normal(scale=0.3, size=(14, 3))
+    ctrl[:3], ctrl[-3:] = ctrl[0], ctrl[-1]
+    return SplineTrajectory(ctrl, 5, 5.0)
+
+
+def _retimed() -> RetimedPath:
+    u = np.linspace(0.0, 1.0, 12)
+    curve = make_interp_spline(u, np.c_[np.cos(u), np.sin(u), 1.0 + 0 * u], k=5)
+    t = np.linspace(0.0, 3.0, 60)
+    x = t / 3.0
+    law = (10 * x**3 - 15 * x**4 + 6 * x**5, (30 * x**2 - 60 * x**3 + 30 * x**4) / 3.0,
+           (60 * x - 180 * x**2 + 120 * x**3) / 9.0)  # fmt: skip
+    return RetimedPath.from_samples(curve, t, *law)
+
+
+@pytest.mark.parametrize("name", list(EXPORTERS))
+@pytest.mark.parametrize("kind", ["spline", "retimed"])
+def test_every_format_reads_back_within_its_tolerance(tmp_path: Path, name: str, kind: str) -> None:
+    traj: Trajectory = _spline() if kind == "spline" else _retimed()
+    plans = [("drone", PlannedTrajectory(traj, (), LIMITS))]
+    chosen = EXPORTERS[name]
+    report = chosen(plans, tmp_path / f"out{chosen.suffix}", ExportOptions(100.0))
+    assert report.format == name and report.files and all(f.is_file() for f in report.files)
+    refit = report.details.get("refit_max_deviation_m", 0.0)
+    assert report.max_error_m <= TOLERANCE_M[name] + refit
+    assert report.as_dict()["max_error_m"] == report.max_error_m
+    if kind == "spline":
+        assert refit == 0.0
+
+
+def test_two_drones_get_two_files_or_one_show(tmp_path: Path) -> None:
+    plans = [(f"trajectory_{i}", PlannedTrajectory(_spline(), (), LIMITS)) for i in range(2)]
+    csv = EXPORTERS["csv"](plans, tmp_path / "x.csv", ExportOptions())
+    assert [f.name for f in csv.files] == ["x_trajectory_0.csv", "x_trajectory_1.csv"]
+    show = EXPORTERS["skyc"](plans, tmp_path / "show.skyc", ExportOptions())
+    assert [f.name for f in show.files] == ["show.skyc"]
+
+
+def test_refit_keeps_the_limits_and_reports_its_deviation() -> None:
+    traj = _retimed()
+    fitted = as_spline(traj, LIMITS)
+    assert not fitted.exact and 0.0 < fitted.max_deviation_m < 1e-3
+    assert verify(fitted.spline, LIMITS).max_excess <= 1e-9
+    same = as_spline(_spline(), LIMITS)
+    assert same.exact and same.max_deviation_m == 0.0
+
+
+def test_unknown_format_is_named() -> None:
+    with pytest.raises(InputError, match="format: got 'kml', expected one of crazyswarm"):
+        exporter("kml")
+    assert exporter("skyc") is EXPORTERS["skyc"]
