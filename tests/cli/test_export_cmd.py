@@ -11,6 +11,7 @@ import pytest
 from typer.testing import CliRunner
 
 from skyquill.cli.main import app
+from skyquill.export import EXPORTERS
 
 EXAMPLES = Path(__file__).parents[2] / "examples"
 runner = CliRunner()
@@ -28,7 +29,7 @@ def fitted(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 @pytest.mark.parametrize("fmt", ["crazyswarm", "skyc", "px4", "csv", "json"])
 def test_every_format_from_a_fit(fitted: Path, tmp_path: Path, fmt: str) -> None:
-    out = tmp_path / f"show.{'skyc' if fmt == 'skyc' else 'csv'}"
+    out = tmp_path / f"show{EXPORTERS[fmt].suffix}"
     result = runner.invoke(app, ["export", str(fitted), "--format", fmt, "--out", str(out)])
     assert result.exit_code == 0, result.output
     summary = json.loads((tmp_path / "show.summary.json").read_text())
@@ -38,6 +39,22 @@ def test_every_format_from_a_fit(fitted: Path, tmp_path: Path, fmt: str) -> None
     if fmt == "skyc":
         with zipfile.ZipFile(summary["files"][0]) as archive:
             assert "show.json" in archive.namelist()
+
+
+def test_an_out_file_of_another_kind_is_refused_not_renamed(fitted: Path, tmp_path: Path) -> None:
+    out = tmp_path / "results.dat"
+    result = runner.invoke(app, ["export", str(fitted), "--format", "csv", "--out", str(out)])
+    assert result.exit_code == 2
+    assert "expected a file ending in .csv for --format csv" in " ".join(result.output.split())
+    assert not any(tmp_path.iterdir())
+
+
+def test_an_export_never_writes_over_the_plan_it_reads(fitted: Path) -> None:
+    before = (fitted / "trajectory.json").read_bytes()
+    out = fitted / "trajectory.json"
+    result = runner.invoke(app, ["export", str(fitted), "--format", "json", "--out", str(out)])
+    assert result.exit_code == 2 and "one of this command's inputs" in result.output
+    assert (fitted / "trajectory.json").read_bytes() == before
 
 
 def test_crazyswarm_splits_long_trajectories_and_says_so(fitted: Path, tmp_path: Path) -> None:

@@ -7,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from skyquill.cli.main import OutDir, Vmax, app, console, user_errors
+from skyquill.cli.main import Force, OutDir, Vmax, app, console, say_done, user_errors
 from skyquill.errors import InputError
 from skyquill.limits import VehicleLimits
 
@@ -50,6 +50,7 @@ def cover(
     ] = None,
     rate: Annotated[float, typer.Option(help="Setpoint rate, Hz.")] = 50.0,
     altitude: Annotated[float, typer.Option(help="Flight height, m.")] = 2.0,
+    force: Force = False,
 ) -> None:
     """Plan a coverage flight of REGION; write summary.json, trajectory.csv and plot.png."""
     from skyquill.coverage.plan import (
@@ -59,6 +60,7 @@ def cover(
         plan_tuned,
     )
     from skyquill.coverage.regions import load_region
+    from skyquill.io.outputs import staged_output
     from skyquill.io.plan_dir import write_plan
     from skyquill.io.trajectory_json import PlannedTrajectory
     from skyquill.viz.coverage_plot import plot_coverage
@@ -82,24 +84,26 @@ def cover(
                 plan = plan_coverage(shape, options)
             else:
                 plan = plan_tuned(shape, options, min_coverage)
-        with console.status("writing and checking the plan"):
-            # The spray is on along the whole path: every part of it covers.
-            planned = PlannedTrajectory(
-                plan.trajectory, ((0.0, plan.duration),), coverage_limits(plan.options)
-            )
+        # The spray is on along the whole path: every part of it covers.
+        planned = PlannedTrajectory(
+            plan.trajectory, ((0.0, plan.duration),), coverage_limits(plan.options)
+        )
+        with (
+            console.status("writing and checking the plan"),
+            staged_output(out, "cover", force=force, inputs=[region]) as stage,
+        ):
             summary = write_plan(
-                out,
+                stage,
                 [planned],
                 rate=rate,
                 guaranteed=False,
                 summary=plan.summary() | {"region": str(region)},
                 plot=lambda path: plot_coverage(plan, path),
             )
-    console.print(
+    say_done(
         f"{plan.options.pattern}: {plan.duration:.2f} s, {plan.path_length:.1f} m, "
         f"coverage {plan.coverage:.4f}, max excess {summary['plan']['max_excess']:.4f}, "
-        f"planned in {plan.planning_time:.2f} s -> {out}",
-        highlight=False,
+        f"planned in {plan.planning_time:.2f} s -> {out}"
     )
 
 

@@ -7,10 +7,11 @@ from typing import Annotated
 
 import typer
 
-from skyquill.cli.main import app, console, positive_rate, user_errors
+from skyquill.cli.main import Force, app, console, positive_rate, say_done, user_errors
 from skyquill.errors import InputError
 from skyquill.export import EXPORTERS, ExportOptions
 from skyquill.io.atomic import write_json
+from skyquill.io.outputs import staged_output
 from skyquill.io.plan_dir import read_plan
 
 FORMAT_HELP = "; ".join(f"{e.name}: {e.help}" for e in EXPORTERS.values())
@@ -28,20 +29,32 @@ def export(
     out: Annotated[Path, typer.Option("--out", help="File to write (one per drone if several).")],
     format: Annotated[str, typer.Option(help=FORMAT_HELP)] = "csv",
     rate: Annotated[float, typer.Option(help="Sample rate of px4/csv/json, Hz.")] = 100.0,
+    force: Force = False,
 ) -> None:
     """Export the planned trajectories of PLAN; read them back; report to <out>.summary.json."""
     with user_errors():
         if format not in EXPORTERS:
             raise InputError(f"--format: got {format!r}, expected one of {', '.join(EXPORTERS)}")
         chosen = EXPORTERS[format]
+        if out.suffix.lower() != chosen.suffix:
+            raise InputError(
+                f"--out: got {str(out)!r}, expected a file ending in {chosen.suffix} for "
+                f"--format {format}"
+            )
         options = ExportOptions(rate_hz=positive_rate(rate))
         plans = read_plan(plan)
-        out.parent.mkdir(parents=True, exist_ok=True)
-        with console.status(f"exporting {len(plans)} trajectory(ies) to {format}"):
-            report = chosen(plans, out, options)
-        summary = report.as_dict() | {"plan": str(plan), "drones": [name for name, _ in plans]}
-        write_json(out.with_name(f"{out.stem}.summary.json"), summary)
-    console.print(
-        f"[green]done[/] {report.message} (read back: within {1e3 * report.max_error_m:.3g} mm)",
-        highlight=False,
-    )
+        folder = out.parent
+        inputs = [plan] if plan.is_file() else list(plan.glob("*"))
+        with (
+            console.status(f"exporting {len(plans)} trajectory(ies) to {format}"),
+            staged_output(folder, f"export {out.name}", force=force, inputs=inputs) as stage,
+        ):
+            report = chosen(plans, stage / out.name, options)
+            summary = report.as_dict() | {
+                "files": [str(folder / f.name) for f in report.files],
+                "message": report.message.replace(str(stage), str(folder)),
+                "plan": str(plan),
+                "drones": [name for name, _ in plans],
+            }
+            write_json(stage / f"{out.stem}.summary.json", summary)
+    say_done(f"{summary['message']} (read back: within {1e3 * report.max_error_m:.3g} mm)")

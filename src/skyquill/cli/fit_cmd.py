@@ -6,10 +6,12 @@ from pathlib import Path
 from typing import Annotated, Any
 
 import typer
+from rich.markup import escape
 
 from skyquill.cli.main import (
     Amax,
     AmaxAxis,
+    Force,
     Jmax,
     JmaxAxis,
     NormSides,
@@ -20,9 +22,11 @@ from skyquill.cli.main import (
     console,
     limits_from_flags,
     positive_rate,
+    say_done,
     user_errors,
 )
 from skyquill.errors import InputError
+from skyquill.io.outputs import staged_output
 from skyquill.io.plan_dir import write_plan
 from skyquill.io.points import read_points_csv
 from skyquill.io.trajectory_json import PlannedTrajectory
@@ -67,27 +71,31 @@ def run_fit(
     options: FitOptions,
     out: Path,
     rate: float,
-    title: str,
+    source: Path,
+    force: bool = False,
 ) -> dict[str, Any]:
-    """Fit, then write the plan directory ``out`` (trajectory, plot, summary)."""
+    """Fit the points of ``source``, then write the plan directory ``out``."""
     from skyquill.viz.fit_plot import plot_fit
 
-    with console.status(f"fitting {points.shape[0]} points ({title})"):
+    title = source.stem
+    with console.status(f"fitting {points.shape[0]} points ({escape(title)})"):
         fit = fit_points(points, times, options)
-    with console.status("writing and checking the plan"):
+    with (
+        console.status("writing and checking the plan"),
+        staged_output(out, "fit", force=force, inputs=[source]) as stage,
+    ):
         summary = write_plan(
-            out,
+            stage,
             [PlannedTrajectory(fit.result.trajectory.in_3d(), limits=fit.limits)],
             rate=rate,
             guaranteed=True,
             summary=fit_summary(fit, options, rate),
             plot=lambda path: plot_fit(fit, path, title),
         )
-    console.print(
-        f"[green]done[/] {out}: duration {summary['duration_s']:.2f} s, solve "
+    say_done(
+        f"{out}: duration {summary['duration_s']:.2f} s, solve "
         f"{1e3 * summary['solve_time_s']:.1f} ms, max excess {summary['max_excess']:.1e}, "
-        f"rms deviation {1e3 * summary['rms_deviation_m']:.2f} mm",
-        highlight=False,
+        f"rms deviation {1e3 * summary['rms_deviation_m']:.2f} mm"
     )
     return summary
 
@@ -117,6 +125,7 @@ def fit(
             "else path."
         ),
     ] = None,
+    force: Force = False,
 ) -> None:
     """Fit a smooth trajectory to POINTS_CSV that starts and ends at rest."""
     with user_errors():
@@ -137,7 +146,7 @@ def fit(
             raise InputError(f"--timing: got 'given', but {points_csv.name} has no t column")
         if timing in ("path", "segments"):
             times = None
-        run_fit(points, times, options, out, positive_rate(rate), points_csv.stem)
+        run_fit(points, times, options, out, positive_rate(rate), points_csv, force)
 
 
 def _hull(name: str) -> Any:

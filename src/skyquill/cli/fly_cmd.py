@@ -7,10 +7,21 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any, Literal
 
 import typer
+from rich.markup import escape
 
-from skyquill.cli.main import OutDir, app, console, parse_vector3, positive_rate, user_errors
+from skyquill.cli.main import (
+    Force,
+    OutDir,
+    app,
+    console,
+    parse_vector3,
+    positive_rate,
+    say_done,
+    user_errors,
+)
 from skyquill.errors import InputError
-from skyquill.io.atomic import atomic_path, write_json
+from skyquill.io.atomic import write_json
+from skyquill.io.outputs import staged_output
 
 if TYPE_CHECKING:  # the fly command imports the simulator lazily
     from skyquill.sim import Disturbances, Flight, OuterLoop
@@ -44,6 +55,7 @@ def fly(
     ] = 0.0,
     seed: Annotated[int, typer.Option(help="Seed of the random generator (gusts, noise).")] = 0,
     rate: Annotated[float, typer.Option(help="Control and integration rate, Hz.")] = 500.0,
+    force: Force = False,
 ) -> None:
     """Fly every trajectory of PLAN in closed loop; write summary.json, flight.csv, plot.png."""
     import numpy as np
@@ -67,21 +79,23 @@ def fly(
         plans = read_plan(plan)
         disturbances = Disturbances(wind_mps=wind_mps, gust_std_mps=gust, position_noise_m=noise)
         setup = _Setup(loop, sim, disturbances, seed, rate)
-        flights = [_fly_drone(name, p.trajectory, setup, out, len(plans) > 1) for name, p in plans]
-        summary = _worst(flights) | {
-            "plan": str(plan),
-            "rate_hz": rate,
-            "wind_mps": [float(w) for w in wind_mps],
-            "gust_std_mps": gust,
-            "position_noise_m": noise,
-            "seed": seed,
-            "drones": flights,
-        }
-        write_json(out / "summary.json", summary)
-    console.print(
-        f"[green]done[/] {out}: RMSE {1e3 * summary['rmse_m']:.2f} mm, max "
-        f"{1e3 * summary['max_error_m']:.2f} mm, {summary['realtime_factor']:.0f}x real time",
-        highlight=False,
+        with staged_output(out, "fly", force=force, inputs=_plan_files(plan)) as stage:
+            flights = [
+                _fly_drone(name, p.trajectory, setup, stage, len(plans) > 1) for name, p in plans
+            ]
+            summary = _worst(flights) | {
+                "plan": str(plan),
+                "rate_hz": rate,
+                "wind_mps": [float(w) for w in wind_mps],
+                "gust_std_mps": gust,
+                "position_noise_m": noise,
+                "seed": seed,
+                "drones": flights,
+            }
+            write_json(stage / "summary.json", summary)
+    say_done(
+        f"{out}: RMSE {1e3 * summary['rmse_m']:.2f} mm, max "
+        f"{1e3 * summary['max_error_m']:.2f} mm, {summary['realtime_factor']:.0f}x real time"
     )
 
 
@@ -105,7 +119,7 @@ def _fly_drone(
     from skyquill.viz.flight_plot import plot_flight
 
     with console.status(
-        f"flying {trajectory.duration:.1f} s of {name} on {setup.sim} at {setup.rate:g} Hz"
+        f"flying {trajectory.duration:.1f} s of {escape(name)} on {setup.sim} at {setup.rate:g} Hz"
     ):
         flight = _fly_once(trajectory, setup)
     if not (np.all(np.isfinite(flight.p)) and np.all(np.isfinite(flight.v))):
@@ -113,12 +127,10 @@ def _fly_drone(
             f"{setup.sim}: the flight of {name} diverged (non-finite state), nothing written; "
             "lower the disturbances"
         )
-    out.mkdir(parents=True, exist_ok=True)
     suffix = f"_{name}" if several else ""
-    with atomic_path(out / f"flight{suffix}.csv") as tmp:
-        rows = write_flight_csv(tmp, flight)
-    with console.status("plotting"), atomic_path(out / f"plot{suffix}.png") as tmp:
-        plot_flight(flight, tmp, name)
+    rows = write_flight_csv(out / f"flight{suffix}.csv", flight)
+    with console.status("plotting"):
+        plot_flight(flight, out / f"plot{suffix}.png", name)
     summary = flight.summary()
     return summary | {
         "name": name,
@@ -126,6 +138,11 @@ def _fly_drone(
         "duration_s": trajectory.duration,
         "flight_rows": rows,
     }
+
+
+def _plan_files(plan: Path) -> list[Path]:
+    """The files ``fly`` reads (never written over): the plan file, or the folder's own."""
+    return [plan] if plan.is_file() else [p for p in plan.glob("trajectory*") if p.is_file()]
 
 
 def _worst(flights: list[dict[str, Any]]) -> dict[str, Any]:

@@ -14,11 +14,12 @@ import math
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, NoReturn
 
 import numpy as np
 import typer
 from rich.console import Console
+from rich.text import Text
 
 from skyquill.errors import InputError, SkyquillError
 from skyquill.limits import VehicleLimits
@@ -50,6 +51,10 @@ AmaxAxis = Annotated[
 JmaxAxis = Annotated[
     float | None, typer.Option(help="Optional per-axis bound on |jx|, |jy|, |jz|, m/s^3.")
 ]
+Force = Annotated[
+    bool,
+    typer.Option(help="Replace files in --out that skyquill did not write there itself."),
+]
 NormSides = Annotated[
     int | None,
     typer.Option(
@@ -67,12 +72,46 @@ def main(verbose: Annotated[bool, typer.Option("--verbose", "-v")] = False) -> N
 
 @contextmanager
 def user_errors() -> Iterator[None]:
-    """Turn skyquill's own errors into one clear line and exit status 2."""
+    """The one error boundary of a command: expected failures are one plain line, exit 2.
+
+    skyquill's own errors (bad input, infeasible, solver), the operating
+    system's (a folder that cannot be written, a missing file), undecodable
+    text, memory and nesting limits are the user's to fix: one line, printed
+    literally (never as rich markup: paths and messages may hold ``[...]``),
+    exit status 2. Anything else is a bug: one line saying so, exit status 1.
+    """
     try:
         yield
+    except typer.Exit:
+        raise
     except SkyquillError as exc:
-        console.print(f"[bold red]error:[/] {exc}", highlight=False)
-        raise typer.Exit(2) from None
+        fail(str(exc))
+    except OSError as exc:
+        where = f" {str(exc.filename)!r}" if exc.filename else ""
+        fail(f"cannot use{where}: {exc.strerror or exc}")
+    except UnicodeError as exc:
+        fail(f"got text that is not UTF-8 ({exc}), expected UTF-8 text")
+    except MemoryError:
+        fail("ran out of memory; expected a smaller job (a lower --rate, a smaller input)")
+    except RecursionError:
+        fail("got input nested too deeply to read, expected a flatter file")
+    except Exception as exc:
+        fail(
+            f"internal error ({type(exc).__name__}: {exc}); this is a bug in skyquill, please "
+            "report it with the command line that caused it",
+            status=1,
+        )
+
+
+def fail(message: str, status: int = 2) -> NoReturn:
+    """Print ``error: message`` as one literal line on stderr and exit with ``status``."""
+    console.print(Text("error: ", style="bold red") + Text(message), soft_wrap=True)
+    raise typer.Exit(status)
+
+
+def say_done(message: str) -> None:
+    """``done message`` on stderr, the message printed literally (it holds user paths)."""
+    console.print(Text("done ", style="green") + Text(message), soft_wrap=True)
 
 
 def positive_rate(rate: float) -> float:

@@ -14,7 +14,15 @@ from typing import TYPE_CHECKING, Annotated
 
 import typer
 
-from skyquill.cli.main import OutDir, app, console, parse_vector3, user_errors
+from skyquill.cli.main import (
+    Force,
+    OutDir,
+    app,
+    console,
+    parse_vector3,
+    say_done,
+    user_errors,
+)
 from skyquill.errors import InputError
 
 if TYPE_CHECKING:  # the painting package is imported lazily
@@ -62,11 +70,12 @@ def paint(
         float, typer.Option(help="Probability of a missed contact per approach.")
     ] = 0.0,
     seed: Annotated[int, typer.Option(help="Seed of the random generator.")] = 0,
+    force: Force = False,
 ) -> None:
     """Paint DOTS.csv (or a stippled --image) on a wall; write summary.json, painted.csv, plot."""
     import numpy as np
 
-    from skyquill.io.atomic import atomic_path
+    from skyquill.io.outputs import staged_output
     from skyquill.io.plan_dir import write_plan
     from skyquill.io.trajectory_json import PlannedTrajectory
     from skyquill.painting.dots import drawing_span
@@ -115,13 +124,15 @@ def paint(
                 rng=np.random.default_rng(seed),
                 progress=lambda done, total: bar.update(task, completed=done, total=total),
             )
-        out.mkdir(parents=True, exist_ok=True)
-        with atomic_path(out / "painted.csv") as tmp:
-            _write_painted(tmp, result)
-        with console.status("timing the flight's legs, writing and checking the plan"):
+        inputs = [p for p in (dots_csv, image) if p is not None]
+        with (
+            console.status("timing the flight's legs, writing and checking the plan"),
+            staged_output(out, "paint", force=force, inputs=inputs) as stage,
+        ):
+            _write_painted(stage / "painted.csv", result)
             flown = painting_flight(result)
             write_plan(
-                out,
+                stage,
                 [PlannedTrajectory(flown.trajectory, flown.pen_windows_s, flown.limits)],
                 rate=100.0,
                 guaranteed=True,
@@ -136,11 +147,10 @@ def paint(
                 },
                 plot=lambda path: plot_mission(result, path, (dots_csv or image or Path("")).name),
             )
-    console.print(
-        f"[green]done[/] {out}: {result.painted.sum()} of {len(result.reference)} dots, RMSE "
+    say_done(
+        f"{out}: {result.painted.sum()} of {len(result.reference)} dots, RMSE "
         f"{100 * result.rmse_m:.2f} cm, max {100 * result.max_error_m:.2f} cm, "
-        f"{result.flight_time_s / 60:.1f} min, {result.landings} landing(s)",
-        highlight=False,
+        f"{result.flight_time_s / 60:.1f} min, {result.landings} landing(s)"
     )
 
 

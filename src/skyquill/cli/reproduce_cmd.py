@@ -7,7 +7,8 @@ from typing import Annotated, Any
 
 import typer
 
-from skyquill.cli.main import EXAMPLES, OutDir, app, console, user_errors
+from skyquill.cli.main import EXAMPLES, Force, OutDir, app, console, say_done, user_errors
+from skyquill.io.outputs import staged_output
 
 reproduce_app = typer.Typer(no_args_is_help=True, help="Reproduce the papers' experiments.")
 app.add_typer(reproduce_app, name="reproduce")
@@ -18,20 +19,25 @@ def reproduce_corridor(
     out: OutDir = Path("out/corridor"),
     corridor: Annotated[Path, typer.Option(help="Box corridor JSON.")] = EXAMPLES
     / "s_corridor.json",
+    force: Force = False,
 ) -> None:
     """Paper 003 §5.4 (Fig. 10): coupled vs decoupled limits in a 7-box S corridor."""
     from rich.progress import Progress
 
     from skyquill.reproduce.corridor import run_corridor_study
 
-    with user_errors(), Progress(console=console, transient=True) as progress:
+    with (
+        user_errors(),
+        Progress(console=console, transient=True) as progress,
+        staged_output(out, "reproduce corridor", force=force, inputs=[corridor]) as stage,
+    ):
         task = progress.add_task("control-point counts", total=None)
         summary = run_corridor_study(
             corridor,
-            out,
+            stage,
             on_step=lambda done, total: progress.update(task, completed=done, total=total),
         )
-    console.print(f"[green]done[/] {out}: " + _claims(summary), highlight=False)
+    say_done(f"{out}: " + _claims(summary))
 
 
 @reproduce_app.command("segments")
@@ -39,13 +45,18 @@ def reproduce_segments(
     out: OutDir = Path("out/segments"),
     segments: Annotated[Path, typer.Option(help="Waypoint CSV (x,y,z).")] = EXAMPLES
     / "segments.csv",
+    force: Force = False,
 ) -> None:
     """Paper 003 §5.2 (Fig. 7): line-segment plan, min-snap peer vs our segment fit."""
     from skyquill.reproduce.segments import run_segment_study
 
-    with user_errors(), console.status("flying the line-segment plan three ways"):
-        run_segment_study(segments, out)
-    console.print(f"[green]done[/] {out}/summary.json", highlight=False)
+    with (
+        user_errors(),
+        console.status("flying the line-segment plan three ways"),
+        staged_output(out, "reproduce segments", force=force, inputs=[segments]) as stage,
+    ):
+        run_segment_study(segments, stage)
+    say_done(f"{out}/summary.json")
 
 
 def _claims(summary: dict[str, Any]) -> str:

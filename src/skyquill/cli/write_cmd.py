@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Annotated, Any
 
@@ -11,6 +12,7 @@ import typer
 from skyquill.cli.main import (
     Amax,
     AmaxAxis,
+    Force,
     Jmax,
     JmaxAxis,
     NormSides,
@@ -21,10 +23,12 @@ from skyquill.cli.main import (
     console,
     limits_from_flags,
     positive_rate,
+    say_done,
     user_errors,
 )
 from skyquill.errors import InputError
 from skyquill.io.atomic import write_json
+from skyquill.io.outputs import staged_output
 from skyquill.io.plan_dir import trajectory_names, write_plan
 from skyquill.io.trajectory_json import PlannedTrajectory
 
@@ -87,6 +91,7 @@ def write(
         str | None,
         typer.Option(help="dask.distributed scheduler address (or 'local') for large shows."),
     ] = None,
+    force: Force = False,
 ) -> None:
     """Plan pen-up / pen-down writing flights; write CSVs, input_strokes.json, plot, summary."""
     from skyquill.calligraphy.mission import WritingOptions
@@ -117,12 +122,12 @@ def write(
                 lift_m=lift,
                 fly=fly,
             )
-        summary = write_outputs(show, out, rate)
-    console.print(
-        f"[green]done[/] {out}: {summary['duration_s']:.1f} s of flight, planned in "
+        inputs = [p for p in (strokes, svg, hanzi) if p is not None]
+        summary = write_outputs(show, out, rate, force=force, inputs=inputs)
+    say_done(
+        f"{out}: {summary['duration_s']:.1f} s of flight, planned in "
         f"{summary['planning_time_s']:.2f} s, deviation {1e3 * summary['deviation']['max_m']:.2f}"
-        f" mm, max excess {summary['max_excess']:.1e}",
-        highlight=False,
+        f" mm, max excess {summary['max_excess']:.1e}"
     )
 
 
@@ -134,7 +139,9 @@ def _board_kind(name: str, fly: bool) -> Any:
     return name
 
 
-def write_outputs(show: Any, out: Path, rate: float) -> dict[str, Any]:
+def write_outputs(
+    show: Any, out: Path, rate: float, *, force: bool = False, inputs: Sequence[Path] = ()
+) -> dict[str, Any]:
     """The plan directory: trajectories, ``input_strokes.json``, ``plot.png``, ``summary.json``."""
     from skyquill.viz.writing_plot import plot_missions
 
@@ -157,17 +164,17 @@ def write_outputs(show: Any, out: Path, rate: float) -> dict[str, Any]:
         # Drone i wrote strokes[first[i]:first[i + 1]] (its trajectory_<i>.csv).
         "first_stroke_of_drone": firsts,
     }
-    out.mkdir(parents=True, exist_ok=True)
-    write_json(out / "input_strokes.json", payload, indent=None)
     closest = show.min_separation_m if len(missions) > 1 else None
-    return write_plan(
-        out,
-        planned,
-        rate=rate,
-        guaranteed=True,
-        summary=_merge(per_drone) | {"min_separation_m": closest, "drones": per_drone},
-        plot=lambda path: plot_missions(missions, path, "skyquill write"),
-    )
+    with staged_output(out, "write", force=force, inputs=inputs) as stage:
+        write_json(stage / "input_strokes.json", payload, indent=None)
+        return write_plan(
+            stage,
+            planned,
+            rate=rate,
+            guaranteed=True,
+            summary=_merge(per_drone) | {"min_separation_m": closest, "drones": per_drone},
+            plot=lambda path: plot_missions(missions, path, "skyquill write"),
+        )
 
 
 def _drone_summary(mission: Any, name: str, flight: Any) -> dict[str, Any]:
@@ -211,7 +218,7 @@ def _merge(drones: list[dict[str, Any]]) -> dict[str, Any]:
 
 
 @app.command()
-def demo(out: OutDir = Path("out/demo")) -> None:
+def demo(out: OutDir = Path("out/demo"), force: Force = False) -> None:
     """Write 永 on a horizontal board, fly it with the RPT controller, plot and summarise."""
     from skyquill.calligraphy.mission import WritingOptions
     from skyquill.calligraphy.show import plan_show
@@ -220,13 +227,12 @@ def demo(out: OutDir = Path("out/demo")) -> None:
     with user_errors():
         with console.status("planning 永 (the eight strokes of calligraphy), flying it"):
             show = plan_show([hanzi_strokes("永")], WritingOptions(), fly=True)
-        summary = write_outputs(show, out, 100.0)
+        summary = write_outputs(show, out, 100.0, force=force)
     flight = summary["drones"][0]["flight"]
-    console.print(
-        f"[green]done[/] wrote 永 in {summary['duration_s']:.1f} s of flight "
+    say_done(
+        f"wrote 永 in {summary['duration_s']:.1f} s of flight "
         f"(planned in {summary['planning_time_s']:.2f} s, pen-down deviation "
         f"{1e3 * summary['deviation']['max_m']:.2f} mm, max excess {summary['max_excess']:.1e}); "
         f"flown with RPT: RMSE {1e3 * flight['rmse_m']:.2f} mm.\n"
-        f"  {out / 'plot.png'}\n  {out / 'summary.json'}\n  {out / 'trajectory.csv'}",
-        highlight=False,
+        f"  {out / 'plot.png'}\n  {out / 'summary.json'}\n  {out / 'trajectory.csv'}"
     )
