@@ -7,7 +7,16 @@ from typing import Annotated
 
 import typer
 
-from skyquill.cli.main import Force, OutDir, Vmax, app, console, say_done, user_errors
+from skyquill.cli.main import (
+    Force,
+    OutDir,
+    Vmax,
+    app,
+    check_out,
+    console,
+    say_done,
+    user_errors,
+)
 from skyquill.errors import InputError
 from skyquill.limits import VehicleLimits
 
@@ -66,6 +75,7 @@ def cover(
     from skyquill.viz.coverage_plot import plot_coverage
 
     with user_errors():
+        check_out(out)
         shape = load_region(region)
         options = CoverageOptions(
             width=width,

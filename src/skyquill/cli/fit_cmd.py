@@ -19,6 +19,7 @@ from skyquill.cli.main import (
     Vmax,
     VmaxAxis,
     app,
+    check_out,
     console,
     limits_from_flags,
     positive_rate,
@@ -129,6 +130,7 @@ def fit(
 ) -> None:
     """Fit a smooth trajectory to POINTS_CSV that starts and ends at rest."""
     with user_errors():
+        check_out(out)
         options = FitOptions(
             limits=limits_from_flags(vmax, amax, jmax, vmax_axis, amax_axis, jmax_axis),
             norm_sides=norm_sides,

@@ -13,6 +13,7 @@ from skyquill.cli.main import (
     Force,
     OutDir,
     app,
+    check_out,
     console,
     parse_vector3,
     positive_rate,
@@ -64,6 +65,7 @@ def fly(
     from skyquill.sim import Disturbances
 
     with user_errors():
+        check_out(out)
         if sim not in FLY_SIMS:
             raise InputError(f"--sim: got {sim!r}, expected 'skyquill' or 'rotorpy'")
         loop = _fly_controller(controller, sim)

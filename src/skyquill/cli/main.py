@@ -114,6 +114,20 @@ def say_done(message: str) -> None:
     console.print(Text("done ", style="green") + Text(message), soft_wrap=True)
 
 
+def check_out(out: Path) -> None:
+    """Refuse an ``--out`` that cannot be a folder before any work starts (it is made later)."""
+    if out.exists() and not out.is_dir():
+        raise InputError(f"--out: got {str(out)!r}, an existing file; expected a folder")
+    for parent in out.parents:
+        if parent.exists():
+            if not parent.is_dir():
+                raise InputError(
+                    f"--out: got {str(out)!r}, inside {str(parent)!r} which is a file; "
+                    "expected a folder"
+                )
+            break
+
+
 def positive_rate(rate: float) -> float:
     """``--rate`` (Hz), checked to be a positive number."""
     if not rate > 0:

@@ -18,6 +18,7 @@ from skyquill.cli.main import (
     Force,
     OutDir,
     app,
+    check_out,
     console,
     parse_vector3,
     say_done,
@@ -80,13 +81,20 @@ def paint(
     from skyquill.io.trajectory_json import PlannedTrajectory
     from skyquill.painting.dots import drawing_span
     from skyquill.painting.flight import painting_flight
-    from skyquill.painting.mission import MissionConfig, run_mission
+    from skyquill.painting.mission import ESTIMATORS, MissionConfig, run_mission
+    from skyquill.painting.order import ORDERS
     from skyquill.painting.wall import Placement, Wall, parse_angles
     from skyquill.viz.painting_plot import plot_mission
 
     with user_errors():
-        if out.exists() and not out.is_dir():
-            raise InputError(f"--out: got {str(out)!r}, an existing file; expected a directory")
+        check_out(out)
+        if estimator not in ESTIMATORS:
+            raise InputError(
+                f"--estimator: got {estimator!r}, expected one of {', '.join(ESTIMATORS)}"
+            )
+        if order not in ORDERS:
+            raise InputError(f"--order: got {order!r}, expected one of {', '.join(ORDERS)}")
+        update_mode = _update(update)
         if not -MAX_GAMMA_DEG <= gamma <= MAX_GAMMA_DEG:
             raise InputError(
                 f"--gamma: got {gamma:g}, expected an angle from -{MAX_GAMMA_DEG:g} to "
@@ -117,7 +125,7 @@ def paint(
                 estimator=estimator,
                 localization=localization,
                 order=order,
-                update=_update(update),
+                update=update_mode,
                 config=MissionConfig(
                     false_contact_rate=false_contacts, missed_contact_rate=missed_contacts
                 ),

@@ -7,7 +7,16 @@ from typing import Annotated, Any
 
 import typer
 
-from skyquill.cli.main import EXAMPLES, Force, OutDir, app, console, say_done, user_errors
+from skyquill.cli.main import (
+    EXAMPLES,
+    Force,
+    OutDir,
+    app,
+    check_out,
+    console,
+    say_done,
+    user_errors,
+)
 from skyquill.io.outputs import staged_output
 
 reproduce_app = typer.Typer(no_args_is_help=True, help="Reproduce the papers' experiments.")
@@ -26,6 +35,8 @@ def reproduce_corridor(
 
     from skyquill.reproduce.corridor import run_corridor_study
 
+    with user_errors():
+        check_out(out)
     with (
         user_errors(),
         Progress(console=console, transient=True) as progress,
@@ -50,6 +61,8 @@ def reproduce_segments(
     """Paper 003 §5.2 (Fig. 7): line-segment plan, min-snap peer vs our segment fit."""
     from skyquill.reproduce.segments import run_segment_study
 
+    with user_errors():
+        check_out(out)
     with (
         user_errors(),
         console.status("flying the line-segment plan three ways"),

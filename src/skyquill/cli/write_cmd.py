@@ -20,6 +20,7 @@ from skyquill.cli.main import (
     Vmax,
     VmaxAxis,
     app,
+    check_out,
     console,
     limits_from_flags,
     positive_rate,
@@ -99,6 +100,7 @@ def write(
     from skyquill.strokes import split_text, typed_strokes
 
     with user_errors():
+        check_out(out)
         rate = positive_rate(rate)
         options = WritingOptions(
             size_m=size,
@@ -107,6 +109,8 @@ def write(
             best_effort=best_effort,
             tilt_compensation=tilt_compensation,
         )
+        if drones < 1:
+            raise InputError(f"--drones: got {drones}, expected at least 1")
         if drones != 1:
             if text is None or strokes is not None or svg is not None:
                 raise InputError("--drones: several drones need TEXT to share out, got a file")
@@ -225,6 +229,7 @@ def demo(out: OutDir = Path("out/demo"), force: Force = False) -> None:
     from skyquill.strokes import hanzi_strokes
 
     with user_errors():
+        check_out(out)
         with console.status("planning 永 (the eight strokes of calligraphy), flying it"):
             show = plan_show([hanzi_strokes("永")], WritingOptions(), fly=True)
         summary = write_outputs(show, out, 100.0, force=force)

@@ -1,0 +1,283 @@
+"""Every command under hostile but fair input: one plain line and exit 2, files left alone.
+
+Each case runs a command with broken, huge, tiny, non-UTF-8 or adversarial
+input and asserts what the README promises: exit status 2 (or 0 where the
+input is one the ecosystem really produces, such as a UTF-8 BOM), one line that
+names the problem, no traceback, within the per-test time limit, and a file the
+user already had in ``--out`` left untouched.
+"""
+
+from __future__ import annotations
+
+import json
+import struct
+import zlib
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from skyquill.cli.main import app
+
+runner = CliRunner()
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
+SPIRAL = str(EXAMPLES / "spiral.csv")
+SQUARE = str(EXAMPLES / "coverage" / "square_10m.geojson")
+DOTS = str(EXAMPLES / "painting" / "paper_140.csv")
+#: A file the user had in the output folder: no command may change it.
+SENTINEL = "notes.txt"
+
+
+@dataclass(frozen=True)
+class Case:
+    """A command line (``{tmp}`` and ``{out}`` filled in), and what must come of it."""
+
+    name: str
+    args: list[str]
+    message: str  # a piece of the one line of output
+    status: int = 2
+    setup: Callable[[Path], None] | None = None
+
+
+def _write(path: str, data: bytes | str) -> Callable[[Path], None]:
+    def make(tmp: Path) -> None:
+        target = tmp / path
+        target.parent.mkdir(parents=True, exist_ok=True)
+        if isinstance(data, bytes):
+            target.write_bytes(data)
+        else:
+            target.write_text(data, encoding="utf-8")
+
+    return make
+
+
+def _both(
+    first: Callable[[Path], None] | None, second: Callable[[Path], None]
+) -> Callable[[Path], None]:
+    def make(tmp: Path) -> None:
+        if first is not None:
+            first(tmp)
+        second(tmp)
+
+    return make
+
+
+def _png(width: int, height: int) -> bytes:
+    """A PNG whose header claims ``width x height`` (one tiny, bogus data chunk)."""
+
+    def chunk(kind: bytes, body: bytes) -> bytes:
+        return (
+            struct.pack(">I", len(body)) + kind + body + struct.pack(">I", zlib.crc32(kind + body))
+        )
+
+    header = struct.pack(">IIBBBBB", width, height, 8, 0, 0, 0, 0)
+    return (
+        b"\x89PNG\r\n\x1a\n"
+        + chunk(b"IHDR", header)
+        + chunk(b"IDAT", zlib.compress(b"\0"))
+        + chunk(b"IEND", b"")
+    )
+
+
+def _fit(*extra: str) -> list[str]:
+    return ["fit", SPIRAL, "--out", "{out}", *extra]
+
+
+def _write_cmd(*extra: str) -> list[str]:
+    return ["write", "Hi", "--out", "{out}", *extra]
+
+
+def _cover(*extra: str) -> list[str]:
+    return ["cover", SQUARE, "--out", "{out}", *extra]
+
+
+def _paint(*extra: str) -> list[str]:
+    return ["paint", DOTS, "--out", "{out}", *extra]
+
+
+def _fly(*extra: str) -> list[str]:
+    return ["fly", "{tmp}/traj.csv", "--out", "{out}", *extra]
+
+
+def _export(*extra: str) -> list[str]:
+    return ["export", "{tmp}/traj.csv", "--out", "{out}/x.csv", *extra]
+
+
+TRAJ = (
+    "t,x,y,z,vx,vy,vz,ax,ay,az\n0,0,0,1,0,0,0,0,0,0\n1,0.5,0,1,0,0,0,0,0,0\n2,1,0,1,0,0,0,0,0,0\n"
+)
+WITH_TRAJ = _write("traj.csv", TRAJ)
+
+BAD_NUMBERS = [("-1", "got -1"), ("0", "got 0"), ("nan", "nan"), ("inf", "inf")]
+
+CASES: list[Case] = []
+
+# -- Numbers that cannot be limits, in every command that takes them -------------------------
+for cmd, make in (("fit", _fit), ("write", _write_cmd), ("cover", _cover)):
+    for flag in ("--vmax", "--amax", "--jmax"):
+        for value, message in BAD_NUMBERS:
+            CASES.append(Case(f"{cmd} {flag} {value}", make(flag, value), message))
+    for value, message in (("0", "rate"), ("-5", "rate"), ("nan", "rate"), ("1e9", "rate")):
+        CASES.append(Case(f"{cmd} --rate {value}", make("--rate", value), message))
+for flag in ("--vmax-axis", "--amax-axis", "--jmax-axis"):
+    for value, message in BAD_NUMBERS[:2]:
+        CASES.append(Case(f"fit {flag} {value}", _fit(flag, value), message))
+
+# -- Output folders that cannot be used, in every command --------------------------------------
+OUT_COMMANDS: dict[str, list[str]] = {
+    "fit": _fit(),
+    "write": _write_cmd(),
+    "cover": _cover(),
+    "paint": _paint(),
+    "fly": _fly(),
+    "reproduce segments": ["reproduce", "segments", "--out", "{out}"],
+    "demo": ["demo", "--out", "{out}"],
+}
+
+# -- Input files a user might hand over --------------------------------------------------------
+CSV_CASES = [
+    ("utf-16", "\ufeffx,y\n0,0\n1,1\n".encode("utf-16"), "UTF-16"),
+    ("binary", bytes(range(256)) * 4, "expected"),
+    ("latin-1", "x,y\n0,0\n1,é\n".encode("latin-1"), "UTF-8"),
+    ("empty", b"", "empty"),
+    ("header only", b"x,y\n", "row"),
+    ("one row", b"x,y\n0,0\n", "row"),
+    ("two x columns", b"x,x,y\n0,1,0\n1,2,1\n", "more than once"),
+    ("strings", b"x,y\n0,0\n1,one\n", "one"),
+    ("nan", b"x,y\n0,0\nnan,1\n", "nan"),
+    ("ragged", b"x,y\n0,0\n1,1,1\n", "columns"),
+    ("no y", b"x,z\n0,0\n1,1\n", "missing y"),
+    ("huge coordinate", b"x,y\n0,0\n1e300,1\n", "magnitude"),
+    ("repeated times", b"x,y,t\n0,0,0\n1,1,0\n", "increasing"),
+]
+for label, data, message in CSV_CASES:
+    args = ["fit", "{tmp}/p.csv", "--out", "{out}"]
+    CASES.append(Case(f"fit csv {label}", args, message, setup=_write("p.csv", data)))
+BOM_CSV = "\ufeffx,y\n" + "".join(f"{i / 10},{(i % 3) / 10}\n" for i in range(12))
+CASES.append(
+    Case(
+        "fit csv with a UTF-8 BOM is accepted",
+        ["fit", "{tmp}/p.csv", "--out", "{out}"],
+        "done",
+        status=0,
+        setup=_write("p.csv", BOM_CSV),
+    )
+)
+for label, data, message in [
+    ("missing columns", "t,x,y,z\n0,0,0,0\n1,1,1,1\n", "expected columns"),
+    ("one row", TRAJ.splitlines()[0] + "\n" + TRAJ.splitlines()[1] + "\n", "row"),
+    ("backwards time", TRAJ.replace("\n2,", "\n0.5,"), "increasing"),
+    ("utf-16", TRAJ.encode("utf-16"), "UTF-16"),
+]:
+    CASES.append(Case(f"fly trajectory {label}", _fly(), message, setup=_write("traj.csv", data)))
+    CASES.append(
+        Case(f"export trajectory {label}", _export(), message, setup=_write("traj.csv", data))
+    )
+SPLINE_JSON = (
+    '{{"format": "skyquill-bspline", "degree": 5, "duration_s": 1, "control_points": {points}}}'
+)
+for label, text, message in [
+    ("not json", "{", "invalid JSON"),
+    ("deep json", "[" * 100_000 + "]" * 100_000, "nested"),
+    ("other format", '{"format": "x"}', "format"),
+    ("ragged spline", SPLINE_JSON.format(points="[[0,0],[1]]"), "ragged"),
+    ("nan spline", SPLINE_JSON.format(points=json.dumps([[0, 0, "NaN"]] + [[0, 0, 0]] * 5)), "NaN"),
+]:
+    export_args = ["export", "{tmp}/t.json", "--out", "{out}/x.csv"]
+    fly_args = ["fly", "{tmp}/t.json", "--out", "{out}"]
+    CASES.append(Case(f"export json {label}", export_args, message, setup=_write("t.json", text)))
+    CASES.append(Case(f"fly json {label}", fly_args, message, setup=_write("t.json", text)))
+
+# -- Options out of range -----------------------------------------------------------------------
+OPTION_CASES = [
+    ("fit --degree 9", _fit("--degree", "9"), "degree"),
+    ("fit --timing sideways", _fit("--timing", "sideways"), "--timing"),
+    ("fit --hull round", _fit("--hull", "round"), "--hull"),
+    ("fit --solver cplex", _fit("--solver", "cplex"), "solver"),
+    ("fit --knot-interval 0", _fit("--knot-interval", "0"), "knot_interval"),
+    ("fit --norm-sides 2", _fit("--norm-sides", "2"), "norm_sides"),
+    ("fit --weight -1", _fit("--weight", "-1"), "weight"),
+    ("write --board ceiling", _write_cmd("--board", "ceiling"), "--board"),
+    ("write --drones 0", _write_cmd("--drones", "0"), "drones"),
+    ("write --drones -3", _write_cmd("--drones", "-3"), "drones"),
+    ("write no input", ["write", "--out", "{out}"], "expected"),
+    ("write --font nope", _write_cmd("--font", "nope"), "font"),
+    ("write absent svg", ["write", "--svg", "{tmp}/none.svg", "--out", "{out}"], "svg"),
+    (
+        "write absent strokes",
+        ["write", "--strokes", "{tmp}/none.json", "--out", "{out}"],
+        "strokes",
+    ),
+    ("write --fly on a wall", _write_cmd("--fly", "--board", "wall"), "--fly"),
+    ("cover --pattern snake", _cover("--pattern", "snake"), "pattern"),
+    ("cover --width 0", _cover("--width", "0"), "width"),
+    ("cover --width 50", _cover("--width", "50"), "width"),
+    ("cover --epsilon 2", _cover("--epsilon", "2"), "epsilon"),
+    ("cover --delta 0", _cover("--delta", "0"), "delta"),
+    ("cover --min-coverage 1.5", _cover("--min-coverage", "1.5"), "min_coverage"),
+    ("cover --contours wavy", _cover("--contours", "wavy"), "contours"),
+    ("cover --drift sideways", _cover("--drift", "sideways"), "drift"),
+    ("cover norms and axes", _cover("--amax", "5", "--amax-axis", "5"), "got both"),
+    ("cover absent region", ["cover", "{tmp}/none.geojson", "--out", "{out}"], "none.geojson"),
+    ("paint --gamma 90", _paint("--gamma", "90"), "--gamma"),
+    ("paint --offset 1,2", _paint("--offset", "1,2"), "--offset"),
+    ("paint --offset in front", _paint("--offset", "0,1,0"), "--offset"),
+    ("paint --estimator magic", _paint("--estimator", "magic"), "estimator"),
+    ("paint --order random", _paint("--order", "random"), "order"),
+    ("paint --update sideways", _paint("--update", "sideways"), "--update"),
+    ("paint --false-contacts 1", _paint("--false-contacts", "1"), "--false-contacts"),
+    ("paint --missed-contacts -0.1", _paint("--missed-contacts", "-0.1"), "--missed-contacts"),
+    ("paint --wall-angles x", _paint("--wall-angles", "x"), "wall"),
+    ("paint no dots", ["paint", "--out", "{out}"], "exactly one"),
+    ("paint absent image", ["paint", "--image", "{tmp}/none.png", "--out", "{out}"], "none.png"),
+    ("fly --controller lqr", _fly("--controller", "lqr"), "--controller"),
+    ("fly --sim gazebo", _fly("--sim", "gazebo"), "--sim"),
+    ("fly --wind a,b", _fly("--wind", "a,b"), "--wind"),
+    ("fly --wind 1e5,0,0", _fly("--wind", "1e5,0,0"), "--wind"),
+    ("fly --gust -1", _fly("--gust", "-1"), "--gust"),
+    ("fly --noise inf", _fly("--noise", "inf"), "--noise"),
+    ("fly --rate 0", _fly("--rate", "0"), "--rate"),
+    ("fly absent plan", ["fly", "{tmp}/none", "--out", "{out}"], "plan"),
+    ("export --format kml", _export("--format", "kml"), "--format"),
+    ("export --out of another kind", ["export", "{tmp}/traj.csv", "--out", "{out}/r.dat"], ".csv"),
+    ("export --rate 0", _export("--rate", "0"), "rate"),
+    ("export absent plan", ["export", "{tmp}/none", "--out", "{out}/x.csv"], "plan"),
+]
+for name, args, message in OPTION_CASES:
+    setup = WITH_TRAJ if args[0] in ("fly", "export") else None
+    CASES.append(Case(name, args, message, setup=setup))
+
+# -- Output folders: an existing file, a folder under a file, a name with rich markup -------------
+for cmd, args in OUT_COMMANDS.items():
+    setup = WITH_TRAJ if cmd == "fly" else None
+    make_file = _both(setup, _write("a_file", "x"))
+    as_file = [a.replace("{out}", "{tmp}/a_file") for a in args]
+    under_file = [a.replace("{out}", "{tmp}/a_file/sub") for a in args]
+    CASES.append(Case(f"{cmd} --out is a file", as_file, "existing file", setup=make_file))
+    CASES.append(Case(f"{cmd} --out under a file", under_file, "a_file", setup=make_file))
+
+# -- Data that would be lost ----------------------------------------------------------------------
+OVER_INPUT = ["export", "{tmp}/traj.csv", "--out", "{tmp}/traj.csv"]
+CASES.append(Case("export over its own input", OVER_INPUT, "inputs", setup=WITH_TRAJ))
+
+
+@pytest.mark.timeout(60)
+@pytest.mark.parametrize("case", CASES, ids=[c.name for c in CASES])
+def test_hostile_input(case: Case, tmp_path: Path) -> None:
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / SENTINEL).write_text("the user's own file")
+    if case.setup is not None:
+        case.setup(tmp_path)
+    args = [a.replace("{tmp}", str(tmp_path)).replace("{out}", str(out)) for a in case.args]
+    result = runner.invoke(app, args)
+    text = result.output
+    assert result.exit_code == case.status, text
+    assert "Traceback" not in text
+    assert case.message.lower() in " ".join(text.split()).lower(), text
+    if case.status == 2:
+        lines = [line for line in text.splitlines() if line.strip()]
+        assert len(lines) == 1 and lines[0].startswith("error: "), text
+    assert (out / SENTINEL).read_text() == "the user's own file"
