@@ -39,7 +39,8 @@ def test_the_same_command_replaces_its_own_files_and_drops_stale_ones(tmp_path: 
 def test_another_commands_or_programs_file_is_not_replaced(tmp_path: Path) -> None:
     out = tmp_path / "o"
     _run(out, "fit", {"summary.json": "plan", "plot.png": "p"})
-    with pytest.raises(InputError, match=r"(summary|plot)\.\w+' exists and was written by skyquill fit"):
+    refused = r"(summary|plot)\.\w+' exists and was written by skyquill fit"
+    with pytest.raises(InputError, match=refused):
         _run(out, "fly", {"flight.csv": "f", "summary.json": "flight", "plot.png": "q"})
     assert (out / "summary.json").read_text() == "plan" and not (out / "flight.csv").exists()
     (out / "notes.txt").write_text("mine")
