@@ -66,3 +66,22 @@ def test_hostile_json_never_gets_a_500(client: TestClient, body: Any) -> None:
 @given(raw=st.binary(max_size=300))
 def test_hostile_bytes_never_get_a_500(client: TestClient, raw: bytes) -> None:
     _check(client, raw)
+
+
+@pytest.mark.parametrize(
+    ("body", "field"),
+    [
+        ({"text": "Hi", "drones": True}, "drones"),
+        ({"text": "Hi", "fly": "yes"}, "fly"),
+        ({"text": "Hi", "vmax": "2"}, "vmax"),
+        ({"text": "Hi", "size_m": "0.5"}, "size_m"),
+        ({"strokes": [[["1", 2], [3, 4]]]}, "strokes"),
+        ({"strokes": [[[0, 0], [1, 1]]], "t": [["0", 1]]}, "t"),
+    ],
+)
+def test_values_of_the_wrong_type_are_refused_not_converted(
+    client: TestClient, body: dict[str, Any], field: str
+) -> None:
+    answer = client.post("/api/plan?wait=true", json=body)
+    assert answer.status_code == 422
+    assert field in answer.json()["detail"]

@@ -25,10 +25,10 @@ MAX_DRONES = 8
 #: Largest coordinate magnitude of a drawn point, in the page's units.
 MAX_COORDINATE = 1e6
 
-Coordinate = Annotated[float, Field(ge=-MAX_COORDINATE, le=MAX_COORDINATE)]
+Coordinate = Annotated[float, Field(ge=-MAX_COORDINATE, le=MAX_COORDINATE, strict=True)]
 Point = tuple[Coordinate, Coordinate]
 Stroke = Annotated[list[Point], Field(min_length=2, max_length=MAX_STROKE_POINTS)]
-Timestamp = Annotated[float, Field(ge=0.0, le=1e7)]
+Timestamp = Annotated[float, Field(ge=0.0, le=1e7, strict=True)]
 StrokeTimes = Annotated[list[Timestamp], Field(max_length=MAX_STROKE_POINTS)]
 
 
@@ -38,6 +38,8 @@ class PlanRequest(BaseModel):
     Exactly one of ``strokes`` and ``text`` is given.
     """
 
+    # Numbers and flags are strict (Field(strict=True)): a JSON true is not the number 1,
+    # nor "2" a number: refuse, don't repair.
     model_config = ConfigDict(
         extra="forbid",
         allow_inf_nan=False,
@@ -71,17 +73,31 @@ class PlanRequest(BaseModel):
         default="horizontal", description="A horizontal board (paper 000) or a wall."
     )
     size_m: float = Field(
-        default=0.5, ge=0.05, le=5.0, description="Larger side of each drone's writing, m."
+        default=0.5,
+        ge=0.05,
+        le=5.0,
+        strict=True,
+        description="Larger side of each drone's writing, m.",
     )
-    vmax: float = Field(default=1.0, gt=0.0, le=20.0, description="Speed limit per axis, m/s.")
+    vmax: float = Field(
+        default=1.0, gt=0.0, le=20.0, strict=True, description="Speed: the velocity's norm, m/s."
+    )
     amax: float = Field(
-        default=2.0, gt=0.0, le=50.0, description="Acceleration limit per axis, m/s^2."
+        default=2.0, gt=0.0, le=50.0, strict=True, description="Acceleration norm, m/s^2."
     )
-    jmax: float = Field(default=10.0, gt=0.0, le=1000.0, description="Jerk limit per axis, m/s^3.")
+    jmax: float = Field(
+        default=10.0, gt=0.0, le=1000.0, strict=True, description="Jerk norm, m/s^3."
+    )
     drones: int = Field(
-        default=1, ge=1, le=MAX_DRONES, description="Drones writing at once, boards side by side."
+        default=1,
+        ge=1,
+        le=MAX_DRONES,
+        strict=True,
+        description="Drones writing at once, boards side by side.",
     )
-    fly: bool = Field(default=True, description="Also fly every drone in closed-loop simulation.")
+    fly: bool = Field(
+        default=True, strict=True, description="Also fly every drone in closed-loop simulation."
+    )
 
     @model_validator(mode="after")
     def _one_input(self) -> PlanRequest:
@@ -106,7 +122,7 @@ JobState = Literal["queued", "running", "done", "error"]
 
 
 class Limits(BaseModel):
-    """The per-axis limits the plan was asked to respect."""
+    """The limits the plan was asked to respect: the speed, the acceleration and jerk norms."""
 
     vmax: float
     amax: float
