@@ -258,7 +258,54 @@ for cmd, args in OUT_COMMANDS.items():
     CASES.append(Case(f"{cmd} --out is a file", as_file, "existing file", setup=make_file))
     CASES.append(Case(f"{cmd} --out under a file", under_file, "a_file", setup=make_file))
 
+# -- Text from the user printed literally (rich markup would eat or choke on it) ----------------
+CASES.append(
+    Case(
+        "a missing file named like markup",
+        ["fit", "{tmp}/a[/]b[red].csv", "--out", "{out}"],
+        "a[/]b[red].csv",
+    )
+)
+CASES.append(
+    Case(
+        "columns listed in brackets",
+        ["fit", "{tmp}/p.csv", "--out", "{out}"],
+        "['a', 'b']",
+        setup=_write("p.csv", "a,b\n0,0\n1,1\n"),
+    )
+)
+CASES.append(
+    Case(
+        "an --out folder named like markup",
+        ["fit", SPIRAL, "--out", "{tmp}/[bold]x[/]", "--rate", "20"],
+        "done",
+        status=0,
+    )
+)
+
+
 # -- Data that would be lost ----------------------------------------------------------------------
+def _plan(tmp: Path) -> None:
+    done = runner.invoke(app, ["fit", SPIRAL, "--out", str(tmp / "plan"), "--rate", "20"])
+    assert done.exit_code == 0, done.output
+
+
+CASES.append(
+    Case(
+        "fly into the plan folder it reads",
+        ["fly", "{tmp}/plan", "--out", "{tmp}/plan", "--rate", "100"],
+        "was written by skyquill fit",
+        setup=_plan,
+    )
+)
+CASES.append(
+    Case(
+        "export json over the plan's own trajectory.json",
+        ["export", "{tmp}/plan", "--format", "json", "--out", "{tmp}/plan/trajectory.json"],
+        "inputs",
+        setup=_plan,
+    )
+)
 OVER_INPUT = ["export", "{tmp}/traj.csv", "--out", "{tmp}/traj.csv"]
 CASES.append(Case("export over its own input", OVER_INPUT, "inputs", setup=WITH_TRAJ))
 
