@@ -176,7 +176,12 @@ def write_outputs(
             planned,
             rate=rate,
             guaranteed=True,
-            summary=_merge(per_drone) | {"min_separation_m": closest, "drones": per_drone},
+            summary=_merge(per_drone)
+            | {
+                "vehicle_limits": missions[0].options.limits.as_dict(),
+                "min_separation_m": closest,
+                "drones": per_drone,
+            },
             plot=lambda path: plot_missions(missions, path, "skyquill write"),
         )
 

@@ -248,6 +248,10 @@ class CoveragePlan:
             "planning_time_s": self.planning_time,
             "region_area_m2": float(self.region.area),
             "options": asdict(self.options),
+            "vehicle_limits": self.options.limits.as_dict(),
+            "limits_held": "per axis"
+            if self.options.per_axis
+            else (f"norms (acceleration and jerk by an inscribed {self.options.norm_sides}-gon)"),
             "lp": None
             if lp is None
             else {
