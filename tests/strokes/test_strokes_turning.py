@@ -122,7 +122,9 @@ def test_million_points_in_bounded_time() -> None:
     start = time.perf_counter()
     idx = turning_points(pts, 0.5)
     elapsed = time.perf_counter() - start
-    assert elapsed < 5.0
+    # Not a benchmark (bench/ measures speed): a guard against a quadratic blow-up, which
+    # would take minutes here; ~2 s on an idle machine, 5-6 s when the 2 cores are shared.
+    assert elapsed < 30.0
     assert idx[0] == 0 and idx[-1] == t.size - 1 and 50 < idx.size < 2000
     # spot-check the guarantee on a few segments
     for j in rng.integers(0, idx.size - 1, 20):
