@@ -102,7 +102,7 @@ def load_darkness(path: str | Path) -> FloatArray:
         raise
     except Image.DecompressionBombError:  # Pillow refuses at open from 179 Mpx
         raise InputError(
-            f"--image: got {file.name!r} of more than {2 * Image.MAX_IMAGE_PIXELS:,} px, "
+            f"--image: got {file.name!r} of more than {2 * (Image.MAX_IMAGE_PIXELS or 0):,} px, "
             f"expected a picture of 1 to {MAX_IMAGE_PIXELS:,} pixels"
         ) from None
     except Exception as exc:  # Pillow's decoders raise OSError, ValueError, SyntaxError,
