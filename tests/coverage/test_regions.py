@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -11,6 +12,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from skyquill.coverage.regions import (
+    MAX_VERTICES,
     check_width,
     coverage_fraction,
     load_region,
@@ -118,3 +120,136 @@ def test_a_zero_width_spike_is_refused() -> None:
         region_from_vertices(spike)
     # Repeated vertices are no spike.
     region_from_vertices([[0, 0], [5, 0], [5, 0], [5, 5], [0, 5]])
+
+
+def _geojson(tmp_path: Path, coordinates: object, name: str = "r.geojson") -> Path:
+    path = tmp_path / name
+    path.write_text(json.dumps({"type": "Polygon", "coordinates": coordinates}), encoding="utf-8")
+    return path
+
+
+def test_string_coordinates_are_refused_not_converted(tmp_path: Path) -> None:
+    ring = [["0", "0"], ["10", "0"], ["10", "10"], ["0", "0"]]
+    with pytest.raises(
+        InputError, match=r"r\.geojson: coordinates\[0\]\[0\]: got \['0', '0'\], expected \[x, y\]"
+    ):
+        load_region(_geojson(tmp_path, [ring]))
+
+
+def test_a_z_is_refused_not_dropped(tmp_path: Path) -> None:
+    ring = [[0, 0, 5], [10, 0, 5], [10, 10, 5], [0, 0, 5]]
+    with pytest.raises(
+        InputError,
+        match=r"coordinates\[0\]\[0\]: got 3 values .*expected \[x, y\]: 2-D local metres",
+    ):
+        load_region(_geojson(tmp_path, [ring]))
+    with pytest.raises(InputError, match=r"region: got a POLYGON with a third coordinate"):
+        load_region("POLYGON Z ((0 0 1, 10 0 1, 10 10 1, 0 0 1))")
+
+
+def test_deep_nesting_is_named(tmp_path: Path) -> None:
+    path = tmp_path / "deep.geojson"
+    path.write_text("[" * 100_000 + "]" * 100_000, encoding="utf-8")
+    with pytest.raises(InputError, match=r"deep\.geojson: got JSON nested too deeply"):
+        load_region(path)
+    with pytest.raises(InputError, match=r"deep2\.geojson: got JSON nested more than 64"):
+        load_region(_geojson(tmp_path, _nest(70), "deep2.geojson"))
+
+
+def _nest(depth: int) -> object:
+    value: object = []
+    for _ in range(depth):
+        value = [value]
+    return value
+
+
+@pytest.mark.parametrize(
+    ("raw", "match"),
+    [
+        (b'{"type": "Polygon"}'.decode().encode("utf-16"), "got UTF-16 text"),
+        (b'{"type": "Polyg\xf6n"}', r"got bytes that are not UTF-8 \(at offset 15\)"),
+        (b"\x00\x01\x02", r"got binary data \(a NUL byte at offset 0\)"),
+    ],
+)
+@pytest.mark.parametrize("suffix", [".geojson", ".wkt"])
+def test_text_that_is_not_utf8_is_named(
+    tmp_path: Path, raw: bytes, match: str, suffix: str
+) -> None:
+    path = tmp_path / f"enc{suffix}"
+    path.write_bytes(raw)
+    with pytest.raises(InputError, match=rf"enc\{suffix}: {match}"):
+        load_region(path)
+
+
+def test_byte_order_mark_is_accepted(tmp_path: Path) -> None:
+    path = tmp_path / "bom.geojson"
+    body = json.dumps({"type": "Polygon", "coordinates": [[*SQUARE, SQUARE[0]]]})
+    path.write_bytes(b"\xef\xbb\xbf" + body.encode())
+    assert load_region(path).area == pytest.approx(100.0)
+
+
+def test_too_many_vertices_are_refused(tmp_path: Path) -> None:
+    t = np.linspace(0, 2 * np.pi, MAX_VERTICES + 5)[:-1]
+    ring = np.column_stack([10 * np.cos(t), 10 * np.sin(t)]).tolist()
+    with pytest.raises(InputError, match=rf"more than {MAX_VERTICES:,} vertices"):
+        load_region(_geojson(tmp_path, [[*ring, ring[0]]]))
+
+
+def test_a_feature_collection_with_features_not_a_list(tmp_path: Path) -> None:
+    path = tmp_path / "fc.geojson"
+    path.write_text(json.dumps({"type": "FeatureCollection", "features": 5}), encoding="utf-8")
+    with pytest.raises(InputError, match=r"fc\.geojson: got a FeatureCollection of 5, expected"):
+        load_region(path)
+
+
+_scalar = st.one_of(
+    st.floats(),
+    st.integers(-(10**20), 10**20),
+    st.text(max_size=3),
+    st.booleans(),
+    st.none(),
+)
+_position = st.one_of(
+    st.lists(st.floats(-20, 20), min_size=2, max_size=2),
+    st.lists(_scalar, max_size=4),
+    _scalar,
+)
+_ring = st.one_of(st.lists(_position, max_size=7), _scalar)
+_geometry = st.fixed_dictionaries(
+    {
+        "type": st.sampled_from(["Polygon", "Point", "MultiPolygon", 3]),
+        "coordinates": st.one_of(st.lists(_ring, max_size=3), _scalar),
+    }
+)
+_document = st.one_of(
+    _geometry,
+    st.fixed_dictionaries({"type": st.just("Feature"), "geometry": _geometry}),
+    st.fixed_dictionaries(
+        {"type": st.just("FeatureCollection"), "features": st.one_of(st.lists(_geometry), _scalar)}
+    ),
+    _scalar,
+)
+
+
+@settings(max_examples=200, deadline=None)
+@given(doc=_document)
+def test_random_geojson_gives_a_region_or_an_input_error(doc: object) -> None:
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "random.geojson"
+        path.write_text(json.dumps(doc), encoding="utf-8")
+        try:
+            region = load_region(path)
+        except InputError as exc:
+            assert "random.geojson" in str(exc)
+            return
+    assert region.is_valid and region.area > 0 and not region.has_z
+
+
+@settings(max_examples=100, deadline=None)
+@given(raw=st.binary(max_size=60), suffix=st.sampled_from([".geojson", ".wkt"]))
+def test_random_bytes_give_an_input_error(raw: bytes, suffix: str) -> None:
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / f"raw{suffix}"
+        path.write_bytes(raw)
+        with pytest.raises(InputError, match=r"raw\."):
+            load_region(path)

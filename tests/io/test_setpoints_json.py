@@ -3,11 +3,14 @@
 from __future__ import annotations
 
 import json
+import tempfile
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from skyquill.errors import InputError
 from skyquill.io.points import TRAJECTORY_COLUMNS, trajectory_table
@@ -76,7 +79,7 @@ def write(tmp_path: Path, data: Any) -> Path:
         ({"columns": ["t", "x"]}, r"bad.json: columns: got \['t', 'x'\]"),
         ({"rate_hz": 0}, r"bad.json: rate_hz: got 0, expected a number > 0"),
         ({"rate_hz": "fast"}, r"rate_hz: got 'fast'"),
-        ({"rows": []}, r"rows: got 0 row\(s\), expected a list of at least 2 rows"),
+        ({"rows": []}, r"rows: got 0 row\(s\), expected a list of 2 to 1,000,000 rows"),
         ({"rows": "none"}, r"rows: got 'none'"),
     ],
 )
@@ -105,7 +108,72 @@ def test_bad_files(tmp_path: Path) -> None:
         read_setpoints_json(tmp_path / "missing.json")
     path = tmp_path / "text.json"
     path.write_text("not json", encoding="utf-8")
-    with pytest.raises(InputError, match=r"text\.json: got text that is not JSON"):
+    with pytest.raises(InputError, match=r"text\.json: got malformed JSON at line 1, column 1"):
         read_setpoints_json(path)
     with pytest.raises(InputError, match="got list, expected a JSON object"):
         read_setpoints_json(write(tmp_path, [1, 2]))
+
+
+def test_strings_and_ragged_rows_are_named(tmp_path: Path) -> None:
+    data = good(tmp_path)
+    data["rows"][1][3] = "0.5"
+    with pytest.raises(InputError, match=r"bad\.json: rows\[1\] column z: got '0.5', expected a"):
+        read_setpoints_json(write(tmp_path, data))
+    data = good(tmp_path)
+    data["rows"][4] = [*data["rows"][4], 1.0]
+    with pytest.raises(InputError, match=r"bad\.json: rows\[4\]: got .*expected a list of 13"):
+        read_setpoints_json(write(tmp_path, data))
+
+
+def test_deep_and_undecodable_files_are_named(tmp_path: Path) -> None:
+    path = tmp_path / "deep.json"
+    path.write_text('{"rows": ' + "[" * 100_000 + "]" * 100_000 + "}", encoding="utf-8")
+    with pytest.raises(InputError, match=r"^deep\.json: got JSON nested too deeply"):
+        read_setpoints_json(path)
+    data = good(tmp_path)
+    data["rows"][0] = _nest(70)
+    with pytest.raises(InputError, match=r"^bad\.json: got JSON nested more than 64"):
+        read_setpoints_json(write(tmp_path, data))
+    path.write_bytes(json.dumps(good(tmp_path)).encode("utf-16"))
+    with pytest.raises(InputError, match=r"^deep\.json: got UTF-16 text"):
+        read_setpoints_json(path)
+
+
+def _nest(depth: int) -> Any:
+    value: Any = []
+    for _ in range(depth):
+        value = [value]
+    return value
+
+
+_cell = st.one_of(
+    st.floats(), st.integers(-(10**20), 10**20), st.text(max_size=3), st.none(), st.booleans()
+)
+_row = st.one_of(
+    st.lists(st.floats(-10, 10), min_size=13, max_size=13), st.lists(_cell, max_size=14)
+)
+
+
+@settings(max_examples=150, deadline=None)
+@given(rows=st.lists(_row, max_size=5), rate=_cell)
+def test_random_rows_give_setpoints_or_an_input_error(rows: list[Any], rate: Any) -> None:
+    with tempfile.TemporaryDirectory() as tmp:
+        doc = {"frame": FRAME, "rate_hz": rate, "columns": list(TRAJECTORY_COLUMNS), "rows": rows}
+        path = Path(tmp) / "r.json"
+        path.write_text(json.dumps(doc), encoding="utf-8")
+        try:
+            back = read_setpoints_json(path)
+        except InputError as exc:
+            assert str(exc).startswith("r.json: ")
+            return
+    assert back.rate_hz > 0 and back.trajectory.t.shape == (len(rows),)
+
+
+@settings(max_examples=100, deadline=None)
+@given(raw=st.binary(max_size=60))
+def test_random_bytes_give_an_input_error(raw: bytes) -> None:
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "raw.json"
+        path.write_bytes(raw)
+        with pytest.raises(InputError, match=r"^raw\.json: "):
+            read_setpoints_json(path)

@@ -6,14 +6,18 @@ import copy
 import itertools
 import json
 import math
+import tempfile
 import zipfile
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from skyquill.errors import InputError
+from skyquill.io import skyc
 from skyquill.io.skyc import MAX_SEGMENT_S, read_show_json, validate_show, write_skyc
 from skyquill.trajectory import SplineTrajectory
 from skyquill.validation import FloatArray
@@ -210,10 +214,89 @@ def test_read_show_json_bad_files(tmp_path: Path) -> None:
     broken = tmp_path / "b.skyc"
     with zipfile.ZipFile(broken, "w") as archive:
         archive.writestr("show.json", "{not json")
-    with pytest.raises(InputError, match="not valid JSON"):
+    with pytest.raises(InputError, match=r"show\.json: got malformed JSON at line 1"):
         read_show_json(broken)
     wrong = tmp_path / "w.skyc"
     with zipfile.ZipFile(wrong, "w") as archive:
         archive.writestr("show.json", json.dumps({"version": 1}))
     with pytest.raises(InputError, match="environment"):
         read_show_json(wrong)
+
+
+def _archive(path: Path, show: bytes, compression: int = zipfile.ZIP_DEFLATED) -> Path:
+    with zipfile.ZipFile(path, "w", compression=compression) as archive:
+        archive.writestr("show.json", show)
+    return path
+
+
+def test_a_zip_bomb_is_refused_before_inflating(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setattr(skyc, "MAX_SHOW_BYTES", 10_000)  # a real bomb would claim gigabytes
+    bomb = _archive(tmp_path / "bomb.skyc", b" " * 1_000_000)
+    assert bomb.stat().st_size < 10_000
+    with pytest.raises(
+        InputError, match=r"bomb\.skyc: show\.json: got 1,000,000 bytes, expected at most 10,000"
+    ):
+        read_show_json(bomb)
+
+
+def test_a_corrupt_member_is_named(tmp_path: Path) -> None:
+    path = _archive(tmp_path / "c.skyc", b'{"version": 1}' * 100)
+    raw = bytearray(path.read_bytes())
+    start = raw.index(b"show.json") + len("show.json")  # the local header's name, then data
+    raw[start : start + 20] = b"\xff" * 20
+    path.write_bytes(bytes(raw))
+    with pytest.raises(InputError, match=r"c\.skyc: (show\.json cannot be extracted|got )"):
+        read_show_json(path)
+
+
+@pytest.mark.parametrize(
+    ("show", "match"),
+    [
+        (b"[" * 100_000 + b"]" * 100_000, r"show\.json: got JSON nested too deeply"),
+        (b'{"swarm": ' + b"[" * 70 + b"]" * 70 + b"}", r"show\.json: got JSON nested more than 64"),
+        ('{"version": 1}'.encode("utf-16"), r"show\.json: got UTF-16 text"),
+        (b'{"version": "\xe9"}', r"show\.json: got bytes that are not UTF-8"),
+    ],
+)
+def test_deep_and_undecodable_show_json_is_named(tmp_path: Path, show: bytes, match: str) -> None:
+    with pytest.raises(InputError, match=rf"s\.skyc: {match}"):
+        read_show_json(_archive(tmp_path / "s.skyc", show))
+
+
+@settings(max_examples=100, deadline=None)
+@given(raw=st.binary(max_size=80), zipped=st.booleans())
+def test_random_bytes_give_an_input_error(raw: bytes, zipped: bool) -> None:
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "r.skyc"
+        if zipped:
+            _archive(path, raw)
+        else:
+            path.write_bytes(b"PK\x03\x04" + raw)
+        with pytest.raises(InputError, match=r"r\.skyc|show\.json"):
+            read_show_json(path)
+
+
+@settings(max_examples=100, deadline=None)
+@given(
+    doc=st.recursive(
+        st.one_of(st.none(), st.floats(), st.integers(), st.text(max_size=3)),
+        lambda inner: st.one_of(
+            st.lists(inner, max_size=4),
+            st.dictionaries(
+                st.sampled_from(["version", "environment", "swarm", "drones", "type", "settings"]),
+                inner,
+                max_size=4,
+            ),
+        ),
+        max_leaves=30,
+    )
+)
+def test_random_show_json_gives_a_show_or_an_input_error(doc: object) -> None:
+    with tempfile.TemporaryDirectory() as tmp:
+        path = _archive(Path(tmp) / "r.skyc", json.dumps(doc).encode())
+        try:
+            read_show_json(path)
+        except InputError as exc:
+            assert "show.json" in str(exc)

@@ -3,10 +3,13 @@
 from __future__ import annotations
 
 import json
+import tempfile
 from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from skyquill.errors import InputError
 from skyquill.io.trajectory_json import (
@@ -46,7 +49,7 @@ def test_version_1_is_read(tmp_path: Path) -> None:
 @pytest.mark.parametrize(
     ("text", "message"),
     [
-        ("{", "invalid JSON"),
+        ("{", "got malformed JSON at line 1, column 2"),
         ("[" * 100_000 + "]" * 100_000, "nested too deeply"),
         ('{"format": "other"}', "got format 'other'"),
         ('{"format": "skyquill-trajectory", "trajectory": {"kind": "x"}}', "kind: got 'x'"),
@@ -72,3 +75,121 @@ def test_bad_limits_and_windows_are_named(tmp_path: Path) -> None:
         (tmp_path / "x.json").write_text(json.dumps(good | {field: value}))
         with pytest.raises(InputError, match=message):
             read_trajectory_json(tmp_path / "x.json")
+
+
+def _v2(trajectory: object, **extra: object) -> str:
+    return json.dumps(
+        {"format": "skyquill-trajectory", "version": 2, "trajectory": trajectory, **extra}
+    )
+
+
+_CTRL = SPLINE.control_points.tolist()
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        (
+            _v2(
+                {
+                    "kind": "bspline",
+                    "degree": 5,
+                    "duration_s": 2.0,
+                    "control_points": [*_CTRL, [1, 2]],
+                }
+            ),
+            r"bad\.json: trajectory 'bspline', field 'control_points': got a ragged or non-numeric",
+        ),
+        (
+            _v2(
+                {
+                    "kind": "bspline",
+                    "degree": 5,
+                    "duration_s": 2.0,
+                    "control_points": [[str(v) for v in row] for row in _CTRL],
+                }
+            ),
+            r"field 'control_points': got a ragged or non-numeric array",
+        ),
+        (
+            _v2({"kind": "sampled", "t": [0, 1], "p": [[0, 0, 0], [1, 1]]}),
+            r"trajectory 'sampled', field 'p': got a ragged or non-numeric",
+        ),
+        (
+            _v2(
+                {"kind": "bspline", "degree": 5, "duration_s": 2.0, "control_points": _CTRL},
+                pen_windows_s=[[0, 1], [1]],
+            ),
+            r"bad\.json: pen_windows_s: got \[\[0, 1\], \[1\]\], expected a rectangular array",
+        ),
+        (
+            '{"format": "skyquill-trajectory", "trajectory": ' + "[" * 70 + "]" * 70 + "}",
+            r"bad\.json: got JSON nested more than 64",
+        ),
+        ("\ufeff{", r"bad\.json: got malformed JSON at line 1, column 2"),
+    ],
+)
+def test_ragged_strings_and_deep_are_named(tmp_path: Path, text: str, message: str) -> None:
+    path = tmp_path / "bad.json"
+    path.write_text(text, encoding="utf-8")
+    with pytest.raises(InputError, match=message):
+        read_trajectory_json(path)
+
+
+def test_utf16_is_named(tmp_path: Path) -> None:
+    path = tmp_path / "u.json"
+    path.write_bytes('{"format": "skyquill-trajectory"}'.encode("utf-16"))
+    with pytest.raises(InputError, match=r"u\.json: got UTF-16 text"):
+        read_trajectory_json(path)
+
+
+_leaf = st.one_of(st.floats(), st.integers(-(10**20), 10**20), st.text(max_size=3), st.none())
+_value = st.recursive(_leaf, lambda inner: st.lists(inner, max_size=4), max_leaves=20)
+_trajectory = st.fixed_dictionaries(
+    {"kind": st.sampled_from(["bspline", "polynomial", "sampled", "retimed", "sequence", "x"])},
+    optional={
+        key: _value
+        for key in (
+            "degree",
+            "duration_s",
+            "control_points",
+            "t",
+            "p",
+            "v",
+            "a",
+            "j",
+            "breaks",
+            "coefficients",
+            "pieces",
+            "knots",
+        )
+    },
+)
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    trajectory=st.one_of(_trajectory, _value),
+    windows=_value,
+    limits=st.one_of(_value, st.lists(st.dictionaries(st.sampled_from(["type", "order"]), _leaf))),
+)
+def test_random_documents_give_a_trajectory_or_an_input_error(
+    trajectory: object, windows: object, limits: object
+) -> None:
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "r.json"
+        path.write_text(_v2(trajectory, pen_windows_s=windows, limits=limits), encoding="utf-8")
+        try:
+            read_trajectory_json(path)
+        except InputError as exc:
+            assert str(exc).startswith("r.json: ")
+
+
+@settings(max_examples=100, deadline=None)
+@given(raw=st.binary(max_size=60))
+def test_random_bytes_give_an_input_error(raw: bytes) -> None:
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "raw.json"
+        path.write_bytes(raw)
+        with pytest.raises(InputError, match=r"^raw\.json: "):
+            read_trajectory_json(path)

@@ -2,14 +2,21 @@
 
 from __future__ import annotations
 
+import struct
+import tempfile
+import zlib
 from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from PIL import Image
 
 from skyquill.errors import InputError
 from skyquill.painting.dots import (
+    MAX_IMAGE_PIXELS,
+    STIPPLE_MAX_SIDE,
     load_darkness,
     paper_drawing,
     read_dots_csv,
@@ -103,3 +110,109 @@ def test_example_csv_is_the_paper_drawing() -> None:
     dots = read_dots_csv(example)
     assert dots.shape == (140, 2)
     assert np.allclose(np.sort(dots, axis=0), np.sort(paper_drawing(), axis=0), atol=1e-4)
+
+
+def _png_header(width: int, height: int) -> bytes:
+    """A PNG signature and IHDR claiming ``width`` x ``height`` 8-bit grey, then a bogus IDAT."""
+
+    def chunk(kind: bytes, data: bytes) -> bytes:
+        return (
+            struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
+        )
+
+    ihdr = struct.pack(">IIBBBBB", width, height, 8, 0, 0, 0, 0)
+    return b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", ihdr) + chunk(b"IDAT", zlib.compress(b"\0" * 64))
+
+
+def test_a_decompression_bomb_is_refused_from_its_header(tmp_path: Path) -> None:
+    bomb = tmp_path / "bomb.png"
+    bomb.write_bytes(_png_header(20_000, 20_000))  # 400 Mpx claimed by a 100-byte file
+    with pytest.raises(
+        InputError,
+        match=rf"--image: got 'bomb.png' of more than [0-9,]+ px, expected a picture of 1 "
+        rf"to {MAX_IMAGE_PIXELS:,} pixels",
+    ):
+        load_darkness(bomb)
+    bomb.write_bytes(_png_header(10_000, 5_000))  # below Pillow's own limit, above ours
+    with pytest.raises(
+        InputError,
+        match=rf"--image: got 'bomb.png' of 10000 x 5000 px, expected a picture of 1 to "
+        rf"{MAX_IMAGE_PIXELS:,} pixels",
+    ):
+        load_darkness(bomb)
+
+
+def test_a_truncated_image_is_named(tmp_path: Path) -> None:
+    whole = _picture(tmp_path / "whole.png").read_bytes()
+    cut = tmp_path / "cut.png"
+    cut.write_bytes(whole[: len(whole) // 2])
+    with pytest.raises(InputError, match=r"--image: got 'cut.png' that Pillow cannot read"):
+        load_darkness(cut)
+    small = tmp_path / "small.png"
+    small.write_bytes(_png_header(8, 8))  # the header is fine, the pixel data is not
+    with pytest.raises(InputError, match=r"--image: got 'small.png' that Pillow cannot read"):
+        load_darkness(small)
+
+
+def test_other_formats_are_refused(tmp_path: Path) -> None:
+    gif = tmp_path / "x.gif"
+    Image.new("L", (8, 8), 0).save(gif)
+    with pytest.raises(InputError, match=r"got 'x.gif' that Pillow cannot read.*expected a PNG"):
+        load_darkness(gif)
+
+
+def test_sixteen_bit_grey_keeps_its_range(tmp_path: Path) -> None:
+    path = tmp_path / "deep.png"
+    Image.fromarray(np.array([[0, 32768, 65535]], dtype=np.uint16)).save(path)
+    assert Image.open(path).mode.startswith("I;16")
+    np.testing.assert_allclose(load_darkness(path), [[1.0, 1 - 32768 / 65535, 0.0]], atol=1e-6)
+
+
+def test_transparent_pixels_are_paper(tmp_path: Path) -> None:
+    path = tmp_path / "alpha.png"
+    Image.new("RGBA", (4, 4), (0, 0, 0, 0)).save(path)  # black, but fully transparent
+    np.testing.assert_allclose(load_darkness(path), 0.0)
+
+
+_modes = st.sampled_from(["1", "L", "LA", "P", "RGB", "RGBA", "I;16"])
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    mode=_modes,
+    width=st.integers(1, 300),
+    height=st.integers(1, 30),
+    fmt=st.sampled_from(["PNG", "JPEG"]),
+    cut=st.one_of(st.none(), st.integers(0, 400)),
+)
+def test_random_small_images_give_darkness_or_an_input_error(
+    mode: str, width: int, height: int, fmt: str, cut: int | None
+) -> None:
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "r.img"
+        rng = np.random.default_rng(width * height)
+        img = Image.new(mode, (width, height))
+        img.putdata(rng.integers(0, 255, width * height).tolist())
+        try:
+            img.save(path, fmt)
+        except OSError:  # JPEG cannot hold every mode; nothing to read then
+            return
+        if cut is not None:
+            path.write_bytes(path.read_bytes()[:cut])
+        try:
+            darkness = load_darkness(path)
+        except InputError as exc:
+            assert "r.img" in str(exc)
+            return
+    assert darkness.ndim == 2 and max(darkness.shape) <= STIPPLE_MAX_SIDE
+    assert np.all((darkness >= 0.0) & (darkness <= 1.0))
+
+
+@settings(max_examples=100, deadline=None)
+@given(raw=st.binary(max_size=80), prefix=st.sampled_from([b"", b"\x89PNG\r\n\x1a\n", b"\xff\xd8"]))
+def test_random_bytes_give_an_input_error(raw: bytes, prefix: bytes) -> None:
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "raw.png"
+        path.write_bytes(prefix + raw)
+        with pytest.raises(InputError, match=r"--image: got 'raw.png'"):
+            load_darkness(path)

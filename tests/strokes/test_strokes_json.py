@@ -12,7 +12,9 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from skyquill.errors import InputError
+from skyquill.io.json_read import MAX_DEPTH
 from skyquill.strokes import load_stroke_json
+from skyquill.strokes.model import MAX_POINTS, MAX_STROKES
 
 
 def _write(tmp_path: Path, data: object, name: str = "pad.json") -> Path:
@@ -44,7 +46,7 @@ def test_times_are_optional(tmp_path: Path) -> None:
 def test_malformed_json(tmp_path: Path) -> None:
     p = tmp_path / "bad.json"
     p.write_text('{"strokes": [[[0, 0], [1, 1]]', encoding="utf-8")
-    with pytest.raises(InputError, match=r"bad\.json: malformed JSON at line 1, column \d+"):
+    with pytest.raises(InputError, match=r"bad\.json: got malformed JSON at line 1, column \d+"):
         load_stroke_json(p)
 
 
@@ -91,8 +93,78 @@ def test_nan(tmp_path: Path) -> None:
 
 
 def test_strings_are_refused(tmp_path: Path) -> None:
-    with pytest.raises(InputError, match="stroke 0: got values of type <U"):
+    with pytest.raises(InputError, match=r'"strokes"\[0\]\[0\]: got \[\'a\', \'b\'\], expected'):
         load_stroke_json(_write(tmp_path, {"strokes": [[["a", "b"], [1, 1]]]}))
+
+
+def test_numeric_strings_are_refused_not_converted(tmp_path: Path) -> None:
+    p = _write(tmp_path, {"strokes": [[[0, 0], ["1", "2"]]]})
+    with pytest.raises(
+        InputError, match=r'"strokes"\[0\]\[1\]: got \[\'1\', \'2\'\], expected \[x, y\] of two'
+    ):
+        load_stroke_json(p)
+
+
+def test_string_times_are_refused(tmp_path: Path) -> None:
+    p = _write(tmp_path, {"strokes": [[[0, 0], [1, 1]]], "t": [["0", "1"]]})
+    with pytest.raises(
+        InputError, match=r'"t"\[0\]: got \[\'0\', \'1\'\], expected a list of JSON'
+    ):
+        load_stroke_json(p)
+
+
+def test_deep_nesting_is_named(tmp_path: Path) -> None:
+    p = tmp_path / "deep.json"
+    p.write_text("[" * 100_000 + "]" * 100_000, encoding="utf-8")
+    with pytest.raises(InputError, match=r"deep\.json: got JSON nested too deeply"):
+        load_stroke_json(p)
+    p.write_text('{"strokes": ' + "[" * 80 + "]" * 80 + "}", encoding="utf-8")
+    with pytest.raises(
+        InputError, match=rf"deep\.json: got JSON nested more than {MAX_DEPTH} deep"
+    ):
+        load_stroke_json(p)
+
+
+def test_too_many_strokes_are_refused(tmp_path: Path) -> None:
+    p = _write(tmp_path, {"strokes": [[[0, 0], [1, 1]]] * 10_000})
+    with pytest.raises(
+        InputError, match=rf'"strokes": got 10,000 strokes, expected at most {MAX_STROKES:,}'
+    ):
+        load_stroke_json(p)
+
+
+def test_too_many_points_are_refused(tmp_path: Path) -> None:
+    p = _write(tmp_path, {"strokes": [[[i, 0] for i in range(MAX_POINTS + 1)]]})
+    with pytest.raises(InputError, match=rf"got more than {MAX_POINTS:,} points by stroke 0"):
+        load_stroke_json(p)
+
+
+def test_huge_integer_literal_is_named(tmp_path: Path) -> None:
+    p = tmp_path / "int.json"
+    p.write_text('{"strokes": [[[' + "1" * 5000 + ", 0], [1, 1]]]}", encoding="utf-8")
+    with pytest.raises(InputError, match=r"int\.json: got an unreadable number"):
+        load_stroke_json(p)
+
+
+@pytest.mark.parametrize(
+    ("raw", "match"),
+    [
+        ('{"strokes": [[[0, 0], [1, 1]]]}'.encode("utf-16"), "got UTF-16 text, expected"),
+        (b"\x89PNG\r\n\x1a\n\x00\x00\x00", r"got binary data \(a NUL byte at offset 8\)"),
+        (b'{"strokes": "\xe9"}', r"got bytes that are not UTF-8 \(at offset 13\)"),
+    ],
+)
+def test_text_that_is_not_utf8_is_named(tmp_path: Path, raw: bytes, match: str) -> None:
+    p = tmp_path / "enc.json"
+    p.write_bytes(raw)
+    with pytest.raises(InputError, match=rf"enc\.json: {match}"):
+        load_stroke_json(p)
+
+
+def test_byte_order_mark_is_accepted(tmp_path: Path) -> None:
+    p = tmp_path / "bom.json"
+    p.write_bytes(b"\xef\xbb\xbf" + b'{"strokes": [[[0, 0], [1, 1]]]}')
+    assert load_stroke_json(p).n_points == 2
 
 
 def test_times_not_increasing(tmp_path: Path) -> None:
@@ -115,7 +187,10 @@ _json = st.recursive(
     ),
     max_leaves=40,
 )
-_point = st.tuples(st.floats(-1e6, 1e6), st.floats(-1e6, 1e6)).map(list)
+_point = st.one_of(
+    st.tuples(st.floats(-1e6, 1e6), st.floats(-1e6, 1e6)).map(list),
+    st.lists(st.one_of(st.floats(), st.text(st.characters(categories=["Nd"]), max_size=2))),
+)
 _stroke = st.lists(st.one_of(_point, _point, _json), max_size=6)
 _doc = st.one_of(
     _json,
@@ -144,7 +219,17 @@ def test_random_json_gives_strokes_or_input_error(tmp_path: Path, doc: object) -
 @settings(
     max_examples=100, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
 )
-@given(raw=st.binary(max_size=40))
+@given(
+    raw=st.one_of(
+        st.binary(max_size=40),
+        st.builds(
+            lambda head, body, tail: head + body + tail,
+            st.sampled_from([b"", b"\xef\xbb\xbf", b"\xff\xfe", b"{", b"[" * 70]),
+            st.binary(max_size=40),
+            st.sampled_from([b"", b"}", b"]" * 70]),
+        ),
+    )
+)
 def test_random_bytes_give_input_error(tmp_path: Path, raw: bytes) -> None:
     p = tmp_path / "raw.json"
     p.write_bytes(raw)

@@ -7,9 +7,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 from skyquill.errors import InputError
 from skyquill.strokes import load_svg, segment_distances
+from skyquill.strokes.model import MAX_POINTS, MAX_STROKES
 
 _HEAD = '<svg xmlns="http://www.w3.org/2000/svg" width="200" height="200" viewBox="0 0 200 200">'
 
@@ -129,3 +132,121 @@ def test_missing_svg(tmp_path: Path) -> None:
 def test_bad_tolerance(tmp_path: Path) -> None:
     with pytest.raises(InputError, match="tolerance: got -1"):
         load_svg(_svg(tmp_path, '<path d="M 0 0 L 1 1"/>'), tolerance=-1.0)
+
+
+@pytest.mark.parametrize(
+    ("body", "match"),
+    [
+        (
+            '<path d="M 0 0 L 5 5 L nan 5 L 10 10"/>',
+            r"shape 0 \(Path\) d: got 'nan' at character 14",
+        ),
+        ('<path d="M 0 0 L inf 5"/>', r"shape 0 \(Path\) d: got 'inf' at character 8"),
+        (
+            '<polyline points="0,0 NaN,1 3,3"/>',
+            r"shape 0 \(Polyline\) points: got 'NaN' at character 4",
+        ),
+    ],
+)
+def test_nan_in_path_data_is_refused_not_cut(tmp_path: Path, body: str, match: str) -> None:
+    with pytest.raises(InputError, match=rf"d\.svg: {match}, expected only numbers"):
+        load_svg(_svg(tmp_path, body))
+
+
+def test_overflowing_number_is_refused(tmp_path: Path) -> None:
+    with pytest.raises(InputError, match=r"d\.svg: .*(inf|NaN or infinite)"):
+        load_svg(_svg(tmp_path, '<path d="M 0 0 L 1e400 5 L 10 10"/>'))
+
+
+def test_too_many_paths_are_refused(tmp_path: Path) -> None:
+    body = "".join(f'<path d="M {i % 200} 0 L {i % 200} 1"/>' for i in range(10_000))
+    with pytest.raises(
+        InputError, match=rf"got 10,000 drawn shapes, expected at most {MAX_STROKES:,} strokes"
+    ):
+        load_svg(_svg(tmp_path, body))
+
+
+def test_too_many_subpaths_are_refused(tmp_path: Path) -> None:
+    d = " ".join(f"M {i % 200} 0 L {i % 200} 1" for i in range(MAX_STROKES + 1))
+    with pytest.raises(InputError, match=rf"got more than {MAX_STROKES:,} subpaths"):
+        load_svg(_svg(tmp_path, f'<path d="{d}"/>'))
+
+
+def test_tiny_tolerance_is_bounded(tmp_path: Path) -> None:
+    p = _svg(tmp_path, '<path d="M 0 0 C 50 200 150 -100 200 100"/>')
+    with pytest.raises(InputError, match=rf"got more than {MAX_POINTS:,} points after flattening"):
+        load_svg(p, tolerance=1e-300)
+
+
+def test_entities_are_not_expanded_without_bound(tmp_path: Path) -> None:
+    entities = "".join(
+        f'<!ENTITY {chr(98 + i)} "' + f"&{chr(97 + i)};" * 10 + '">' for i in range(9)
+    )
+    p = tmp_path / "lol.svg"
+    p.write_text(
+        f'<?xml version="1.0"?><!DOCTYPE svg [<!ENTITY a "1 1 2 2 ">{entities}]>'
+        '<svg xmlns="http://www.w3.org/2000/svg"><path d="M 0 0 L &j;"/></svg>',
+        encoding="utf-8",
+    )
+    with pytest.raises(InputError, match=r"lol\.svg: cannot be parsed as SVG"):
+        load_svg(p)
+
+
+def test_external_entities_are_not_fetched(tmp_path: Path) -> None:
+    secret = tmp_path / "secret.txt"
+    secret.write_text("M 0 0 L 5 5", encoding="utf-8")
+    p = tmp_path / "xxe.svg"
+    p.write_text(
+        f'<?xml version="1.0"?><!DOCTYPE svg [<!ENTITY x SYSTEM "file://{secret}">]>'
+        '<svg xmlns="http://www.w3.org/2000/svg"><path d="&x;"/></svg>',
+        encoding="utf-8",
+    )
+    with pytest.raises(InputError, match=r"xxe\.svg: cannot be parsed as SVG"):
+        load_svg(p)
+
+
+def test_deeply_nested_groups_are_named(tmp_path: Path) -> None:
+    body = "<g>" * 5000 + '<path d="M 0 0 L 1 1"/>' + "</g>" * 5000
+    with pytest.raises(InputError, match=r"d\.svg: cannot be parsed as SVG"):
+        load_svg(_svg(tmp_path, body))
+
+
+_svg_number = st.one_of(
+    st.floats(allow_nan=True, allow_infinity=True).map(repr),
+    st.integers(-(10**6), 10**6).map(str),
+    st.sampled_from(["nan", "NaN", "inf", "-inf", "1e400", "-1e-400", "1e308", ".5", "-", "e"]),
+)
+_svg_token = st.one_of(_svg_number, st.sampled_from(list("MmLlHhVvCcSsQqTtAaZz,")))
+_svg_body = st.one_of(
+    st.lists(_svg_token, max_size=16).map(lambda t: f'<path d="M 0 0 {" ".join(t)}"/>'),
+    st.lists(_svg_number, max_size=8).map(lambda t: f'<polyline points="{" ".join(t)}"/>'),
+    st.tuples(_svg_number, _svg_number, _svg_number).map(
+        lambda t: f'<g transform="translate({t[0]} {t[1]}) scale({t[2]})"><path d="M0 0 L9 9"/></g>'
+    ),
+    st.text(max_size=30),
+)
+
+
+@settings(
+    max_examples=200, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
+@given(bodies=st.lists(_svg_body, min_size=1, max_size=3))
+def test_random_svg_gives_strokes_or_input_error(tmp_path: Path, bodies: list[str]) -> None:
+    p = _svg(tmp_path, "".join(bodies), "random.svg")
+    try:
+        s = load_svg(p)
+    except InputError as exc:
+        assert "random.svg" in str(exc)
+        return
+    assert all(np.all(np.isfinite(path)) and path.shape[0] >= 2 for path in s.paths)
+
+
+@settings(
+    max_examples=100, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
+@given(raw=st.binary(max_size=60))
+def test_random_bytes_give_input_error_svg(tmp_path: Path, raw: bytes) -> None:
+    p = tmp_path / "raw.svg"
+    p.write_bytes(raw)
+    with pytest.raises(InputError, match=r"raw\.svg"):
+        load_svg(p)

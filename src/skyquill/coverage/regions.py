@@ -8,7 +8,6 @@ a disc of the coverage diameter (issue 5's metric).
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import Any
 
@@ -17,38 +16,64 @@ import shapely
 from shapely.geometry import LineString, Polygon, shape
 
 from skyquill.errors import InputError
+from skyquill.io.json_read import check_depth, decode_utf8, parse_json
 from skyquill.validation import FloatArray, as_array, as_float
 
 #: Region coordinates beyond this (m) are refused: a local metric frame, not degrees or mm.
 MAX_COORDINATE_M = 1e5
+#: Largest region file read, bytes (checked before reading).
+MAX_BYTES = 16 * 2**20
+#: Most boundary vertices accepted: a field traced at 1 m over a 10 km boundary.
+MAX_VERTICES = 10_000
+_WHAT = "a GeoJSON Polygon in 2-D local metres"
 
 
 def region_from_vertices(vertices: Any, name: str = "vertices") -> Polygon:
     """A region from its boundary vertices (K, 2), m, in order; closing is optional."""
     pts = as_array(name, vertices, ndim=2, max_abs=MAX_COORDINATE_M)
     if pts.shape[1] != 2 or pts.shape[0] < 3:
-        raise InputError(f"{name}: got shape {pts.shape}, expected (K >= 3, 2) boundary vertices")
+        raise InputError(
+            f"{name}: got shape {pts.shape}, expected (K >= 3, 2) boundary vertices "
+            "in 2-D local metres"
+        )
     return _checked(Polygon(pts), name)
 
 
 def load_region(source: str | Path) -> Polygon:
     """Read a region: a ``.geojson``/``.json`` file (Polygon, Feature or one-feature
     FeatureCollection), a ``.wkt`` file, or a WKT string.
+
+    Coordinates are 2-D local metres: JSON numbers (a string such as ``"1"`` is
+    refused, not converted), ``[x, y]`` positions (a third value, a z, is refused,
+    not dropped), at most :data:`MAX_VERTICES` of them. A file is UTF-8 (a
+    byte-order mark is accepted), at most :data:`MAX_BYTES`.
+
+    Raises
+    ------
+    InputError
+        Naming the file (or ``region``) and what is wrong.
     """
     text = str(source)
-    path = Path(text)
     if text.lstrip().upper().startswith("POLYGON"):
         return _from_wkt(text, "region")
-    if not path.is_file():
-        raise InputError(f"region: got {text!r}, expected a GeoJSON or WKT file or a WKT string")
-    content = path.read_text(encoding="utf-8")
-    if path.suffix.lower() == ".wkt":
-        return _from_wkt(content, path.name)
+    path = Path(text)
     try:
-        data = json.loads(content)
-    except json.JSONDecodeError as exc:
-        raise InputError(f"{path.name}: got invalid JSON ({exc}), expected GeoJSON") from None
-    return _from_geojson(data, path.name)
+        is_file = path.is_file()
+    except OSError:  # a name too long for the file system is no file
+        is_file = False
+    if not is_file:
+        raise InputError(
+            f"region: got {text[:80]!r}, expected a GeoJSON or WKT file or a WKT string"
+        )
+    size = path.stat().st_size
+    if size > MAX_BYTES:
+        raise InputError(
+            f"{path.name}: got {size:,} bytes, expected a region of at most {MAX_BYTES:,}"
+        )
+    raw = path.read_bytes()
+    if path.suffix.lower() == ".wkt":
+        return _from_wkt(decode_utf8(raw, path.name, "a WKT POLYGON"), path.name)
+    return _from_geojson(parse_json(raw, path.name, _WHAT), path.name)
 
 
 def _from_wkt(text: str, name: str) -> Polygon:
@@ -58,28 +83,81 @@ def _from_wkt(text: str, name: str) -> Polygon:
         raise InputError(f"{name}: got unreadable WKT ({exc}), expected a POLYGON") from None
     if not isinstance(geometry, Polygon):
         raise InputError(f"{name}: got a {geometry.geom_type}, expected a Polygon")
+    if geometry.has_z or getattr(geometry, "has_m", False):
+        raise InputError(
+            f"{name}: got a POLYGON with a third coordinate (Z or M), expected 2-D local "
+            "metres (x y)"
+        )
+    if len(geometry.exterior.coords) > MAX_VERTICES:
+        raise InputError(
+            f"{name}: got {len(geometry.exterior.coords):,} vertices, expected at most "
+            f"{MAX_VERTICES:,}"
+        )
     return _checked(geometry, name)
 
 
 def _from_geojson(data: Any, name: str) -> Polygon:
+    check_depth(data, name, _WHAT)
     if isinstance(data, dict) and data.get("type") == "FeatureCollection":
-        features = data.get("features") or []
-        if len(features) != 1:
-            raise InputError(
-                f"{name}: got a FeatureCollection of {len(features)} features, expected one"
-            )
+        features = data.get("features")
+        if not isinstance(features, list) or len(features) != 1:
+            got = f"{len(features)} features" if isinstance(features, list) else repr(features)
+            raise InputError(f"{name}: got a FeatureCollection of {got[:60]}, expected one feature")
         data = features[0]
     if isinstance(data, dict) and data.get("type") == "Feature":
         data = data.get("geometry")
     if not isinstance(data, dict) or data.get("type") != "Polygon":
         kind = data.get("type") if isinstance(data, dict) else type(data).__name__
-        raise InputError(f"{name}: got GeoJSON of type {kind!r}, expected a Polygon")
+        raise InputError(f"{name}: got GeoJSON of type {str(kind)[:40]!r}, expected a Polygon")
+    _check_coordinates(data.get("coordinates"), name)
     try:
         geometry = shape(data)
     except (ValueError, TypeError, IndexError, shapely.errors.GEOSException) as exc:
         raise InputError(f"{name}: got malformed Polygon coordinates ({exc})") from None
     assert isinstance(geometry, Polygon)
     return _checked(geometry, name)
+
+
+def _check_coordinates(rings: Any, name: str) -> None:
+    """Refuse Polygon coordinates that are not rings of ``[x, y]`` JSON numbers.
+
+    shapely would convert ``"1"`` to 1.0 and keep a z silently; both are refused here.
+    """
+    if not isinstance(rings, list) or not rings:
+        raise InputError(
+            f"{name}: coordinates: got {repr(rings)[:40]}, expected a list of rings "
+            "[[[x, y], ...], ...]"
+        )
+    count = 0
+    for r, ring in enumerate(rings):
+        if not isinstance(ring, list):
+            raise InputError(
+                f"{name}: coordinates[{r}]: got {repr(ring)[:40]}, expected a ring [[x, y], ...]"
+            )
+        count += len(ring)
+        if count > MAX_VERTICES:
+            raise InputError(
+                f"{name}: coordinates: got more than {MAX_VERTICES:,} vertices, expected at most "
+                f"{MAX_VERTICES:,}"
+            )
+        for k, position in enumerate(ring):
+            _check_position(position, f"{name}: coordinates[{r}][{k}]")
+
+
+def _check_position(position: Any, where: str) -> None:
+    if isinstance(position, list) and len(position) > 2:
+        raise InputError(
+            f"{where}: got {len(position)} values {repr(position)[:40]}, expected [x, y]: "
+            "2-D local metres (a z is not dropped silently; project and flatten first)"
+        )
+    if not (
+        isinstance(position, list)
+        and len(position) == 2
+        and all(isinstance(v, int | float) and not isinstance(v, bool) for v in position)
+    ):
+        raise InputError(
+            f"{where}: got {repr(position)[:40]}, expected [x, y] of two JSON numbers (m)"
+        )
 
 
 def _checked(polygon: Polygon, name: str) -> Polygon:

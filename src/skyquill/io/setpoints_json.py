@@ -14,7 +14,6 @@ trajectories are written with ``z = 0``. The CSV form of the same table is
 
 from __future__ import annotations
 
-import json
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -24,6 +23,7 @@ import numpy as np
 
 from skyquill.errors import InputError
 from skyquill.io.atomic import write_json
+from skyquill.io.json_read import read_json_file
 from skyquill.io.points import TRAJECTORY_COLUMNS, trajectory_table
 from skyquill.trajectory import Trajectory
 from skyquill.trajectory.sampled import MIN_STEP_S, SampledTrajectory
@@ -33,6 +33,10 @@ from skyquill.validation import as_float
 FRAME = "world ENU z-up, SI"
 #: Largest coordinate magnitude accepted on reading (larger is almost surely a unit error).
 MAX_ABS = 1e6
+#: Largest file read, bytes (checked before reading): 1,000,000 rows of 13 numbers.
+MAX_BYTES = 256 * 2**20
+#: Most rows read: 2.8 h at 100 Hz, as :data:`skyquill.io.table.MAX_ROWS`.
+MAX_ROWS = 1_000_000
 
 
 @dataclass(frozen=True)
@@ -100,18 +104,21 @@ def read_setpoints_json(path: str | Path) -> SetpointsJson:
     ------
     InputError
         Naming the file and the field when the file is missing or not JSON,
-        ``frame`` or ``columns`` differ from what is written, ``rate_hz`` is
-        not > 0, there are fewer than 2 rows, a row has the wrong length or a
-        cell is not a finite number (magnitude <= 1e6), or times do not increase.
+        larger than :data:`MAX_BYTES`, not UTF-8 or nested too deep
+        (:mod:`skyquill.io.json_read`), ``frame`` or ``columns`` differ from
+        what is written, ``rate_hz`` is not > 0, there are fewer than 2 or more
+        than :data:`MAX_ROWS` rows, a row has the wrong length or a cell is not
+        a finite JSON number (magnitude <= 1e6; a string is refused), or times
+        do not increase.
     """
     file = Path(path)
     if not file.is_file():
         raise InputError(f"setpoints file: got {str(file)!r}, expected an existing JSON file")
     name = file.name
     try:
-        data = json.loads(file.read_text(encoding="utf-8"))
-    except (UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise InputError(f"{name}: got text that is not JSON ({exc}), expected JSON") from None
+        data = read_json_file(file, "setpoints JSON", max_bytes=MAX_BYTES)
+    except InputError as exc:  # say the file's name, as every other message here does
+        raise InputError(str(exc).replace(str(file), name, 1)) from None
     if not isinstance(data, dict):
         raise InputError(f"{name}: got {type(data).__name__}, expected a JSON object")
     if data.get("frame") != FRAME:
@@ -125,9 +132,9 @@ def read_setpoints_json(path: str | Path) -> SetpointsJson:
         raise InputError(f"{name}: rate_hz: got {raw_rate!r}, expected a number > 0 (Hz)")
     rate = float(raw_rate)
     rows = data.get("rows")
-    if not isinstance(rows, list) or len(rows) < 2:
-        got = f"{len(rows)} row(s)" if isinstance(rows, list) else repr(rows)[:60]
-        raise InputError(f"{name}: rows: got {got}, expected a list of at least 2 rows")
+    if not isinstance(rows, list) or not 2 <= len(rows) <= MAX_ROWS:
+        got = f"{len(rows):,} row(s)" if isinstance(rows, list) else repr(rows)[:60]
+        raise InputError(f"{name}: rows: got {got}, expected a list of 2 to {MAX_ROWS:,} rows")
     width = len(TRAJECTORY_COLUMNS)
     for r, row in enumerate(rows):
         if not isinstance(row, list) or len(row) != width:

@@ -39,6 +39,7 @@ import itertools
 import json
 import math
 import zipfile
+import zlib
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -47,9 +48,12 @@ from typing import Any
 import numpy as np
 
 from skyquill.errors import InputError
+from skyquill.io.json_read import parse_json
 from skyquill.trajectory import PiecewisePolynomial, SplineTrajectory
 from skyquill.validation import FloatArray, as_array, as_float
 
+#: Largest ``show.json`` read from an archive, bytes (checked before inflating it).
+MAX_SHOW_BYTES = 256 * 2**20
 #: Longest Bézier segment Skybrush accepts, s.
 MAX_SEGMENT_S = 65.5
 #: Points at which each approximated piece's error is measured (ends included).
@@ -285,8 +289,10 @@ def read_show_json(path: str | Path) -> dict[str, Any]:
     Raises
     ------
     InputError
-        When the file is missing, not a ZIP, has no ``show.json``, the JSON is
-        malformed, or :func:`validate_show` rejects it.
+        When the file is missing, not a ZIP (or a corrupt or encrypted one), has
+        no ``show.json`` or one larger than :data:`MAX_SHOW_BYTES`, the JSON is
+        malformed, not UTF-8 or nested too deep (:mod:`skyquill.io.json_read`),
+        or :func:`validate_show` rejects it.
     """
     file = Path(path)
     if not file.is_file():
@@ -295,15 +301,28 @@ def read_show_json(path: str | Path) -> dict[str, Any]:
         with zipfile.ZipFile(file) as archive:
             if "show.json" not in archive.namelist():
                 raise InputError(
-                    f"{file.name}: got members {archive.namelist()}, expected a show.json"
+                    f"{file.name}: got members {archive.namelist()[:10]}, expected a show.json"
+                )
+            # The size in the directory is checked before inflating: a ZIP bomb is
+            # a few kilobytes that claim gigabytes.
+            size = archive.getinfo("show.json").file_size
+            if size > MAX_SHOW_BYTES:
+                raise InputError(
+                    f"{file.name}: show.json: got {size:,} bytes, expected at most "
+                    f"{MAX_SHOW_BYTES:,}"
                 )
             raw = archive.read("show.json")
+    except InputError:
+        raise
     except zipfile.BadZipFile:
         raise InputError(f"{file.name}: got a file that is not a ZIP, expected a .skyc") from None
-    try:
-        show = json.loads(raw.decode("utf-8"))
-    except (UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise InputError(f"{file.name}: show.json is not valid JSON ({exc})") from None
+    except (OSError, EOFError, RuntimeError, NotImplementedError, zlib.error) as exc:
+        # encrypted members, unknown compression, a corrupt stream
+        raise InputError(
+            f"{file.name}: show.json cannot be extracted ({type(exc).__name__}: {exc}), "
+            "expected a .skyc written by a show designer"
+        ) from None
+    show = parse_json(raw, f"{file.name}: show.json", "a Skybrush show object")
     validate_show(show)
     if not isinstance(show, dict):  # pragma: no cover - validate_show checked it
         raise InputError("show.json: expected an object")

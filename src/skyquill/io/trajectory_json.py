@@ -27,6 +27,7 @@ import numpy as np
 
 from skyquill.errors import InputError
 from skyquill.io.atomic import write_text
+from skyquill.io.json_read import parse_json
 from skyquill.limits import BoxLimit, CylinderLimit, DerivativeLimit, NormLimit
 from skyquill.trajectory import Trajectory
 from skyquill.trajectory.codec import decode, encode
@@ -96,12 +97,7 @@ def read_trajectory_json(path: str | Path) -> PlannedTrajectory:
     size = file.stat().st_size
     if size > MAX_BYTES:
         raise InputError(f"{file.name}: got {size:,} bytes, expected at most {MAX_BYTES:,}")
-    try:
-        data = json.loads(file.read_bytes().decode("utf-8"))
-    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
-        raise InputError(f"{file.name}: got invalid JSON ({exc}), expected {FORMAT}") from None
-    except RecursionError:
-        raise InputError(f"{file.name}: got JSON nested too deeply, expected {FORMAT}") from None
+    data = parse_json(file.read_bytes(), file.name, f"a {FORMAT} JSON file")
     try:
         return _planned(data)
     except InputError as exc:

@@ -14,8 +14,10 @@ from __future__ import annotations
 
 import csv
 import math
+import warnings
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -28,6 +30,11 @@ from skyquill.validation import FloatArray, as_array, as_int
 STIPPLE_MAX_SIDE = 200
 #: Most dots a mission takes (a mural of 10,000 dots is ~ 20 h of flight already).
 MAX_DOTS = 10_000
+#: Largest picture accepted, pixels (checked from the header, before decoding): a 40 Mpx
+#: photo decodes to ~160 MB of RGBA; Pillow's own bomb check stops only at twice 89 Mpx.
+MAX_IMAGE_PIXELS = 40_000_000
+#: The picture formats read: Pillow's others (EPS runs Ghostscript, for one) are refused.
+IMAGE_FORMATS = ("PNG", "JPEG")
 
 
 def read_dots_csv(path: str | Path) -> FloatArray:
@@ -63,25 +70,79 @@ def write_dots_csv(path: str | Path, dots: FloatArray) -> None:
 
 
 def load_darkness(path: str | Path) -> FloatArray:
-    """The picture as darkness in [0, 1] (1 = black), shape (H, W), longest side <= 200 px."""
-    from PIL import Image, UnidentifiedImageError
+    """The picture as darkness in [0, 1] (1 = black), shape (H, W), longest side <= 200 px.
+
+    The file is a PNG or a JPEG of at most :data:`MAX_IMAGE_PIXELS` pixels; the size is
+    read from the header and checked before anything is decoded, so a small file that
+    claims to be 20000 x 20000 px (a decompression bomb) is refused without the
+    gigabyte it would take. Transparent pixels count as white paper; 16-bit greys keep
+    their full range.
+
+    Raises
+    ------
+    InputError
+        Naming ``--image`` when the file is missing, not a PNG or JPEG Pillow can
+        decode (truncated, corrupt), or larger than :data:`MAX_IMAGE_PIXELS`.
+    """
+    from PIL import Image
 
     file = Path(path)
     if not file.is_file():
         raise InputError(f"--image: got {str(file)!r}, expected an existing PNG or JPEG file")
     try:
-        with Image.open(file) as img:
+        with warnings.catch_warnings():
+            # Pillow warns from 89 Mpx; our own ceiling, checked next, is lower
+            warnings.simplefilter("ignore", Image.DecompressionBombWarning)
+            img = Image.open(file, formats=IMAGE_FORMATS)
+        with img:
+            _check_pixels(file, img.size)
             img.load()
-            gray = img.convert("L")
-    except (UnidentifiedImageError, OSError, ValueError) as exc:
+            gray = _gray(img)
+    except InputError:
+        raise
+    except Image.DecompressionBombError:  # Pillow refuses at open from 179 Mpx
         raise InputError(
-            f"--image: got {file.name!r} that Pillow cannot read ({exc}), expected a PNG or JPEG"
+            f"--image: got {file.name!r} of more than {2 * (Image.MAX_IMAGE_PIXELS or 0):,} px, "
+            f"expected a picture of 1 to {MAX_IMAGE_PIXELS:,} pixels"
+        ) from None
+    except Exception as exc:  # Pillow's decoders raise OSError, ValueError, SyntaxError,
+        # struct.error, EOFError, DecompressionBombError or MemoryError on a hostile file
+        raise InputError(
+            f"--image: got {file.name!r} that Pillow cannot read ({type(exc).__name__}: "
+            f"{str(exc)[:120]}), expected a PNG or JPEG"
         ) from None
     scale = STIPPLE_MAX_SIDE / max(gray.size)
     if scale < 1.0:
         size = (max(1, round(gray.width * scale)), max(1, round(gray.height * scale)))
         gray = gray.resize(size, Image.Resampling.LANCZOS)
-    return 1.0 - np.asarray(gray, dtype=float) / 255.0
+    if gray.mode == "F":  # 16-bit grey, already in [0, 1]; Lanczos may overshoot it
+        darkness: FloatArray = 1.0 - np.clip(np.asarray(gray, dtype=float), 0.0, 1.0)
+    else:
+        darkness = 1.0 - np.asarray(gray, dtype=float) / 255.0
+    return darkness
+
+
+def _check_pixels(file: Path, size: tuple[int, int]) -> None:
+    width, height = size
+    if width < 1 or height < 1 or width * height > MAX_IMAGE_PIXELS:
+        raise InputError(
+            f"--image: got {file.name!r} of {width} x {height} px, expected a picture of 1 to "
+            f"{MAX_IMAGE_PIXELS:,} pixels (it is resampled to {STIPPLE_MAX_SIDE} px anyway)"
+        )
+
+
+def _gray(img: Any) -> Any:
+    """``img`` as an 8-bit grey (mode ``L``) image, or 16-bit grey as ``F`` in [0, 1]."""
+    from PIL import Image
+
+    if img.mode.startswith("I;16"):
+        # convert("L") would clip every value above 255 to white
+        return Image.fromarray(np.asarray(img, dtype=np.float32) / 65535.0)
+    if "A" in img.mode or "transparency" in img.info:
+        rgba = img.convert("RGBA")
+        paper = Image.new("RGBA", rgba.size, (255, 255, 255, 255))
+        return Image.alpha_composite(paper, rgba).convert("L")
+    return img.convert("L")
 
 
 def stipple(

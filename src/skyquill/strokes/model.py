@@ -17,6 +17,12 @@ FloatArray = NDArray[np.float64]
 #: Coordinates beyond this magnitude are almost surely in the wrong unit, and
 #: squared distances of them would overflow in the geometry stages.
 MAX_COORDINATE = 1e12
+#: Most strokes a file reader (stroke JSON, SVG) accepts: a page of handwriting
+#: has a few hundred; more is a drawing to be rasterised, not flown.
+MAX_STROKES = 2_000
+#: Most points, over all strokes, a file reader accepts (a 200 Hz tablet over
+#: eight minutes of drawing); a larger drawing is refused before planning starts.
+MAX_POINTS = 100_000
 
 
 def _frozen(arr: FloatArray) -> FloatArray:

@@ -40,12 +40,16 @@ def _array(data: dict[str, Any], key: str) -> Any:
     if key not in data:
         raise InputError(f"trajectory {data.get('kind')!r}: got no {key!r} field, expected one")
     try:
-        return np.asarray(data[key], dtype=float)
-    except (TypeError, ValueError):
+        # No dtype here: asarray(..., dtype=float) would turn the string "1" into 1.0.
+        raw = np.asarray(data[key])
+    except (TypeError, ValueError, OverflowError):
+        raw = None
+    if raw is None or (raw.size and raw.dtype.kind not in "iuf"):
         raise InputError(
             f"trajectory {data.get('kind')!r}, field {key!r}: got a ragged or non-numeric "
             "array, expected a rectangular array of numbers"
-        ) from None
+        )
+    return raw.astype(float)
 
 
 def _encode_spline(traj: SplineTrajectory) -> dict[str, Any]:

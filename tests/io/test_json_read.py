@@ -1,0 +1,91 @@
+"""The one JSON parser every reader uses: encodings, depth, size and malformed text named."""
+
+from __future__ import annotations
+
+import json
+import tempfile
+from pathlib import Path
+
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from skyquill.errors import InputError
+from skyquill.io.json_read import MAX_DEPTH, parse_json, read_json_file
+
+WHAT = "a test document"
+
+
+@pytest.mark.parametrize(
+    ("raw", "match"),
+    [
+        ("[" * 100_000 + "]" * 100_000, "got JSON nested too deeply"),
+        ("[" * (MAX_DEPTH + 1) + "]" * (MAX_DEPTH + 1), f"got JSON nested more than {MAX_DEPTH}"),
+        ('{"a": ' * (MAX_DEPTH + 1) + "1" + "}" * (MAX_DEPTH + 1), "got JSON nested more"),
+        ("[1, 2", r"got malformed JSON at line 1, column 6 \(Expecting ',' delimiter\)"),
+        ("[" + "9" * 5000 + "]", "got an unreadable number"),
+        ("", r"got malformed JSON at line 1, column 1"),
+    ],
+)
+def test_malformed_text_is_named(raw: str, match: str) -> None:
+    with pytest.raises(InputError, match=rf"doc\.json: {match}"):
+        parse_json(raw.encode(), "doc.json", WHAT)
+
+
+@pytest.mark.parametrize(
+    ("raw", "match"),
+    [
+        ('{"a": 1}'.encode("utf-16"), "got UTF-16 text, expected a test document in UTF-8"),
+        ('{"a": 1}'.encode("utf-16-be").replace(b"\0{", b"\xfe\xff\0{", 1), "got UTF-16"),
+        (b'{"a": "\xe9"}', r"got bytes that are not UTF-8 \(at offset 7\)"),
+        (b"\x89PNG\r\n\x1a\n\x00", r"got binary data \(a NUL byte at offset 8\)"),
+    ],
+)
+def test_encodings_other_than_utf8_are_named(raw: bytes, match: str) -> None:
+    with pytest.raises(InputError, match=rf"doc\.json: {match}"):
+        parse_json(raw, "doc.json", WHAT)
+
+
+def test_a_byte_order_mark_and_deep_enough_nesting_are_accepted() -> None:
+    assert parse_json(b'\xef\xbb\xbf{"a": [1]}', "doc.json", WHAT) == {"a": [1]}
+    deepest = "[" * MAX_DEPTH + "]" * MAX_DEPTH
+    assert parse_json(deepest.encode(), "doc.json", WHAT) is not None
+
+
+def test_files_missing_or_too_large(tmp_path: Path) -> None:
+    with pytest.raises(InputError, match=r"none\.json: no such file, expected a test document"):
+        read_json_file(tmp_path / "none.json", WHAT)
+    big = tmp_path / "big.json"
+    big.write_text("[" + "0," * 100 + "0]", encoding="utf-8")
+    with pytest.raises(InputError, match=r"big\.json: got 203 bytes, expected .* at most 100"):
+        read_json_file(big, WHAT, max_bytes=100)
+    with pytest.raises(InputError, match=r"cannot be read"):
+        read_json_file(tmp_path, WHAT)
+
+
+_json = st.recursive(
+    st.one_of(st.none(), st.booleans(), st.floats(), st.integers(), st.text(max_size=4)),
+    lambda inner: st.one_of(
+        st.lists(inner, max_size=4), st.dictionaries(st.text(max_size=3), inner, max_size=3)
+    ),
+    max_leaves=30,
+)
+
+
+@settings(max_examples=200, deadline=None)
+@given(doc=_json)
+def test_any_json_document_round_trips(doc: object) -> None:
+    text = json.dumps(doc)
+    assert json.dumps(parse_json(text.encode(), "doc.json", WHAT)) == text
+
+
+@settings(max_examples=300, deadline=None)
+@given(raw=st.binary(max_size=64))
+def test_random_bytes_give_a_document_or_an_input_error(raw: bytes) -> None:
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "raw.json"
+        path.write_bytes(raw)
+        try:
+            read_json_file(path, WHAT)
+        except InputError as exc:
+            assert "raw.json" in str(exc)
