@@ -26,7 +26,6 @@ axis ``(cos yaw, sin yaw, 0)``, ``width`` along ``(-sin yaw, cos yaw, 0)`` and
 
 from __future__ import annotations
 
-import json
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -36,6 +35,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from skyquill.errors import InputError
+from skyquill.io.json_read import read_json_file
 
 __all__ = ["CONTAINMENT_TOL", "BoxCorridor", "OrientedBox", "load_box_corridor"]
 
@@ -301,19 +301,7 @@ def load_box_corridor(path: str | Path) -> BoxCorridor:
     file = Path(path)
     if not file.is_file():
         raise _error("path", repr(src), "an existing corridor JSON file")
-    try:
-        text = file.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise _error("path", f"{src!r} ({exc})", "a readable UTF-8 JSON file") from exc
-    try:
-        data = json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise _error(
-            "path",
-            f"invalid JSON ({exc.msg} at line {exc.lineno}, column {exc.colno})",
-            "a JSON object",
-            src,
-        ) from exc
+    data = read_json_file(file, "a corridor JSON file")  # UTF-8, bounded size and depth
     if not isinstance(data, Mapping):
         raise _error("(top level)", type(data).__name__, "a JSON object {...}", src)
     _check_keys(data, "(top level)", _TOP_KEYS, _OPTIONAL_TOP_KEYS, src)
