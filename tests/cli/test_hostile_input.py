@@ -179,16 +179,55 @@ SPLINE_JSON = (
     '{{"format": "skyquill-bspline", "degree": 5, "duration_s": 1, "control_points": {points}}}'
 )
 for label, text, message in [
-    ("not json", "{", "invalid JSON"),
+    ("not json", "{", "malformed JSON"),
     ("deep json", "[" * 100_000 + "]" * 100_000, "nested"),
     ("other format", '{"format": "x"}', "format"),
     ("ragged spline", SPLINE_JSON.format(points="[[0,0],[1]]"), "ragged"),
-    ("nan spline", SPLINE_JSON.format(points=json.dumps([[0, 0, "NaN"]] + [[0, 0, 0]] * 5)), "NaN"),
+    (
+        "nan spline",
+        SPLINE_JSON.format(points=json.dumps([[0, 0, "NaN"]] + [[0, 0, 0]] * 5)),
+        "non-numeric",
+    ),
 ]:
     export_args = ["export", "{tmp}/t.json", "--out", "{out}/x.csv"]
     fly_args = ["fly", "{tmp}/t.json", "--out", "{out}"]
     CASES.append(Case(f"export json {label}", export_args, message, setup=_write("t.json", text)))
     CASES.append(Case(f"fly json {label}", fly_args, message, setup=_write("t.json", text)))
+
+# -- Stroke, SVG, region and image files ---------------------------------------------------------
+STROKE = [[0, 0], [1, 1]]
+SVG = '<svg xmlns="http://www.w3.org/2000/svg">{}</svg>'
+SQUARE_RING = [[0, 0], [10, 0], [10, 10], [0, 10], [0, 0]]
+READER_CASES = [
+    ("strokes deep", "write", "s.json", "[" * 100_000 + "]" * 100_000, "nested"),
+    ("strokes strings", "write", "s.json", json.dumps({"strokes": [[["1", "2"], [3, 4]]]}),
+     "two JSON numbers"),
+    ("strokes too many", "write", "s.json", json.dumps({"strokes": [STROKE] * 3000}), "at most"),
+    ("strokes utf-16", "write", "s.json", json.dumps({"strokes": [STROKE]}).encode("utf-16"),
+     "UTF-16"),
+    ("strokes binary", "write", "s.json", b"\x00\x01\x02" * 100, "binary"),
+    ("svg nan", "write", "d.svg", SVG.format('<path d="M 0 0 L NaN 5"/>'), "nan"),
+    ("svg many paths", "write", "d.svg", SVG.format('<path d="M 0 0 L 1 1"/>' * 3000), "at most"),
+    ("geojson strings", "cover", "r.geojson",
+     json.dumps({"type": "Polygon", "coordinates": [[[str(c) for c in p] for p in SQUARE_RING]]}),
+     "number"),
+    ("geojson z", "cover", "r.geojson",
+     json.dumps({"type": "Polygon", "coordinates": [[[*p, 5] for p in SQUARE_RING]]}), "2-D"),
+    ("geojson deep", "cover", "r.geojson", "[" * 100_000 + "]" * 100_000, "nested"),
+    ("geojson latin-1", "cover", "r.geojson", '{"type": "Polygon", "name": "é"}'.encode("latin-1"),
+     "UTF-8"),
+    ("image too large", "paint", "big.png", _png(20000, 20000), "pixels"),
+    ("image not an image", "paint", "x.png", b"not a png at all", "png"),
+]  # fmt: skip
+for label, cmd, name, data, message in READER_CASES:
+    if cmd == "write":
+        flag = "--svg" if name.endswith(".svg") else "--strokes"
+        args = ["write", flag, f"{{tmp}}/{name}", "--out", "{out}"]
+    elif cmd == "cover":
+        args = ["cover", f"{{tmp}}/{name}", "--out", "{out}"]
+    else:
+        args = ["paint", "--image", f"{{tmp}}/{name}", "--out", "{out}"]
+    CASES.append(Case(f"{cmd} {label}", args, message, setup=_write(name, data)))
 
 # -- Options out of range -----------------------------------------------------------------------
 OPTION_CASES = [

@@ -67,7 +67,7 @@ def test_holes_are_refused_not_ignored() -> None:
 @pytest.mark.parametrize(
     ("source", "message"),
     [
-        ("nope.geojson", "expected a GeoJSON or WKT file"),
+        ("nope.geojson", "expected an existing GeoJSON or WKT file"),
         ("POLYGON ((0 0, 1 0", "unreadable WKT"),
     ],
 )

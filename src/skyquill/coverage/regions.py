@@ -63,7 +63,8 @@ def load_region(source: str | Path) -> Polygon:
         is_file = False
     if not is_file:
         raise InputError(
-            f"region: got {text[:80]!r}, expected a GeoJSON or WKT file or a WKT string"
+            f"region: got {_shown(text)!r}, expected an existing GeoJSON or WKT file or a WKT "
+            "string"
         )
     size = path.stat().st_size
     if size > MAX_BYTES:
@@ -225,3 +226,8 @@ def coverage_fraction(region: Polygon, path: FloatArray, width: float) -> float:
     pts = as_array("path", path, ndim=2)
     swept = LineString(pts[:, :2]).buffer(0.5 * as_float("width", width, positive=True))
     return float(region.intersection(swept).area / region.area)
+
+
+def _shown(text: str, limit: int = 200) -> str:
+    """``text`` for a message: whole if short, else its start and its end (a file name)."""
+    return text if len(text) <= limit else f"{text[: limit // 2]}...{text[-limit // 2 :]}"
