@@ -103,3 +103,22 @@ def test_example_csv_is_the_paper_drawing() -> None:
     dots = read_dots_csv(example)
     assert dots.shape == (140, 2)
     assert np.allclose(np.sort(dots, axis=0), np.sort(paper_drawing(), axis=0), atol=1e-4)
+
+
+def test_a_decompression_bomb_is_a_named_error(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # Pillow refuses pictures over 2 x MAX_IMAGE_PIXELS; lowered here so no test allocates.
+    Image.new("L", (20, 20)).save(tmp_path / "bomb.png")
+    monkeypatch.setattr(Image, "MAX_IMAGE_PIXELS", 10)
+    with pytest.raises(InputError, match=r"--image: got 'bomb.png' that Pillow cannot read"):
+        load_darkness(tmp_path / "bomb.png")
+
+
+def test_stipple_refuses_a_picture_over_the_pixel_budget() -> None:
+    message = (
+        r"^darkness: got a 1001 x 1000 picture, expected at most 1,000,000 pixels "
+        r"\(downscale it, as load_darkness does to 200 px\)$"
+    )
+    with pytest.raises(InputError, match=message):
+        stipple(np.ones((1001, 1000)), 3, rng=np.random.default_rng(0))

@@ -28,6 +28,10 @@ from skyquill.validation import FloatArray, as_array, as_int
 STIPPLE_MAX_SIDE = 200
 #: Most dots a mission takes (a mural of 10,000 dots is ~ 20 h of flight already).
 MAX_DOTS = 10_000
+#: Most pixels :func:`stipple` takes: every Lloyd step queries every pixel's
+#: nearest dot (40 steps), ~1 s per million pixels each; :func:`load_darkness`
+#: gives at most STIPPLE_MAX_SIDE^2.
+MAX_STIPPLE_PIXELS = 1_000_000
 
 
 def read_dots_csv(path: str | Path) -> FloatArray:
@@ -73,7 +77,7 @@ def load_darkness(path: str | Path) -> FloatArray:
         with Image.open(file) as img:
             img.load()
             gray = img.convert("L")
-    except (UnidentifiedImageError, OSError, ValueError) as exc:
+    except (UnidentifiedImageError, OSError, ValueError, Image.DecompressionBombError) as exc:
         raise InputError(
             f"--image: got {file.name!r} that Pillow cannot read ({exc}), expected a PNG or JPEG"
         ) from None
@@ -122,6 +126,12 @@ def stipple(
 
     n = as_int("--dots", n_dots, low=1, high=MAX_DOTS)
     rho = np.clip(as_array("darkness", darkness, ndim=2), 0.0, 1.0)
+    if rho.size > MAX_STIPPLE_PIXELS:
+        raise InputError(
+            f"darkness: got a {rho.shape[0]} x {rho.shape[1]} picture, expected at most "
+            f"{MAX_STIPPLE_PIXELS:,} pixels (downscale it, as load_darkness does to "
+            f"{STIPPLE_MAX_SIDE} px)"
+        )
     if rho.sum() <= 0.0:
         raise InputError("--image: got an all-white picture, expected some dark pixels to stipple")
     h, w = rho.shape
