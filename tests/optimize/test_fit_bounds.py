@@ -86,6 +86,7 @@ def test_a_long_plan_is_refused_before_assembly() -> None:
         ({"tolerance_m": 0.0}, "tolerance_m: got 0, expected a number > 0"),
         ({"tolerance_m": float("nan")}, "tolerance_m: got nan, expected a finite number"),
         ({"best_effort": 1}, "best_effort: got 1, expected True or False"),
+        ({"max_stretches": 51}, "max_stretches: got 51, expected an integer from 0 to 50"),
     ],
 )
 def test_fidelity_options_are_checked(kwargs: dict[str, object], message: str) -> None:

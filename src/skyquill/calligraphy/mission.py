@@ -171,8 +171,9 @@ class WritingOptions:
         if self.norm_sides is not None:
             as_int("norm_sides", self.norm_sides, low=3, high=1024)
         as_int("degree", self.degree, low=3, high=7)
-        as_int("max_stretches", self.max_stretches, low=0)
-        as_int("resegment_iterations", self.resegment_iterations, low=0)
+        # Each stretch and each descent step is one more solve (bounded work).
+        as_int("max_stretches", self.max_stretches, low=0, high=50)
+        as_int("resegment_iterations", self.resegment_iterations, low=0, high=100)
         if self.resegment not in ("off", "fixed", "free"):
             raise InputError(
                 f"resegment: got {self.resegment!r}, expected 'off', 'fixed' or 'free'"

@@ -127,7 +127,8 @@ class FitOptions:
         as_int("degree", self.degree, low=3, high=7)
         if as_float("stretch_factor", self.stretch_factor) <= 1.0:
             raise InputError(f"stretch_factor: got {self.stretch_factor:g}, expected > 1")
-        as_int("max_stretches", self.max_stretches, low=0)
+        # Every stretch is one more solve; 1.25^50 is already 70 000 times slower.
+        as_int("max_stretches", self.max_stretches, low=0, high=50)
         if self.timing not in ("path", "segments"):
             raise InputError(f"timing: got {self.timing!r}, expected 'path' or 'segments'")
         fraction = as_float(

@@ -88,3 +88,15 @@ def test_the_route_estimate_bounds_the_route() -> None:
     built = float(np.linalg.norm(np.diff(points, axis=0), axis=1).sum())
     assert built <= route_length(world, board, home) + 1e-9
     assert built >= 0.7 * route_length(world, board, home)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [
+        ({"max_stretches": 10**6}, "max_stretches: got 1000000, expected an integer from 0 to 50"),
+        ({"resegment_iterations": 10**9}, "resegment_iterations: got 1000000000, expected an"),
+    ],
+)
+def test_solve_counts_are_bounded(kwargs: dict[str, int], message: str) -> None:
+    with pytest.raises(InputError, match=f"^{message}"):
+        WritingOptions(**kwargs)  # type: ignore[arg-type]
