@@ -400,6 +400,11 @@ def plan_writing(
 
     Raises
     ------
+    InputError
+        More than :data:`MAX_INPUT_POINTS` points or :data:`MAX_STROKES` strokes, a
+        route of more than :data:`MAX_ROUTE_SAMPLES` samples (estimated by
+        :func:`route_length` before it is built) or a solve of more than
+        :data:`MAX_SPANS` knot spans (before it is assembled).
     InfeasibleError
         The limits cannot be met, or the pen-down path stays beyond the
         tolerance, even after ``max_stretches`` stretches.

@@ -7,7 +7,10 @@ minimum-jerk smoothing with point deviation (paper 000 §5.2-5.3, paper 003
 §3.3.1), rest at both ends, the vehicle's limits through the convex hull. If
 the limits cannot be met in the time given (jerk is not part of the
 allocation) the whole timing is stretched by ``stretch_factor`` and the
-problem solved again; the factor used is reported, never hidden.
+problem solved again; the factor used is reported, never hidden. A fit
+farther from the points than the tolerance is not a result: allocated timings
+are redone slower, then it is an :class:`~skyquill.errors.InfeasibleError`
+(unless ``best_effort``).
 """
 
 from __future__ import annotations
@@ -37,7 +40,7 @@ from skyquill.validation import FloatArray, as_array, as_float, as_int, strictly
 MAX_SPANS = 100_000
 #: Most points one fit may take: each is a row of the deviation block
 #: (``degree + 1`` nonzeros per axis); 200 k points is a tablet recording
-#: of over half an hour at 100 Hz, and resample them first beyond it.
+#: of over half an hour at 100 Hz: beyond it, resample first.
 MAX_POINTS = 200_000
 #: Default fidelity tolerance as a fraction of the points' bounding-box
 #: diagonal when the timing is allocated (path or segments): the allocation
