@@ -127,3 +127,23 @@ def per_axis(name: str, value: Any, dim: int) -> FloatArray:
     if np.any(arr <= 0.0):
         raise InputError(f"{name}: got {arr.tolist()}, expected positive limits")
     return arr
+
+
+#: Largest seed accepted: numpy's SeedSequence takes any non-negative integer,
+#: but a seed that does not fit 64 bits is almost surely a typo or overflow.
+MAX_SEED = 2**64 - 1
+
+
+def as_seed(name: str, value: Any) -> int:
+    """A seed for :func:`numpy.random.default_rng`: an integer in ``[0, 2**64 - 1]``.
+
+    ``default_rng(-1)`` raises a bare ``ValueError``; this names the argument first.
+    """
+    if isinstance(value, bool) or not isinstance(value, int | np.integer):
+        raise InputError(f"{name}: got {_describe(value)}, expected an integer >= 0")
+    seed = int(value)
+    if seed < 0:
+        raise InputError(f"{name}: got {seed}, expected an integer >= 0")
+    if seed > MAX_SEED:
+        raise InputError(f"{name}: got {seed}, expected an integer from 0 to 2**64 - 1")
+    return seed

@@ -216,3 +216,12 @@ def test_random_bytes_give_an_input_error(raw: bytes, prefix: bytes) -> None:
         path.write_bytes(prefix + raw)
         with pytest.raises(InputError, match=r"--image: got 'raw.png'"):
             load_darkness(path)
+
+
+def test_stipple_refuses_a_picture_over_the_pixel_budget() -> None:
+    message = (
+        r"^darkness: got a 1001 x 1000 picture, expected at most 1,000,000 pixels "
+        r"\(downscale it, as load_darkness does to 200 px\)$"
+    )
+    with pytest.raises(InputError, match=message):
+        stipple(np.ones((1001, 1000)), 3, rng=np.random.default_rng(0))

@@ -190,3 +190,11 @@ def test_missing_rotorpy_says_how_to_install(
     monkeypatch.setitem(sys.modules, "rotorpy.environments", None)  # import now fails
     with pytest.raises(ImportError, match=r"pip install 'skyquill\[rotorpy\]'"):
         fly_rotorpy(circle)
+
+
+def test_rotorpy_refuses_a_flight_over_the_step_budget(circle: SplineTrajectory) -> None:
+    long = SplineTrajectory(np.zeros((6, 3)), 5, 1e6)
+    with pytest.raises(InputError, match=r"expected at most 2,000,000 steps"):
+        fly_rotorpy(long)
+    with pytest.raises(InputError, match=r"rate_hz: got 1e\+06 Hz, expected 50 to 10000 Hz"):
+        fly_rotorpy(circle, rate_hz=1e6)

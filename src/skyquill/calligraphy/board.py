@@ -15,6 +15,11 @@ import numpy as np
 from skyquill.errors import InputError
 from skyquill.validation import FloatArray, as_array, as_float
 
+#: Highest lift accepted, m: the brush only has to clear the surface (default
+#: 5 cm), every lift is flown twice per stroke and sampled every centimetre,
+#: and a lift of metres is a unit error (1000 once hung the planner).
+MAX_LIFT_M = 1.0
+
 
 @dataclass(frozen=True)
 class Board:
@@ -30,7 +35,8 @@ class Board:
     origin
         World position (3,) of the character box's bottom-left corner, m.
     lift_m
-        How far the brush leaves the surface between strokes, m.
+        How far the brush leaves the surface between strokes, m, in
+        ``(0, MAX_LIFT_M]``.
     """
 
     kind: Literal["horizontal", "wall"] = "horizontal"
@@ -41,7 +47,11 @@ class Board:
         if self.kind not in ("horizontal", "wall"):
             raise InputError(f"board kind: got {self.kind!r}, expected 'horizontal' or 'wall'")
         object.__setattr__(self, "origin", as_array("board origin", self.origin, shape=(3,)))
-        as_float("lift_m", self.lift_m, positive=True)
+        if as_float("lift_m", self.lift_m, positive=True) > MAX_LIFT_M:
+            raise InputError(
+                f"lift_m: got {self.lift_m:g} m, expected at most {MAX_LIFT_M:g} m (the brush "
+                "only clears the surface between strokes)"
+            )
 
     @property
     def normal(self) -> FloatArray:

@@ -50,6 +50,26 @@ if TYPE_CHECKING:  # the simulator is imported only to fly
 TRANSIT_SPACING_M = 0.01
 #: Largest input a mission takes, points: a tablet at 200 Hz for 15 minutes.
 MAX_INPUT_POINTS = 200_000
+#: Character sizes accepted, m. Below 1 cm a character is narrower than a brush
+#: stroke and its 1 % tolerance (0.1 mm) is finer than a quadrotor's position
+#: estimate (motion capture: ~1 mm), so "within tolerance" would mean nothing;
+#: above 20 m the route (sampled every TRANSIT_SPACING_M) and the flight grow
+#: past a board and a battery: that is sky writing, not calligraphy.
+SIZE_RANGE_M = (0.01, 20.0)
+#: Longest brush accepted, m: the tip is modelled as rigid along the thrust
+#: axis (``L (e_z - b3)``); a longer "brush" is a tether that swings on its own.
+MAX_BRUSH_LENGTH_M = 2.0
+#: Most strokes per mission: each adds a lift, a transit and a pen window
+#: (a page of text is a few hundred); split a longer text between drones.
+MAX_STROKES = 2_000
+#: Most route samples (stroke points plus lifts and transits every
+#: TRANSIT_SPACING_M), estimated from the route's length before it is built:
+#: each is a row of the QP's deviation block (~1 kB with its factors).
+MAX_ROUTE_SAMPLES = 400_000
+#: Most knot spans of one solve, checked before each assembly: 3 x (spans + 5)
+#: unknowns and a hull block per span and limit; 20 000 spans is 1000 s of
+#: flight at the default 0.05 s, and ~1 GB of KKT factors.
+MAX_SPANS = 20_000
 #: Solves of the tilt compensation's fixed-point iteration.
 TILT_PASSES = 3
 GRAVITY = 9.81  # m/s^2
@@ -62,7 +82,8 @@ class WritingOptions:
     Attributes
     ----------
     size_m
-        The strokes' larger side is scaled to this (paper 000: 0.5 m boards).
+        The strokes' larger side is scaled to this, m, within
+        :data:`SIZE_RANGE_M` (paper 000: 0.5 m boards).
     limits
         The vehicle's limits (``vmax`` the speed, ``amax`` and ``jmax`` the
         norms; per-axis boxes only as ``*_axis``).
@@ -81,8 +102,8 @@ class WritingOptions:
     degree
         Spline degree.
     brush_length_m
-        Tip to vehicle distance along the board normal, m (the default
-        simulated vehicle's brush).
+        Tip to vehicle distance along the board normal, m, at most
+        :data:`MAX_BRUSH_LENGTH_M` (the default simulated vehicle's brush).
     resegment
         Time re-segmentation after the first feasible, faithful plan (paper
         000 §5.4): ``"fixed"`` keeps the total time, ``"free"`` lets it move
@@ -133,14 +154,26 @@ class WritingOptions:
             as_float(name, getattr(self, name), positive=True)
         for name in ("data_weight", "turning_weight", "transit_weight", "brush_length_m"):
             as_float(name, getattr(self, name), nonneg=True)
+        low, high = SIZE_RANGE_M
+        if not low <= self.size_m <= high:
+            raise InputError(
+                f"size_m: got {self.size_m:g} m, expected {low:g} to {high:g} m (a character "
+                "legible with a brush, within the position accuracy, on one board)"
+            )
+        if self.brush_length_m > MAX_BRUSH_LENGTH_M:
+            raise InputError(
+                f"brush_length_m: got {self.brush_length_m:g} m, expected at most "
+                f"{MAX_BRUSH_LENGTH_M:g} m (the brush is modelled as rigid)"
+            )
         for name in ("tolerance_m", "turning_threshold_m"):
             if getattr(self, name) is not None:
                 as_float(name, getattr(self, name), positive=True)
         if self.norm_sides is not None:
             as_int("norm_sides", self.norm_sides, low=3, high=1024)
         as_int("degree", self.degree, low=3, high=7)
-        as_int("max_stretches", self.max_stretches, low=0)
-        as_int("resegment_iterations", self.resegment_iterations, low=0)
+        # Each stretch and each descent step is one more solve (bounded work).
+        as_int("max_stretches", self.max_stretches, low=0, high=50)
+        as_int("resegment_iterations", self.resegment_iterations, low=0, high=100)
         if self.resegment not in ("off", "fixed", "free"):
             raise InputError(
                 f"resegment: got {self.resegment!r}, expected 'off', 'fixed' or 'free'"
@@ -311,6 +344,39 @@ def _route(
     return np.vstack(route.points), np.concatenate(route.role)
 
 
+def route_length(
+    strokes_world: tuple[FloatArray, ...], board: Board, home: FloatArray | None
+) -> float:
+    """An upper estimate of the route's length, m, without building it.
+
+    Strokes, two lifts per stroke, the transits between strokes and, with a
+    ``home`` (3,), the legs to and from it (taxicab: climb, then fly).
+    """
+    ends = [(s[0], s[-1]) for s in strokes_world]
+    drawn = sum(float(np.linalg.norm(np.diff(s, axis=0), axis=1).sum()) for s in strokes_world)
+    moves = sum(float(np.linalg.norm(b[0] - a[1])) for a, b in itertools.pairwise(ends))
+    legs = 0.0
+    if home is not None:
+        legs = float(np.abs(ends[0][0] - home).sum() + np.abs(ends[-1][1] - home).sum())
+    return drawn + moves + legs + 2.0 * len(strokes_world) * board.lift_m
+
+
+def _check_route_size(
+    strokes_world: tuple[FloatArray, ...], board: Board, home: FloatArray | None
+) -> None:
+    """Refuse a route of more than :data:`MAX_ROUTE_SAMPLES` samples before building it."""
+    length = route_length(strokes_world, board, home)
+    n_points = sum(len(s) for s in strokes_world)
+    samples = length / TRANSIT_SPACING_M + n_points
+    if samples > MAX_ROUTE_SAMPLES:
+        raise InputError(
+            f"strokes: got a route of about {length:.4g} m ({samples:.3g} samples, one every "
+            f"{100 * TRANSIT_SPACING_M:g} cm), expected at most {MAX_ROUTE_SAMPLES:,} samples, "
+            f"i.e. about {MAX_ROUTE_SAMPLES * TRANSIT_SPACING_M / 1e3:g} km (a smaller size_m, "
+            "lift_m, a home nearer the board or fewer strokes)"
+        )
+
+
 def plan_writing(
     strokes: Strokes,
     board: Board | None = None,
@@ -334,6 +400,11 @@ def plan_writing(
 
     Raises
     ------
+    InputError
+        More than :data:`MAX_INPUT_POINTS` points or :data:`MAX_STROKES` strokes, a
+        route of more than :data:`MAX_ROUTE_SAMPLES` samples (estimated by
+        :func:`route_length` before it is built) or a solve of more than
+        :data:`MAX_SPANS` knot spans (before it is assembled).
     InfeasibleError
         The limits cannot be met, or the pen-down path stays beyond the
         tolerance, even after ``max_stretches`` stretches.
@@ -344,6 +415,11 @@ def plan_writing(
             f"strokes: got {strokes.n_points:,} points, expected at most {MAX_INPUT_POINTS:,} "
             "(resample the input: a 0.5 m character needs a few hundred)"
         )
+    if len(strokes.paths) > MAX_STROKES:
+        raise InputError(
+            f"strokes: got {len(strokes.paths):,} strokes, expected at most {MAX_STROKES:,} "
+            "(split the text between drones or missions)"
+        )
     opts = options or WritingOptions()
     board = board or Board()
     home_pos = None if home is None else as_array("home", home, shape=(3,))
@@ -351,6 +427,7 @@ def plan_writing(
         home_pos = home_pos - opts.brush_length_m * board.normal  # the tip's home
     scaled = strokes.scaled(opts.size_m)
     strokes_world = tuple(board.to_world(path) for path in scaled.paths)
+    _check_route_size(strokes_world, board, home_pos)
     points, roles = _route(strokes_world, board, home_pos)
     vmax, amax = opts.limits.timing_bounds()
     times = allocate_path_times(points, vmax, 0.5 * amax)
@@ -521,6 +598,13 @@ def _problem(
     n_ctrl: int | None = None,
 ) -> SmoothingProblem:
     duration = float(times[-1])
+    spans = n_ctrl - opts.degree if n_ctrl else max(1, math.ceil(duration / opts.knot_interval))
+    if spans > MAX_SPANS:
+        raise InputError(
+            f"knot_interval: got {opts.knot_interval:g} s for a {duration:.4g} s flight, i.e. "
+            f"{spans:,} knot spans, expected at most {MAX_SPANS:,} (a longer knot_interval, "
+            "a smaller size_m or fewer strokes)"
+        )
     stroke = roles >= 0
     deviations = [
         PointDeviation(times[stroke], points[stroke], opts.data_weight),
@@ -531,7 +615,7 @@ def _problem(
     return SmoothingProblem(
         dim=3,
         degree=opts.degree,
-        n_ctrl=n_ctrl or max(1, math.ceil(duration / opts.knot_interval)) + opts.degree,
+        n_ctrl=spans + opts.degree,
         duration=duration,
         smoothness={3: 1.0},
         deviations=tuple(deviations),

@@ -40,6 +40,10 @@ if TYPE_CHECKING:
 #: Extra room between boards beyond the required separation, m (lifts, transits).
 BOARD_MARGIN_M = 0.25
 
+#: Most drones in one show: the separation check compares every pair over the
+#: whole flight (n^2 / 2 distance sweeps) and paper 000's shows had a handful.
+MAX_DRONES = 64
+
 #: How long to wait for a ``dask.distributed`` scheduler to answer, s.
 SCHEDULER_TIMEOUT_S = 5.0
 
@@ -90,7 +94,7 @@ def layout(
     A horizontal board lies at ``height_m``; a wall is the plane ``y = 0`` with
     the character's bottom at ``height_m``.
     """
-    as_int("drones", n, low=1, high=64)
+    as_int("drones", n, low=1, high=MAX_DRONES)
     pitch = as_float("size_m", size_m, positive=True) + separation_m + BOARD_MARGIN_M
     out = []
     for i in range(n):

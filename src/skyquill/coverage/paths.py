@@ -77,10 +77,10 @@ def contours(
         Rings ``(K, 2)`` without the repeated closing vertex, counter-clockwise,
         each starting at its vertex nearest to the previous ring's start.
     """
-    w = check_width(region, width)
     eps = as_float("epsilon", epsilon, positive=True)
     if eps > 1.0:
         raise InputError(f"epsilon: got {eps:g}, expected a value in (0, 1]")
+    w = check_width(region, width, eps)
     if mode == "offset":
         rings = _offset_rings(region, eps * w)
     elif mode == "homothetic":

@@ -95,7 +95,7 @@ class CoverageOptions:
     rate : float
         Setpoint rate, Hz (the control period of §2.2 is ``1 / rate``).
     altitude : float
-        Flight height written to the setpoints, m.
+        Flight height above the ground written to the setpoints, m, > 0.
     grid : int or None
         Speed-LP grid points; ``None`` picks them from the path length.
     norm_sides : int
@@ -122,7 +122,10 @@ class CoverageOptions:
         for name in ("width", "delta", "rate"):
             as_float(name, getattr(self, name), positive=True)
         _check_limits(self.limits)
-        as_float("altitude", self.altitude)
+        if as_float("altitude", self.altitude) <= 0.0:
+            raise InputError(
+                f"altitude: got {self.altitude:g} m, expected a height above the ground, > 0"
+            )
         if self.pattern not in PATTERNS:
             raise InputError(f"pattern: got {self.pattern!r}, expected one of {PATTERNS}")
         if self.contours not in CONTOUR_MODES:
@@ -336,6 +339,8 @@ def plan_tuned(region: Polygon, options: CoverageOptions, target: float) -> Cove
     goal = as_float("min_coverage", target, positive=True)
     if goal > 1.0:
         raise InputError(f"min_coverage: got {goal:g}, expected a fraction in (0, 1]")
+    # Every trial is checked against the budget at the densest spacing tried.
+    _check_region(region, replace(options, epsilon=min(TUNING_EPSILONS)))
     deltas = (options.delta,) if options.pattern == "zigzag-stop" else TUNING_DELTAS
     laps = (False,) if options.pattern == "spiral" else (False, True)
     candidates: list[CoverageOptions] = []
@@ -364,6 +369,19 @@ def plan_tuned(region: Polygon, options: CoverageOptions, target: float) -> Cove
     return min(plans, key=lambda plan: plan.duration)
 
 
+def _check_region(region: Polygon, options: CoverageOptions) -> None:
+    """Refuse a region too large, or a path too long, before any path is built."""
+    if not isinstance(region, Polygon):
+        raise InputError(f"region: got {type(region).__name__}, expected a shapely Polygon")
+    minx, miny, maxx, maxy = region.bounds
+    if max(maxx - minx, maxy - miny) > MAX_REGION_SIZE_M:
+        raise InputError(
+            f"region: got a region {maxx - minx:.4g} x {maxy - miny:.4g} m, expected at most "
+            f"{MAX_REGION_SIZE_M:g} m across (split it into several missions)"
+        )
+    check_width(region, options.width, options.epsilon)
+
+
 def _plan_or_none(region: Polygon, options: CoverageOptions) -> CoveragePlan | None:
     """The plan, or ``None`` where the path cannot be timed within the limits."""
     try:
@@ -390,7 +408,10 @@ def plan_coverage(region: Polygon, options: CoverageOptions | None = None) -> Co
     Raises
     ------
     InputError
-        Width not positive or too large for the region, bad options.
+        Width not positive or too large for the region, bad options; a path
+        estimated longer than :data:`~skyquill.coverage.regions.MAX_PATH_LENGTH_M`
+        (refused before it is built; the speed LP's size is capped by
+        :data:`GRID_POINTS` and ``grid``).
     InfeasibleError
         The path cannot be timed within the limits. A concave region's
         spiral whose joins are too tight to time is flown part by part,
@@ -398,15 +419,7 @@ def plan_coverage(region: Polygon, options: CoverageOptions | None = None) -> Co
     """
     start = time.perf_counter()
     opts = options or CoverageOptions()
-    if not isinstance(region, Polygon):
-        raise InputError(f"region: got {type(region).__name__}, expected a shapely Polygon")
-    minx, miny, maxx, maxy = region.bounds
-    if max(maxx - minx, maxy - miny) > MAX_REGION_SIZE_M:
-        raise InputError(
-            f"region: got a region {maxx - minx:.4g} x {maxy - miny:.4g} m, expected at most "
-            f"{MAX_REGION_SIZE_M:g} m across (split it into several missions)"
-        )
-    check_width(region, opts.width)
+    _check_region(region, opts)
     waypoints, path = covering_path(region, opts)
     try:
         timed = _timed_path(waypoints, path, opts)

@@ -209,9 +209,38 @@ def _check_spikes(ring: FloatArray, name: str) -> None:
         )
 
 
-def check_width(region: Polygon, width: float) -> float:
-    """The coverage diameter ``width`` (m), > 0 and small enough to need a path at all."""
+#: Longest covering path accepted, m, estimated before any path is made.
+#: Planning time grows with it (a 100 m square at a 2 m swath, ~5 km, plans in
+#: ~15 s) and the speed LP's grid is capped (``GRID_POINTS`` of
+#: :mod:`skyquill.coverage.plan`), so beyond ~10 km it is too coarse to hold
+#: the limits (a 200 m square at 2 m, ~20 km, fails after planning); 10 km at
+#: 3 m/s is also about an hour of flight, more than one battery.
+MAX_PATH_LENGTH_M = 10_000.0
+
+
+def estimate_path_length(region: Polygon, spacing: float) -> float:
+    """About how long a path with lines ``spacing`` m apart covering ``region`` is, m.
+
+    Area over spacing (the sweeps or rings) plus the perimeter (turns, laps):
+    an over-estimate of the planned spiral and zigzag lengths (by ~9 % on a
+    100 m square at a 2 m swath, ~2x on a 10 m one, where the perimeter term dominates).
+    """
+    return float(region.area / spacing + region.exterior.length)
+
+
+def check_width(region: Polygon, width: float, epsilon: float = 1.0) -> float:
+    """The coverage diameter ``width`` (m), > 0, small enough to need a path at all
+    and large enough for a path of at most :data:`MAX_PATH_LENGTH_M` at a spacing
+    of ``epsilon * width`` (checked first, from the area: nothing is built)."""
     w = as_float("width", width, positive=True)
+    spacing = epsilon * w
+    length = estimate_path_length(region, spacing)
+    if length > MAX_PATH_LENGTH_M:
+        raise InputError(
+            f"width: got {w:g} m on a region of {region.area:.4g} m², i.e. a path of about "
+            f"{length / 1e3:.4g} km, expected at most {MAX_PATH_LENGTH_M / 1e3:g} km "
+            f"({_what_fits(region, epsilon)})"
+        )
     if region.buffer(-0.5 * w).is_empty:
         minx, miny, maxx, maxy = region.bounds
         raise InputError(
@@ -219,6 +248,15 @@ def check_width(region: Polygon, width: float) -> float:
             f"{maxx - minx:.3g} x {maxy - miny:.3g} m): one disc would already cover it"
         )
     return w
+
+
+def _what_fits(region: Polygon, epsilon: float) -> str:
+    """Which swath would fit the path budget, or that the region must be split."""
+    room = MAX_PATH_LENGTH_M - region.exterior.length
+    if room <= 0.0:
+        return "the perimeter alone is too long: split the region into several missions"
+    least = region.area / (epsilon * room)
+    return f"a swath of at least {least:.3g} m, or a smaller region: split it into missions"
 
 
 def coverage_fraction(region: Polygon, path: FloatArray, width: float) -> float:

@@ -7,13 +7,16 @@ minimum-jerk smoothing with point deviation (paper 000 §5.2-5.3, paper 003
 §3.3.1), rest at both ends, the vehicle's limits through the convex hull. If
 the limits cannot be met in the time given (jerk is not part of the
 allocation) the whole timing is stretched by ``stretch_factor`` and the
-problem solved again; the factor used is reported, never hidden.
+problem solved again; the factor used is reported, never hidden. A fit
+farther from the points than the tolerance is not a result: allocated timings
+are redone slower, then it is an :class:`~skyquill.errors.InfeasibleError`
+(unless ``best_effort``).
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Literal
 
 import numpy as np
@@ -31,7 +34,29 @@ from skyquill.solvers import DEFAULT_BACKEND
 from skyquill.spline import HullKind
 from skyquill.validation import FloatArray, as_array, as_float, as_int, strictly_increasing
 
+#: Most knot spans one fit may have: the QP has ``(spans + degree) * d``
+#: unknowns and a hull constraint block per span and limit; beyond this the
+#: assembly alone takes gigabytes (refused before assembly).
 MAX_SPANS = 100_000
+#: Most points one fit may take: each is a row of the deviation block
+#: (``degree + 1`` nonzeros per axis); 200 k points is a tablet recording
+#: of over half an hour at 100 Hz: beyond it, resample first.
+MAX_POINTS = 200_000
+#: Default fidelity tolerance as a fraction of the points' bounding-box
+#: diagonal when the timing is allocated (path or segments): the allocation
+#: slows in turns, so the fit follows the points closely (bundled spiral: 10 mm
+#: of a 1.1 m diagonal); a fit farther off is not the drawing asked for.
+TOLERANCE_FRACTION = 0.01
+#: The same with the caller's times (a tablet's clock): the fit is measured at
+#: each point's recorded time, and a hand faster than the limits allow makes
+#: the fit lag behind its clock, so the deviation measures the clock more than
+#: the shape (bundled spiral: 74 mm RMS, 241 mm max, 22 % of its 1.08 m
+#: diagonal, at the default limits); only a fit that lost the drawing is refused.
+GIVEN_TOLERANCE_FRACTION = 0.3
+#: How many times an allocated timing is redone with half the acceleration
+#: when the fit misses the tolerance (bundled waypoints at 1.5 m/s, 1 m/s^2,
+#: 4 m/s^3: 250 mm off at 0.5, 0.1 mm at 0.25); each costs one more solve.
+MAX_SLOWDOWNS = 3
 
 
 @dataclass(frozen=True)
@@ -70,6 +95,14 @@ class FitOptions:
         deviation 51 mm at 1.0, 10 mm at 0.5, 7 mm at 0.35 for 19% more time).
     stretch_factor, max_stretches
         Timing stretch on infeasibility.
+    tolerance_m
+        Largest accepted distance, m, between a point and the fit at the point's
+        time. ``None``: :data:`TOLERANCE_FRACTION` of the points' bounding-box
+        diagonal with allocated times, :data:`GIVEN_TOLERANCE_FRACTION` of it
+        with the caller's times (see :func:`default_tolerance`).
+    best_effort
+        Return a fit that misses the tolerance instead of raising
+        :class:`~skyquill.errors.InfeasibleError` (as ``WritingOptions.best_effort``).
     """
 
     limits: VehicleLimits = field(default_factory=lambda: VehicleLimits(1.0, 2.0, 10.0))
@@ -83,6 +116,8 @@ class FitOptions:
     allocation_accel_fraction: float = 0.5
     stretch_factor: float = 1.25
     max_stretches: int = 10
+    tolerance_m: float | None = None
+    best_effort: bool = False
 
     def __post_init__(self) -> None:
         if not isinstance(self.limits, VehicleLimits):
@@ -95,7 +130,8 @@ class FitOptions:
         as_int("degree", self.degree, low=3, high=7)
         if as_float("stretch_factor", self.stretch_factor) <= 1.0:
             raise InputError(f"stretch_factor: got {self.stretch_factor:g}, expected > 1")
-        as_int("max_stretches", self.max_stretches, low=0)
+        # Every stretch is one more solve; 1.25^50 is already 70 000 times slower.
+        as_int("max_stretches", self.max_stretches, low=0, high=50)
         if self.timing not in ("path", "segments"):
             raise InputError(f"timing: got {self.timing!r}, expected 'path' or 'segments'")
         fraction = as_float(
@@ -103,6 +139,22 @@ class FitOptions:
         )
         if fraction > 1.0:
             raise InputError(f"allocation_accel_fraction: got {fraction:g}, expected <= 1")
+        if self.tolerance_m is not None:
+            as_float("tolerance_m", self.tolerance_m, positive=True)
+        if not isinstance(self.best_effort, bool):
+            raise InputError(f"best_effort: got {self.best_effort!r}, expected True or False")
+
+
+def default_tolerance(points: FloatArray, given_times: bool) -> float:
+    """The default fidelity tolerance, m, of a fit to ``points`` (N, d), m.
+
+    A fraction of the bounding-box diagonal (:data:`TOLERANCE_FRACTION`, or
+    :data:`GIVEN_TOLERANCE_FRACTION` when the times are the caller's), never
+    below 1 mm (a single point's noise).
+    """
+    diagonal = float(np.linalg.norm(points.max(axis=0) - points.min(axis=0)))
+    fraction = GIVEN_TOLERANCE_FRACTION if given_times else TOLERANCE_FRACTION
+    return max(fraction * diagonal, 1e-3)
 
 
 @dataclass(frozen=True)
@@ -123,6 +175,10 @@ class PointFit:
         The limits imposed.
     rms_deviation_m, max_deviation_m
         ``||p(t_i) - points_i||`` statistics.
+    accel_fraction
+        The fraction of ``amax`` the allocation used (``None`` with given
+        times): ``options.allocation_accel_fraction``, halved up to
+        :data:`MAX_SLOWDOWNS` times while the fit missed the tolerance.
     """
 
     result: FitResult
@@ -132,6 +188,7 @@ class PointFit:
     limits: tuple[DerivativeLimit, ...]
     rms_deviation_m: float
     max_deviation_m: float
+    accel_fraction: float | None = None
 
 
 def fit_points(
@@ -149,20 +206,52 @@ def fit_points(
         Shape (N,), s, strictly increasing, or ``None`` to allocate them.
     options
         :class:`FitOptions`; defaults if ``None``.
+
+    Raises
+    ------
+    InputError
+        Bad points, times or options; more than :data:`MAX_POINTS` points or
+        :data:`MAX_SPANS` knot spans (refused before the QP is assembled).
+    InfeasibleError
+        The limits cannot be met within ``max_stretches``, or the fit is farther
+        than the tolerance from the points (unless ``best_effort``); allocated
+        timings are first redone slower (see ``PointFit.accel_fraction``).
     """
     opts = options or FitOptions()
     pts = as_array("points", points, ndim=2, max_abs=MAX_COORDINATE_M)
     if pts.shape[1] not in (2, 3) or pts.shape[0] < 2:
         raise InputError(f"points: got shape {pts.shape}, expected (N >= 2, 2 or 3)")
-    if times is None:
-        vmax, amax = opts.limits.timing_bounds()
-        allocate = allocate_path_times if opts.timing == "path" else allocate_segment_times
-        t = allocate(pts, vmax, opts.allocation_accel_fraction * amax)
-    else:
+    if pts.shape[0] > MAX_POINTS:
+        raise InputError(
+            f"points: got {pts.shape[0]:,} points, expected at most {MAX_POINTS:,} "
+            "(resample the recording more coarsely)"
+        )
+    limits = opts.limits.derivative_limits(pts.shape[1], sides=opts.norm_sides)
+    if times is not None:
         t = as_array("times", times, shape=(pts.shape[0],), max_abs=1e7)
         strictly_increasing("times", t)
-        t = t - t[0]
-    limits = opts.limits.derivative_limits(pts.shape[1], sides=opts.norm_sides)
+        fit = _fit_timed(pts, t - t[0], limits, opts)
+        _check_fidelity(fit.max_deviation_m, pts, True, opts)
+        return fit
+    # The allocation knows nothing of jerk: when the fit cuts the turns, allocate
+    # again with half the acceleration (slower turns), reported in the result.
+    vmax, amax = opts.limits.timing_bounds()
+    allocate = allocate_path_times if opts.timing == "path" else allocate_segment_times
+    fraction = opts.allocation_accel_fraction
+    for slowdown in range(MAX_SLOWDOWNS + 1):
+        fit = _fit_timed(pts, allocate(pts, vmax, fraction * amax), limits, opts)
+        fit = replace(fit, accel_fraction=fraction)
+        if fit.max_deviation_m <= _tolerance(pts, False, opts) or slowdown == MAX_SLOWDOWNS:
+            break
+        fraction *= 0.5
+    _check_fidelity(fit.max_deviation_m, pts, False, opts)
+    return fit
+
+
+def _fit_timed(
+    pts: FloatArray, t: FloatArray, limits: tuple[DerivativeLimit, ...], opts: FitOptions
+) -> PointFit:
+    """Fit at times ``t`` (N,), stretched by ``stretch_factor`` while infeasible."""
     scale = 1.0
     for attempt in range(opts.max_stretches + 1):
         try:
@@ -175,6 +264,28 @@ def fit_points(
     err = np.linalg.norm(result.trajectory.evaluate(t * scale) - pts, axis=1)
     return PointFit(
         result, pts, t * scale, scale, limits, float(np.sqrt(np.mean(err**2))), float(err.max())
+    )
+
+
+def _tolerance(pts: FloatArray, given: bool, opts: FitOptions) -> float:
+    return opts.tolerance_m if opts.tolerance_m is not None else default_tolerance(pts, given)
+
+
+def _check_fidelity(max_dev: float, pts: FloatArray, given: bool, opts: FitOptions) -> None:
+    """Raise InfeasibleError when the fit is farther than the tolerance from the points."""
+    tol = _tolerance(pts, given, opts)
+    if max_dev <= tol or opts.best_effort:
+        return
+    helps = (
+        "times further apart (slower), looser limits"
+        if given
+        else "slower timing (a lower vmax), looser amax/jmax"
+    )
+    raise InfeasibleError(
+        f"tolerance_m: the fit is {max_dev * 1e3:.4g} mm from the points at most, expected "
+        f"at most {tol * 1e3:.4g} mm; {helps}, a shorter knot_interval (more knots), "
+        "a larger tolerance_m or best_effort would help",
+        ("fidelity",),
     )
 
 

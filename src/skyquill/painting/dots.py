@@ -35,6 +35,10 @@ MAX_DOTS = 10_000
 MAX_IMAGE_PIXELS = 40_000_000
 #: The picture formats read: Pillow's others (EPS runs Ghostscript, for one) are refused.
 IMAGE_FORMATS = ("PNG", "JPEG")
+#: Most pixels :func:`stipple` takes: every Lloyd step queries every pixel's
+#: nearest dot (40 steps), ~1 s per million pixels each; :func:`load_darkness`
+#: gives at most STIPPLE_MAX_SIDE^2.
+MAX_STIPPLE_PIXELS = 1_000_000
 
 
 def read_dots_csv(path: str | Path) -> FloatArray:
@@ -183,6 +187,12 @@ def stipple(
 
     n = as_int("--dots", n_dots, low=1, high=MAX_DOTS)
     rho = np.clip(as_array("darkness", darkness, ndim=2), 0.0, 1.0)
+    if rho.size > MAX_STIPPLE_PIXELS:
+        raise InputError(
+            f"darkness: got a {rho.shape[0]} x {rho.shape[1]} picture, expected at most "
+            f"{MAX_STIPPLE_PIXELS:,} pixels (downscale it, as load_darkness does to "
+            f"{STIPPLE_MAX_SIDE} px)"
+        )
     if rho.sum() <= 0.0:
         raise InputError("--image: got an all-white picture, expected some dark pixels to stipple")
     h, w = rho.shape

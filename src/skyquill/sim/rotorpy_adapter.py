@@ -59,6 +59,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from skyquill.errors import InputError, SolverError
+from skyquill.sim.bounds import check_rate, check_steps
 from skyquill.sim.controllers import OuterLoop
 from skyquill.sim.result import Flight
 from skyquill.trajectory import Trajectory
@@ -260,7 +261,8 @@ def fly_rotorpy(
         outer loop is reset first.
     rate_hz
         Simulation and control rate, Hz (RotorPy's ``sim_rate``; commands are
-        held for ``1 / rate_hz`` s, the rigid body is integrated by RK45).
+        held for ``1 / rate_hz`` s, the rigid body is integrated by RK45), within
+        the range and step budget of :mod:`skyquill.sim.bounds`.
     start_at_reference
         Start at rest, level, motors at hover speed, at the reference's start
         position (``True``) or at the world origin ``(0, 0, 0)`` (``False``,
@@ -313,7 +315,8 @@ def fly_rotorpy(
         raise ImportError(_INSTALL_HINT) from exc
 
     reference = RotorPyTrajectory(trajectory, hover_height_m)
-    rate = as_float("rate_hz", rate_hz, positive=True)
+    rate = check_rate(rate_hz)
+    check_steps(reference.duration, rate)  # RotorPy keeps every step's state
     outer = _check_controller(controller)
     params = _vehicle_params(vehicle)
 

@@ -9,13 +9,14 @@ from collections import deque
 import numpy as np
 
 from skyquill.errors import InputError
+from skyquill.sim.bounds import check_rate, check_steps
 from skyquill.sim.contact import ContactBoard
 from skyquill.sim.controllers import OuterLoop, RPTController
 from skyquill.sim.disturbances import Disturbances, WindField
 from skyquill.sim.result import Flight
 from skyquill.sim.vehicle import GRAVITY, Conversion, Quadrotor, thrust_command
 from skyquill.trajectory import Trajectory, sample_times
-from skyquill.validation import FloatArray, as_float
+from skyquill.validation import FloatArray
 
 E_Z = np.array([0.0, 0.0, 1.0])
 
@@ -57,7 +58,8 @@ def simulate(
     rng
         The only source of randomness; required when gusts or noise are set.
     rate_hz
-        Control and integration rate, Hz.
+        Control and integration rate, Hz, within
+        [:data:`~skyquill.sim.bounds.MIN_RATE_HZ`, :data:`~skyquill.sim.bounds.MAX_RATE_HZ`].
     board
         Writing board; the brush-tip trace in contact is returned as ``ink``.
     conversion
@@ -67,11 +69,18 @@ def simulate(
     -------
     Flight
         Time series, errors and saturation counts.
+
+    Raises
+    ------
+    InputError
+        A rate out of range, or more than :data:`~skyquill.sim.bounds.MAX_SIM_STEPS`
+        steps (refused before anything is allocated).
     """
     vehicle = vehicle or Quadrotor()
     controller = controller or RPTController()
     dist = disturbances or Disturbances()
-    rate = as_float("rate_hz", rate_hz, positive=True)
+    rate = check_rate(rate_hz)
+    check_steps(trajectory.duration, rate)  # before any per-step array exists
     random = dist.gust_std_mps > 0 or dist.position_noise_m > 0 or dist.velocity_noise_mps > 0
     if random and not isinstance(rng, np.random.Generator):
         raise InputError(

@@ -1,0 +1,31 @@
+"""The shared argument checks of :mod:`skyquill.validation`."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from skyquill.errors import InputError
+from skyquill.validation import as_seed
+
+
+def test_seed_accepts_non_negative_integers() -> None:
+    assert as_seed("seed", 0) == 0
+    assert as_seed("seed", np.int64(7)) == 7
+    assert as_seed("seed", 2**64 - 1) == 2**64 - 1
+    np.random.default_rng(as_seed("seed", 2**64 - 1))  # numpy accepts the largest one
+
+
+@pytest.mark.parametrize(
+    ("value", "message"),
+    [
+        (-1, "seed: got -1, expected an integer >= 0"),
+        (1.5, "seed: got 1.5, expected an integer >= 0"),
+        (True, "seed: got True, expected an integer >= 0"),
+        ("3", "seed: got '3', expected an integer >= 0"),
+        (2**64, "seed: got 18446744073709551616, expected an integer from 0 to 2**64 - 1"),
+    ],
+)
+def test_seed_refuses_with_a_named_message(value: object, message: str) -> None:
+    with pytest.raises(InputError, match=f"^{message.replace('*', '[*]')}$"):
+        as_seed("seed", value)
