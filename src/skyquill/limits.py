@@ -332,6 +332,12 @@ _VEHICLE_FIELDS: dict[str, tuple[int, str, str]] = {
 }
 
 
+#: Largest limit accepted per derivative order, SI: far beyond any multirotor (1000 m/s,
+#: ~1000 g, and a jerk to match), so a larger number is a unit mistake; and a bound that
+#: large would leave the solvers a badly scaled problem to fail on.
+_CEILINGS = {1: 1e3, 2: 1e4, 3: 1e6}
+
+
 @dataclass(frozen=True)
 class VehicleLimits:
     """The vehicle's limits: built once at the entry, passed down (DESIGN.md).
@@ -358,10 +364,17 @@ class VehicleLimits:
     jmax_axis: float | None = None
 
     def __post_init__(self) -> None:
-        for name in _VEHICLE_FIELDS:
+        for name, (order, unit, _) in _VEHICLE_FIELDS.items():
             value = getattr(self, name)
-            if value is not None:
-                object.__setattr__(self, name, as_float(name, value, positive=True))
+            if value is None:
+                continue
+            bound = as_float(name, value, positive=True)
+            if bound > _CEILINGS[order]:
+                raise InputError(
+                    f"{name}: got {bound:g} {unit}, expected at most {_CEILINGS[order]:g} {unit} "
+                    "(beyond any vehicle: is it in SI units?)"
+                )
+            object.__setattr__(self, name, bound)
 
     def norm(self, order: int) -> float | None:
         """The norm bound on derivative ``order`` (1: vmax, 2: amax, 3: jmax; else None)."""

@@ -229,6 +229,35 @@ for label, cmd, name, data, message in READER_CASES:
         args = ["paint", "--image", f"{{tmp}}/{name}", "--out", "{out}"]
     CASES.append(Case(f"{cmd} {label}", args, message, setup=_write(name, data)))
 
+# -- Work that would not end, or not be what was asked (estimated before it starts) ---------------
+KM_SQUARE = json.dumps(
+    {"type": "Polygon", "coordinates": [[[0, 0], [1000, 0], [1000, 1000], [0, 1000], [0, 0]]]}
+)
+LONG_TRAJ = "t,x,y,z,vx,vy,vz,ax,ay,az\n0,0,0,1,0,0,0,0,0,0\n1000000,1,0,1,0,0,0,0,0,0\n"
+MOVING_END = TRAJ.replace("2,1,0,1,0,0,0", "2,1,0,1,0.5,0,0")
+BOUND_CASES = [
+    Case("fit at 1000 m/s is re-timed slower", _fit("--timing", "path", "--vmax", "1000"), "done",
+         status=0),
+    Case("fit that cannot follow its points", _fit("--knot-interval", "5"), "from the points"),
+    Case("write --size 1e-6", _write_cmd("--size", "1e-6"), "size_m"),
+    Case("write --size 1e6", _write_cmd("--size", "1e6"), "size_m"),
+    Case("write --lift 1000", _write_cmd("--lift", "1000"), "lift"),
+    Case("write limits of 1e12", _write_cmd("--vmax", "1e12", "--amax", "1e12", "--jmax", "1e12"),
+         "SI units"),
+    Case("write at 100 m/s cannot stay on the strokes", _write_cmd("--vmax", "1000", "--amax", "1e4", "--jmax", "1e6"),
+         "lower speed limit"),
+    Case("cover --altitude -5", _cover("--altitude", "-5"), "altitude"),
+    Case("cover a km square at 2 m", ["cover", "{tmp}/km.geojson", "--out", "{out}"], "km",
+         setup=_write("km.geojson", KM_SQUARE)),
+    Case("cover --width 0.001", _cover("--width", "0.001"), "km"),
+    Case("fly --rate 1e6", _fly("--rate", "1e6"), "rate", setup=WITH_TRAJ),
+    Case("fly 10^6 s", _fly(), "steps", setup=_write("traj.csv", LONG_TRAJ)),
+    Case("fly a moving end", _fly(), "expected rest", setup=_write("traj.csv", MOVING_END)),
+    Case("fly --seed -1", _fly("--seed", "-1"), "seed", setup=WITH_TRAJ),
+    Case("paint --seed -1", _paint("--seed", "-1"), "seed"),
+]  # fmt: skip
+CASES.extend(BOUND_CASES)
+
 # -- Options out of range -----------------------------------------------------------------------
 OPTION_CASES = [
     ("fit --degree 9", _fit("--degree", "9"), "degree"),

@@ -459,7 +459,8 @@ def plan_writing(
             f"after {opts.max_stretches} stretches ({scale:.3g}x slower) within "
             f"{opts.limits.describe()}, expected within the "
             f"tolerance of {1e3 * opts.tolerance:.3g} mm (1 % of the size unless tolerance_m "
-            "is given); a larger size, looser limits or best_effort",
+            "is given); a larger size, a lower speed limit (the route is timed by it) or "
+            "best_effort",
             ("fidelity",),
         )
     if not compensate and opts.resegment != "off" and opts.resegment_iterations > 0:

@@ -126,6 +126,16 @@ def fit(
             "else path."
         ),
     ] = None,
+    tolerance: Annotated[
+        float | None,
+        typer.Option(
+            help="Largest distance from the points, m (default 1 % of their extent; 30 % with "
+            "--timing given, a tablet's own clock)."
+        ),
+    ] = None,
+    best_effort: Annotated[
+        bool, typer.Option(help="Write the fit even if it misses the points by more.")
+    ] = False,
     force: Force = False,
 ) -> None:
     """Fit a smooth trajectory to POINTS_CSV that starts and ends at rest."""
@@ -140,6 +150,8 @@ def fit(
             hull=_hull(hull),
             solver=solver,
             timing="segments" if timing == "segments" else "path",
+            tolerance_m=tolerance,
+            best_effort=best_effort,
         )
         points, times = read_points_csv(points_csv)
         if timing not in (None, "given", "path", "segments"):

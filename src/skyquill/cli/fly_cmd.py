@@ -56,13 +56,18 @@ def fly(
     ] = 0.0,
     seed: Annotated[int, typer.Option(help="Seed of the random generator (gusts, noise).")] = 0,
     rate: Annotated[float, typer.Option(help="Control and integration rate, Hz.")] = 500.0,
+    allow_motion: Annotated[
+        bool,
+        typer.Option(help="Fly a trajectory that does not start and end at rest (a cut-out)."),
+    ] = False,
     force: Force = False,
 ) -> None:
     """Fly every trajectory of PLAN in closed loop; write summary.json, flight.csv, plot.png."""
     import numpy as np
 
     from skyquill.io.plan_dir import read_plan
-    from skyquill.sim import Disturbances
+    from skyquill.sim import Disturbances, check_rest_ends
+    from skyquill.validation import as_seed
 
     with user_errors():
         check_out(out)
@@ -78,7 +83,11 @@ def fly(
             if not 0.0 <= value <= most:
                 raise InputError(f"{option}: got {value:g}, expected a number from 0 to {most:g}")
         rate = positive_rate(rate)
+        seed = as_seed("--seed", seed)
         plans = read_plan(plan)
+        if not allow_motion:
+            for _, planned in plans:
+                check_rest_ends(planned.trajectory)
         disturbances = Disturbances(wind_mps=wind_mps, gust_std_mps=gust, position_noise_m=noise)
         setup = _Setup(loop, sim, disturbances, seed, rate)
         with staged_output(out, "fly", force=force, inputs=_plan_files(plan)) as stage:

@@ -84,10 +84,12 @@ def paint(
     from skyquill.painting.mission import ESTIMATORS, MissionConfig, run_mission
     from skyquill.painting.order import ORDERS
     from skyquill.painting.wall import Placement, Wall, parse_angles
+    from skyquill.validation import as_seed
     from skyquill.viz.painting_plot import plot_mission
 
     with user_errors():
         check_out(out)
+        seed = as_seed("--seed", seed)
         if estimator not in ESTIMATORS:
             raise InputError(
                 f"--estimator: got {estimator!r}, expected one of {', '.join(ESTIMATORS)}"
