@@ -312,6 +312,14 @@ OPTION_CASES = [
     ("export --out of another kind", ["export", "{tmp}/traj.csv", "--out", "{out}/r.dat"], ".csv"),
     ("export --rate 0", _export("--rate", "0"), "rate"),
     ("export absent plan", ["export", "{tmp}/none", "--out", "{out}/x.csv"], "plan"),
+    ("studio --port 0", ["studio", "--port", "0"], "--port"),
+    ("studio --port 70000", ["studio", "--port", "70000"], "--port"),
+    ("studio --time-limit 0", ["studio", "--time-limit", "0"], "--time-limit"),
+    (
+        "reproduce corridor absent",
+        ["reproduce", "corridor", "--corridor", "{tmp}/no.json", "--out", "{out}"],
+        "no.json",
+    ),
 ]
 for name, args, message in OPTION_CASES:
     setup = WITH_TRAJ if args[0] in ("fly", "export") else None
@@ -396,3 +404,40 @@ def test_hostile_input(case: Case, tmp_path: Path) -> None:
         lines = [line for line in text.splitlines() if line.strip()]
         assert len(lines) == 1 and lines[0].startswith("error: "), text
     assert (out / SENTINEL).read_text() == "the user's own file"
+
+
+#: Command lines that, unrefused, took all 24 GB of the machine.
+MEMORY_HUNGRY = [
+    (["write", "Hi", "--size", "1e6", "--out", "{out}"], "size_m"),
+    (["fly", "{tmp}/long.csv", "--out", "{out}"], "steps"),
+    (["fit", SPIRAL, "--rate", "1e9", "--out", "{out}"], "rate"),
+]
+
+
+@pytest.mark.timeout(120)
+@pytest.mark.parametrize(("args", "message"), MEMORY_HUNGRY, ids=["size", "long flight", "rate"])
+def test_memory_hungry_input_is_refused_under_a_memory_limit(
+    tmp_path: Path, args: list[str], message: str
+) -> None:
+    """Run in a child process limited to 3 GiB of address space: refused before allocating."""
+    import resource
+    import subprocess
+    import sys
+
+    _write("long.csv", LONG_TRAJ)(tmp_path)
+    argv = [a.replace("{tmp}", str(tmp_path)).replace("{out}", str(tmp_path / "o")) for a in args]
+
+    def limit() -> None:
+        resource.setrlimit(resource.RLIMIT_AS, (3 * 2**30, 3 * 2**30))
+
+    code = "from skyquill.cli.main import app; app(prog_name='skyquill')"
+    done = subprocess.run(
+        [sys.executable, "-c", code, *argv],
+        preexec_fn=limit,
+        capture_output=True,
+        text=True,
+        timeout=110,
+        check=False,
+    )
+    assert done.returncode == 2, done.stderr
+    assert message in done.stderr and "Traceback" not in done.stderr

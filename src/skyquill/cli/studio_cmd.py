@@ -7,6 +7,7 @@ import socket
 from typing import Annotated
 
 import typer
+from rich.markup import escape
 
 from skyquill.cli.main import app, console, user_errors
 from skyquill.errors import InputError
@@ -34,11 +35,11 @@ def studio(
     jobs = JobManager(time_limit_s=time_limit)
     studio_app = create_app(jobs=jobs, allowed_hosts=LOOPBACK_NAMES if loopback else None)
     shown = f"[{host}]" if ":" in host else host
-    console.print(f"[green]skyquill studio[/] on http://{shown}:{port}/  (Ctrl+C stops it)")
+    console.print(f"[green]skyquill studio[/] on http://{escape(shown)}:{port}/  (Ctrl+C stops it)")
     if not loopback:
         console.print(
-            f"[yellow]warning:[/] listening on {host}: anyone who can reach this machine can "
-            "use the studio (there is no login)",
+            f"[yellow]warning:[/] listening on {escape(host)}: anyone who can reach this "
+            "machine can use the studio (there is no login)",
             highlight=False,
         )
     uvicorn.run(studio_app, host=host, port=port, log_level="warning")
