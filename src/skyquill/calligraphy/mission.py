@@ -40,6 +40,7 @@ from skyquill.optimize import Boundary, PointDeviation, SmoothingProblem, resegm
 from skyquill.optimize.solve import FitResult
 from skyquill.optimize.timing import allocate_path_times
 from skyquill.strokes import Strokes, turning_points
+from skyquill.strokes.model import MAX_STROKES
 from skyquill.trajectory import SplineTrajectory
 from skyquill.validation import FloatArray, as_array, as_float, as_int
 
@@ -59,9 +60,6 @@ SIZE_RANGE_M = (0.01, 20.0)
 #: Longest brush accepted, m: the tip is modelled as rigid along the thrust
 #: axis (``L (e_z - b3)``); a longer "brush" is a tether that swings on its own.
 MAX_BRUSH_LENGTH_M = 2.0
-#: Most strokes per mission: each adds a lift, a transit and a pen window
-#: (a page of text is a few hundred); split a longer text between drones.
-MAX_STROKES = 2_000
 #: Most route samples (stroke points plus lifts and transits every
 #: TRANSIT_SPACING_M), estimated from the route's length before it is built:
 #: each is a row of the QP's deviation block (~1 kB with its factors).
