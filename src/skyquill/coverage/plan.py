@@ -452,14 +452,15 @@ _Timed = tuple[Trajectory, SpeedPlan | None]
 def coverage_limits(options: CoverageOptions) -> tuple[DerivativeLimit, ...]:
     """The limits of a coverage flight (3-D, at constant height), as the verifier states them.
 
-    The speed is the norm; acceleration and jerk per axis, or horizontal norms
-    with ``limit_norm_sides``.
+    The speed is the norm; acceleration and jerk the horizontal norms, or per
+    axis when the options say so (the flight is level: the horizontal norm is
+    the norm). Checked by their true shapes, whatever polygon the LP used.
     """
 
     def norm(order: int, bound: float) -> CylinderLimit:
         return CylinderLimit(order, bound, z_lower=-bound, z_upper=bound)
 
-    if options.limit_norm_sides is not None:
+    if not options.per_axis:
         return (norm(1, options.vmax), norm(2, options.amax), norm(3, options.jmax))
     return (
         norm(1, options.vmax),
@@ -475,7 +476,7 @@ def _lifted(points: FloatArray, altitude: float) -> FloatArray:
 def _timed_path(waypoints: FloatArray, path: FloatArray, opts: CoverageOptions) -> _Timed:
     """The path's trajectory at the flight height and its speed plan (``None`` for stop-and-go)."""
     if opts.pattern == "zigzag-stop":
-        legs = LegLimits(opts.vmax, opts.amax, opts.jmax, per_axis=opts.limit_norm_sides is None)
+        legs = LegLimits(opts.vmax, opts.amax, opts.jmax, per_axis=opts.per_axis)
         flown = stop_and_go(_lifted(waypoints, opts.altitude), legs)
         return flown.trajectory, None
     n = opts.grid or grid_points(_length(path))
