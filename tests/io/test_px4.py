@@ -203,7 +203,7 @@ def test_fake_system_sees_the_offboard_sequence() -> None:
     np.testing.assert_allclose(fake.sent[0][1], fake.sent[1][1])  # the pre-start setpoint is row 0
     # streamed at the requested rate: 20 periods of 20 ms, by the absolute schedule
     times = np.array([t for t, _ in fake.sent[1:]])
-    assert times[-1] - times[0] == pytest.approx(20 * 0.02, abs=0.05)
+    assert times[-1] - times[0] == pytest.approx(20 * 0.02, abs=0.1)
     assert np.median(np.diff(times)) == pytest.approx(0.02, abs=0.005)
 
 

@@ -240,6 +240,8 @@ class MavsdkSystem:
         """Wait for the first autopilot; the caller bounds the wait with a timeout."""
         # A negative timeout waits until cancelled: send_mavsdk owns the time limit.
         system = await self._mavsdk.first_autopilot(timeout_s=-1.0)
+        if system is None:  # only when the instance was destroyed meanwhile
+            raise SolverError("address: got no autopilot, expected one (MAVSDK was closed)")
         self._offboard = self._off.OffboardAsync(system)
 
     def setpoint(
