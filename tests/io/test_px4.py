@@ -2,21 +2,29 @@
 
 from __future__ import annotations
 
+import asyncio
+import dataclasses
+import socket
 import sys
+import time
+import types
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
 
-from skyquill.errors import InputError
+from skyquill.errors import InputError, SolverError
 from skyquill.io.px4 import (
     PX4_COLUMNS,
+    MavsdkSystem,
     Px4Setpoints,
     px4_setpoints,
     send_mavsdk,
     yaw_enu_to_ned_deg,
 )
 from skyquill.trajectory import SplineTrajectory
+from skyquill.validation import FloatArray
 
 
 def line(velocity_enu: tuple[float, float, float], duration: float = 2.0) -> SplineTrajectory:
@@ -83,7 +91,8 @@ def test_rate_and_count() -> None:
     ("rate", "match"),
     [
         (0.0, "rate_hz: got 0, expected a number > 0"),
-        (1.0, "rate_hz: got 1, expected a rate from 2 to 1000 Hz"),
+        (1.0, "rate_hz: got 1, expected a rate above 2 and up to 1000 Hz"),
+        (2.0, "rate_hz: got 2, expected a rate above 2"),
         (5000.0, "rate_hz: got 5000"),
         (float("nan"), "rate_hz: got nan"),
         ("50", "rate_hz: got '50', expected a number"),
@@ -118,8 +127,163 @@ def test_dry_run_counts_and_does_not_import_mavsdk(monkeypatch: pytest.MonkeyPat
 def test_send_without_mavsdk_is_input_error(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setitem(sys.modules, "mavsdk", None)
     sp = px4_setpoints(line((1.0, 0.0, 0.0)), rate_hz=25.0)
-    with pytest.raises(InputError, match="pip install mavsdk"):
+    with pytest.raises(InputError, match=r"not installed; expected it installed \(pip install"):
         send_mavsdk(sp, dry_run=False)
+
+
+def test_send_with_grpc_mavsdk_is_input_error(monkeypatch: pytest.MonkeyPatch) -> None:
+    # mavsdk < 4 (the gRPC wrapper) has no mavsdk.asyncio
+    old = types.ModuleType("mavsdk")
+    old.__version__ = "3.0.0"  # type: ignore[attr-defined]
+    monkeypatch.setitem(sys.modules, "mavsdk", old)
+    monkeypatch.setitem(sys.modules, "mavsdk.asyncio", None)
+    sp = px4_setpoints(line((1.0, 0.0, 0.0)), rate_hz=25.0)
+    with pytest.raises(InputError, match=r"mavsdk 3.0.0 installed, .*expected mavsdk>=4.1,<5"):
+        send_mavsdk(sp, dry_run=False)
+
+
+class FakeSystem:
+    """A PX4 stand-in with the async methods send_mavsdk calls; records every call."""
+
+    def __init__(self, connects: bool = True, start_ok: bool = True) -> None:
+        self.connects = connects
+        self.calls: list[str] = []
+        self.sent: list[tuple[float, tuple[float, ...]]] = []  # (loop time, setpoint row)
+        self.offboard_active = False
+        self.closed = False
+
+    async def connect(self, system_address: str) -> None:
+        self.calls.append(f"connect {system_address}")
+
+    async def wait_connected(self) -> None:
+        self.calls.append("wait_connected")
+        if not self.connects:
+            await asyncio.Event().wait()  # a vehicle that never answers
+
+    def setpoint(
+        self, position_ned: FloatArray, velocity_ned: FloatArray, accel_ned: FloatArray, yaw: float
+    ) -> tuple[Any, Any, Any]:
+        return ((*position_ned, yaw), (*velocity_ned, yaw), tuple(accel_ned))
+
+    async def set_position_velocity_acceleration_ned(self, p: Any, v: Any, a: Any) -> None:
+        self.calls.append("setpoint")
+        self.sent.append((asyncio.get_running_loop().time(), (*p, *v, *a)))
+
+    async def start_offboard(self) -> None:
+        # PX4 refuses offboard unless a setpoint came first
+        assert self.sent, "offboard started before any setpoint"
+        self.calls.append("start")
+        self.offboard_active = True
+
+    async def stop_offboard(self) -> None:
+        self.calls.append("stop")
+        self.offboard_active = False
+
+    def close(self) -> None:
+        self.closed = True
+
+
+def test_fake_system_sees_the_offboard_sequence() -> None:
+    sp = px4_setpoints(line((1.0, 0.0, 0.0), duration=0.4), rate_hz=50.0, yaw_enu_rad=np.pi / 2)
+    fake = FakeSystem()
+    n = send_mavsdk(sp, "udpin://0.0.0.0:14540", dry_run=False, system_factory=lambda: fake)
+    assert n == len(sp) == 21
+    assert fake.calls == (
+        ["connect udpin://0.0.0.0:14540", "wait_connected", "setpoint", "start"]
+        + ["setpoint"] * len(sp)
+        + ["stop"]
+    )
+    assert fake.closed and not fake.offboard_active
+    # every row arrives, in order, as the NED setpoint (yaw 0 = north)
+    rows = np.array([row for _, row in fake.sent[1:]])
+    np.testing.assert_allclose(rows[:, 0:3], sp.position_ned)
+    np.testing.assert_allclose(rows[:, 3], 0.0, atol=1e-12)
+    np.testing.assert_allclose(rows[:, 4:7], sp.velocity_ned)
+    np.testing.assert_allclose(rows[:, 8:11], sp.acceleration_ned)
+    np.testing.assert_allclose(fake.sent[0][1], fake.sent[1][1])  # the pre-start setpoint is row 0
+    # streamed at the requested rate: 20 periods of 20 ms, by the absolute schedule
+    times = np.array([t for t, _ in fake.sent[1:]])
+    assert times[-1] - times[0] == pytest.approx(20 * 0.02, abs=0.1)
+    assert np.median(np.diff(times)) == pytest.approx(0.02, abs=0.005)
+
+
+def test_stop_runs_after_a_failed_send() -> None:
+    class Failing(FakeSystem):
+        async def set_position_velocity_acceleration_ned(self, p: Any, v: Any, a: Any) -> None:
+            await super().set_position_velocity_acceleration_ned(p, v, a)
+            if len(self.sent) == 3:
+                await asyncio.Event().wait()  # the link stalls
+
+    fake = Failing()
+    sp = px4_setpoints(line((1.0, 0.0, 0.0), duration=0.2), rate_hz=50.0)
+    with pytest.raises(
+        SolverError, match=r"send_timeout_s: got 0.05 s, which passed before setpoint 1"
+    ):
+        send_mavsdk(sp, dry_run=False, send_timeout_s=0.05, system_factory=lambda: fake)
+    assert fake.calls[-1] == "stop" and fake.closed
+
+
+def test_never_connecting_hits_the_connect_timeout() -> None:
+    sp = px4_setpoints(line((1.0, 0.0, 0.0)), rate_hz=25.0)
+    fake = FakeSystem(connects=False)
+    begin = time.monotonic()
+    with pytest.raises(
+        SolverError, match=r"connect_timeout_s: got 0.05 s, which passed before a vehicle"
+    ):
+        send_mavsdk(sp, dry_run=False, connect_timeout_s=0.05, system_factory=lambda: fake)
+    assert time.monotonic() - begin < 2.0
+    assert fake.calls == ["connect udpin://0.0.0.0:14540", "wait_connected"]
+    assert fake.closed and not fake.sent
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"connect_timeout_s": 0.0}, "connect_timeout_s: got 0, expected a number > 0"),
+        ({"send_timeout_s": float("nan")}, "send_timeout_s: got nan"),
+    ],
+)
+def test_bad_timeouts(kwargs: dict[str, float], match: str) -> None:
+    sp = px4_setpoints(line((1.0, 0.0, 0.0)), rate_hz=25.0)
+    with pytest.raises(InputError, match=match):
+        send_mavsdk(sp, **kwargs)  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize("rate", [2.0, 1.0])
+def test_send_refuses_a_rate_of_2_hz_or_less(rate: float) -> None:
+    sp = px4_setpoints(line((1.0, 0.0, 0.0)), rate_hz=10.0)
+    slow = dataclasses.replace(sp, rate_hz=rate)
+    with pytest.raises(InputError, match=f"rate_hz: got {rate:g}, expected a rate above 2"):
+        send_mavsdk(slow, dry_run=False, system_factory=FakeSystem)
+
+
+def test_real_mavsdk_types_and_no_vehicle() -> None:
+    """The installed mavsdk (4.x) builds the real setpoint types and times out without PX4."""
+    pytest.importorskip("mavsdk.asyncio")
+    from mavsdk.asyncio.plugins.offboard import AccelerationNed, PositionNedYaw, VelocityNedYaw
+
+    system = MavsdkSystem()
+    try:
+        p, v, a = system.setpoint(
+            np.array([1.0, 2.0, -3.0]), np.array([0.5, 0.0, 0.0]), np.zeros(3), 90.0
+        )
+    finally:
+        system.close()
+    assert isinstance(p, PositionNedYaw) and isinstance(v, VelocityNedYaw)
+    assert isinstance(a, AccelerationNed)
+    assert (p.north_m, p.east_m, p.down_m, p.yaw_deg) == (1.0, 2.0, -3.0, 90.0)
+    assert (v.north_m_s, v.yaw_deg) == (0.5, 90.0)
+    # a real MAVSDK listening on a free local port: nobody answers, the timeout ends it
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    sp = px4_setpoints(line((1.0, 0.0, 0.0)), rate_hz=25.0)
+    begin = time.monotonic()
+    with pytest.raises(SolverError, match=r"connect_timeout_s: got 0\.3 s"):
+        send_mavsdk(sp, f"udpin://127.0.0.1:{port}", dry_run=False, connect_timeout_s=0.3)
+    assert time.monotonic() - begin < 5.0
+    with pytest.raises(InputError, match="address: got 'nonsense://x', which MAVSDK cannot open"):
+        send_mavsdk(sp, "nonsense://x", dry_run=False, connect_timeout_s=0.3)
 
 
 def test_send_needs_setpoints() -> None:

@@ -13,20 +13,22 @@ The world origin maps to PX4's local origin (the EKF origin, usually where the
 vehicle was armed): place the trajectory relative to it before streaming.
 
 :func:`px4_setpoints` is pure; :func:`send_mavsdk` optionally streams the result
-through MAVSDK (an optional dependency, imported only when really sending).
+through MAVSDK 4.x (``mavsdk>=4.1,<5``, the optional ``px4`` extra, imported only
+when really sending; tested with 4.1.0) or through any :class:`OffboardSystem`.
 """
 
 from __future__ import annotations
 
 import asyncio
 import importlib
+from collections.abc import Awaitable, Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, Protocol, TypeVar
 
 import numpy as np
 
-from skyquill.errors import InputError
+from skyquill.errors import InputError, SolverError
 from skyquill.io.points import trajectory_table
 from skyquill.io.table import read_table
 from skyquill.trajectory import SampledTrajectory, Trajectory
@@ -36,6 +38,10 @@ from skyquill.validation import FloatArray, as_float
 MIN_RATE_HZ = 2.0
 #: Faster than this is more than the MAVLink link or PX4 consumes.
 MAX_RATE_HZ = 1000.0
+#: The MAVSDK versions :class:`MavsdkSystem` works with (4.1.0 tested).
+MAVSDK_REQUIREMENT = "mavsdk>=4.1,<5"
+#: PX4 SITL's offboard port, in MAVSDK >= 2 URL syntax (listen for UDP).
+DEFAULT_ADDRESS = "udpin://0.0.0.0:14540"
 #: Header of :meth:`Px4Setpoints.to_csv`.
 PX4_COLUMNS = (
     "t",
@@ -50,6 +56,8 @@ PX4_COLUMNS = (
     "a_down",
     "yaw_deg",
 )
+
+T = TypeVar("T")
 
 
 def enu_to_ned(x: FloatArray) -> FloatArray:
@@ -114,8 +122,8 @@ def px4_setpoints(
         Trajectory in the world frame (x east, y north, z up), m; a 2-D
         trajectory is taken at ``z = 0``.
     rate_hz
-        Setpoint rate, Hz, in ``[2, 1000]`` (PX4 drops out of offboard below
-        2 Hz). Samples run from 0 to the duration inclusive.
+        Setpoint rate, Hz, above 2 and at most 1000 (PX4 drops out of
+        offboard below 2 Hz). Samples run from 0 to the duration inclusive.
     yaw_enu_rad
         Constant heading, rad counter-clockwise from east (0 = facing east).
 
@@ -129,14 +137,9 @@ def px4_setpoints(
     ------
     InputError
         When ``rate_hz`` or ``yaw_enu_rad`` is not a finite number or the rate
-        is outside ``[2, 1000]`` Hz.
+        is not in ``(2, 1000]`` Hz.
     """
-    rate_hz = as_float("rate_hz", rate_hz, positive=True)
-    if not MIN_RATE_HZ <= rate_hz <= MAX_RATE_HZ:
-        raise InputError(
-            f"rate_hz: got {rate_hz:g}, expected a rate from {MIN_RATE_HZ:g} to "
-            f"{MAX_RATE_HZ:g} Hz (PX4 leaves offboard below 2 Hz)"
-        )
+    rate_hz = check_stream_rate(rate_hz)
     yaw = as_float("yaw_enu_rad", yaw_enu_rad)
     table = trajectory_table(traj, rate_hz)
     t = np.ascontiguousarray(table[:, 0])
@@ -150,82 +153,276 @@ def px4_setpoints(
     )
 
 
+class OffboardSystem(Protocol):
+    """What :func:`send_mavsdk` needs from a vehicle link (MAVSDK, or a test fake).
+
+    The real one is :class:`MavsdkSystem`; a fake with these methods, returned
+    by the ``system_factory`` of :func:`send_mavsdk`, stands in for a vehicle.
+    """
+
+    async def connect(self, system_address: str) -> None:
+        """Open the MAVLink connection (returns before a vehicle answers)."""
+
+    async def wait_connected(self) -> None:
+        """Return once an autopilot is discovered on the connection."""
+
+    def setpoint(
+        self, position_ned: FloatArray, velocity_ned: FloatArray, accel_ned: FloatArray, yaw: float
+    ) -> tuple[Any, Any, Any]:
+        """One setpoint as the offboard message types (position+yaw, velocity+yaw, accel)."""
+
+    async def set_position_velocity_acceleration_ned(self, p: Any, v: Any, a: Any) -> None:
+        """Send one setpoint built by :meth:`setpoint`."""
+
+    async def start_offboard(self) -> None:
+        """Switch the vehicle to offboard mode (needs a setpoint sent before)."""
+
+    async def stop_offboard(self) -> None:
+        """Leave offboard mode (PX4 goes to Hold)."""
+
+    def close(self) -> None:
+        """Release the link; called once, also after errors."""
+
+
+def _mavsdk_module() -> Any:
+    """The ``mavsdk`` package, checked to be the native binding (MAVSDK >= 4).
+
+    Up to 3.x ``mavsdk`` was the gRPC wrapper with another API; 4.x has
+    ``mavsdk.asyncio``. An InputError names the fix for a missing or old one.
+    """
+    try:
+        mavsdk = importlib.import_module("mavsdk")
+    except ImportError:
+        raise InputError(
+            "dry_run: got False, but the optional package 'mavsdk' is not installed; "
+            f"expected it installed (pip install 'skyquill[px4]', i.e. {MAVSDK_REQUIREMENT}) "
+            "or dry_run=True"
+        ) from None
+    try:
+        importlib.import_module("mavsdk.asyncio")
+    except ImportError:
+        version = getattr(mavsdk, "__version__", "unknown")
+        raise InputError(
+            f"dry_run: got False with mavsdk {version} installed, which has the old gRPC API; "
+            f"expected {MAVSDK_REQUIREMENT} (pip install 'skyquill[px4]') or dry_run=True"
+        ) from None
+    return mavsdk
+
+
+class MavsdkSystem:
+    """:class:`OffboardSystem` on MAVSDK >= 4 (the native ``mavsdk.asyncio`` binding).
+
+    Tested with mavsdk 4.1.0 (message types and connection without a vehicle);
+    the gRPC ``mavsdk < 4`` has a different API and is refused.
+    """
+
+    def __init__(self) -> None:
+        _mavsdk_module()
+        self._aio = importlib.import_module("mavsdk.asyncio")
+        self._off = importlib.import_module("mavsdk.asyncio.plugins.offboard")
+        config = self._aio.Configuration.create_with_component_type(
+            self._aio.ComponentType.GROUND_STATION
+        )
+        self._mavsdk = self._aio.Mavsdk(config)
+        self._offboard: Any = None
+
+    async def connect(self, system_address: str) -> None:
+        """Add the connection URL (e.g. ``udpin://0.0.0.0:14540``)."""
+        try:
+            await self._mavsdk.add_any_connection(system_address)
+        except self._aio.MavsdkConnectionError as exc:
+            raise InputError(
+                f"address: got {system_address!r}, which MAVSDK cannot open ({exc}); "
+                "expected a MAVSDK connection URL such as 'udpin://0.0.0.0:14540'"
+            ) from None
+
+    async def wait_connected(self) -> None:
+        """Wait for the first autopilot; the caller bounds the wait with a timeout."""
+        # A negative timeout waits until cancelled: send_mavsdk owns the time limit.
+        system = await self._mavsdk.first_autopilot(timeout_s=-1.0)
+        if system is None:  # only when the instance was destroyed meanwhile
+            raise SolverError("address: got no autopilot, expected one (MAVSDK was closed)")
+        self._offboard = self._off.OffboardAsync(system)
+
+    def setpoint(
+        self, position_ned: FloatArray, velocity_ned: FloatArray, accel_ned: FloatArray, yaw: float
+    ) -> tuple[Any, Any, Any]:
+        """The MAVSDK ``PositionNedYaw``, ``VelocityNedYaw``, ``AccelerationNed``."""
+        p, v, a = (
+            np.asarray(x, dtype=float).tolist() for x in (position_ned, velocity_ned, accel_ned)
+        )
+        return (
+            self._off.PositionNedYaw(p[0], p[1], p[2], float(yaw)),
+            self._off.VelocityNedYaw(v[0], v[1], v[2], float(yaw)),
+            self._off.AccelerationNed(a[0], a[1], a[2]),
+        )
+
+    async def set_position_velocity_acceleration_ned(self, p: Any, v: Any, a: Any) -> None:
+        """Send one setpoint (MAVSDK keeps re-sending the last one at 20 Hz)."""
+        await self._offboard.set_position_velocity_acceleration_ned(p, v, a)
+
+    async def start_offboard(self) -> None:
+        """Start offboard; a SolverError carries PX4's reason when it refuses."""
+        try:
+            await self._offboard.start()
+        except self._off.OffboardError as exc:
+            raise SolverError(
+                f"offboard start: got {exc}, expected PX4 to accept offboard "
+                "(armed, airborne, a position estimate)"
+            ) from None
+
+    async def stop_offboard(self) -> None:
+        """Stop offboard (PX4 holds position)."""
+        await self._offboard.stop()
+
+    def close(self) -> None:
+        """Destroy the MAVSDK instance (this also ends a pending discovery)."""
+        if self._offboard is not None:
+            self._offboard.destroy()
+        self._mavsdk.destroy()
+
+
+def check_stream_rate(rate_hz: float) -> float:
+    """The setpoint rate, Hz, checked to be above 2 Hz and at most 1000 Hz.
+
+    PX4 leaves offboard when setpoints come slower than 2 Hz, so exactly 2 Hz
+    (with any jitter) is refused too.
+    """
+    rate_hz = as_float("rate_hz", rate_hz, positive=True)
+    if not MIN_RATE_HZ < rate_hz <= MAX_RATE_HZ:
+        raise InputError(
+            f"rate_hz: got {rate_hz:g}, expected a rate above {MIN_RATE_HZ:g} and up to "
+            f"{MAX_RATE_HZ:g} Hz (PX4 leaves offboard below 2 Hz)"
+        )
+    return rate_hz
+
+
 def send_mavsdk(
-    setpoints: Px4Setpoints, address: str = "udp://:14540", dry_run: bool = True
+    setpoints: Px4Setpoints,
+    address: str = DEFAULT_ADDRESS,
+    dry_run: bool = True,
+    *,
+    connect_timeout_s: float = 10.0,
+    send_timeout_s: float = 1.0,
+    system_factory: Callable[[], OffboardSystem] | None = None,
 ) -> int:
     """Stream ``setpoints`` to a PX4 vehicle in offboard mode through MAVSDK.
 
     The vehicle must already be armed and airborne at (or near) the first
-    setpoint; this sends the first setpoint, starts offboard, streams every
-    setpoint at ``setpoints.rate_hz`` and stops offboard.
+    setpoint. The sequence is: connect, wait for an autopilot, send the first
+    setpoint (PX4 refuses offboard without one), start offboard, stream every
+    setpoint at ``setpoints.rate_hz``, stop offboard (also after an error).
+
+    Works with ``mavsdk`` 4.x (the native binding, tested with 4.1.0; install
+    with ``pip install 'skyquill[px4]'``); the gRPC ``mavsdk < 4`` is refused.
 
     Parameters
     ----------
     setpoints
-        From :func:`px4_setpoints`.
+        From :func:`px4_setpoints`; its ``rate_hz`` must be above 2 Hz.
     address
-        MAVSDK system address (default the PX4 SITL port).
+        MAVSDK connection URL (default the PX4 SITL port, ``udpin://0.0.0.0:14540``).
     dry_run
         When True (default) nothing is imported or sent: returns the number of
         setpoint messages that would be sent.
+    connect_timeout_s
+        Longest wait, s, for the connection and the vehicle's discovery.
+    send_timeout_s
+        Longest wait, s, for each send, offboard start and offboard stop.
+    system_factory
+        Makes the :class:`OffboardSystem` to talk to; default
+        :class:`MavsdkSystem` (tests pass a fake vehicle here).
 
     Returns
     -------
     int
-        Number of setpoint messages sent (or that would be sent).
+        Number of setpoint messages streamed (or that would be), the first
+        one sent before offboard starts not counted.
 
     Raises
     ------
     InputError
-        When ``setpoints`` is not a :class:`Px4Setpoints`, or sending is asked
-        for and the optional ``mavsdk`` package is not installed.
+        When ``setpoints`` is not a :class:`Px4Setpoints`, its rate is not above
+        2 Hz, a timeout is not a positive number, or sending is asked for and
+        ``mavsdk >= 4`` is not installed.
+    SolverError
+        When no vehicle is discovered within ``connect_timeout_s`` or a send
+        takes longer than ``send_timeout_s`` (the link, not the input, failed).
     """
     if not isinstance(setpoints, Px4Setpoints):
         raise InputError(
             f"setpoints: got {type(setpoints).__name__}, expected Px4Setpoints (from px4_setpoints)"
         )
+    check_stream_rate(setpoints.rate_hz)
+    limits = _Timeouts(
+        as_float("connect_timeout_s", connect_timeout_s, positive=True),
+        as_float("send_timeout_s", send_timeout_s, positive=True),
+    )
     if dry_run:
         return len(setpoints)
+    system = (system_factory or MavsdkSystem)()
     try:
-        mavsdk = importlib.import_module("mavsdk")
-        offboard = importlib.import_module("mavsdk.offboard")
-    except ImportError:
-        raise InputError(
-            "dry_run: got False, but the optional package 'mavsdk' is not installed; "
-            "expected it installed (pip install mavsdk) or dry_run=True"
+        return asyncio.run(_stream(system, setpoints, address, limits))
+    finally:
+        system.close()
+
+
+@dataclass(frozen=True)
+class _Timeouts:
+    """Time limits of :func:`send_mavsdk`, s."""
+
+    connect: float
+    send: float
+
+
+async def _bounded(step: Awaitable[T], limit: float, what: str, name: str) -> T:
+    """Await ``step`` at most ``limit`` s; a SolverError names the timeout argument."""
+    try:
+        return await asyncio.wait_for(step, limit)
+    except TimeoutError:
+        raise SolverError(
+            f"{name}: got {limit:g} s, which passed before {what}; expected a PX4 vehicle "
+            "answering on the address (is it powered, on the link, the URL right?) or a "
+            "larger timeout"
         ) from None
-    return asyncio.run(_stream(mavsdk, offboard, setpoints, address))
 
 
-async def _stream(mavsdk: Any, offboard: Any, sp: Px4Setpoints, address: str) -> int:
-    """Connect, start offboard, stream at the set rate, stop; untested without a vehicle."""
-    drone = mavsdk.System()
-    await drone.connect(system_address=address)
-    async for state in drone.core.connection_state():
-        if state.is_connected:
-            break
+async def _stream(system: OffboardSystem, sp: Px4Setpoints, address: str, lim: _Timeouts) -> int:
+    """Connect, send the first setpoint, start offboard, stream at the rate, stop."""
 
-    def message(i: int) -> tuple[Any, Any, Any]:
-        p, v, a, yaw = sp.position_ned[i], sp.velocity_ned[i], sp.acceleration_ned[i], sp.yaw_deg[i]
-        return (
-            offboard.PositionNedYaw(float(p[0]), float(p[1]), float(p[2]), float(yaw)),
-            offboard.VelocityNedYaw(float(v[0]), float(v[1]), float(v[2]), float(yaw)),
-            offboard.AccelerationNed(float(a[0]), float(a[1]), float(a[2])),
+    async def connect() -> None:
+        await system.connect(system_address=address)
+        await system.wait_connected()
+
+    await _bounded(
+        connect(), lim.connect, f"a vehicle was discovered at {address!r}", "connect_timeout_s"
+    )
+
+    def send(i: int) -> Awaitable[None]:
+        msg = system.setpoint(
+            sp.position_ned[i], sp.velocity_ned[i], sp.acceleration_ned[i], float(sp.yaw_deg[i])
+        )
+        return _bounded(
+            system.set_position_velocity_acceleration_ned(*msg),
+            lim.send,
+            f"setpoint {i} was sent",
+            "send_timeout_s",
         )
 
-    await drone.offboard.set_position_velocity_acceleration_ned(*message(0))
-    await drone.offboard.start()
+    await send(0)
+    await _bounded(system.start_offboard(), lim.send, "offboard started", "send_timeout_s")
     period = 1.0 / sp.rate_hz
     loop = asyncio.get_running_loop()
     start = loop.time()
     sent = 0
     try:
         for i in range(len(sp)):
-            await drone.offboard.set_position_velocity_acceleration_ned(*message(i))
+            await send(i)
             sent += 1
+            # Sleep to the absolute tick so send latency does not slow the rate down.
             await asyncio.sleep(max(0.0, start + (i + 1) * period - loop.time()))
     finally:
-        await drone.offboard.stop()
+        await _bounded(system.stop_offboard(), lim.send, "offboard stopped", "send_timeout_s")
     return sent
 
 
