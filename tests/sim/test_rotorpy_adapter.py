@@ -12,9 +12,10 @@ pytest.importorskip("rotorpy")
 from skyquill.errors import InputError, SolverError
 from skyquill.limits import VehicleLimits
 from skyquill.optimize.fit import FitOptions, fit_points
-from skyquill.sim.controllers import CascadePID, RPTController
+from skyquill.sim.controllers import PAPER_XY, CascadePID, RPTController
 from skyquill.sim.rotorpy_adapter import (
     ATTITUDE_GAINS,
+    MATCHED_Z,
     RotorPyTrajectory,
     fly_rotorpy,
     matched_rpt,
@@ -111,6 +112,8 @@ def test_matched_rpt_reads_the_vehicle() -> None:
     omega_hover = np.sqrt(m * G / (4 * k_eta))
     assert hb.drag_per_mass == pytest.approx(4 * k_d * omega_hover / m)
     assert hb.drag_per_mass == pytest.approx(0.447, abs=1e-3)
+    assert hb.lag_s == px4.lag_s  # the Hummingbird's kp_att is the one filled in
+    assert np.allclose(px4.k_p, [PAPER_XY.gains()[1], PAPER_XY.gains()[1], MATCHED_Z.gains()[1]])
 
 
 @pytest.mark.parametrize("vehicle", ["px4_sihsim_quadx", "hummingbird"])
@@ -121,7 +124,8 @@ def test_matched_rpt_tracks_a_1m_loop_as_well_as_se3(
     se3 = fly_rotorpy(loop_1m, "se3", vehicle=vehicle)  # type: ignore[arg-type]
     rpt = fly_rotorpy(loop_1m, matched_rpt(vehicle), vehicle=vehicle)  # type: ignore[arg-type]
     skyquill_tuned = fly_rotorpy(loop_1m, RPTController(), vehicle=vehicle)  # type: ignore[arg-type]
-    # Measured at 100 Hz: PX4 4.5 / 8.5 / 56 mm, Hummingbird 5.5 / 23 / 30 mm.
+    # Measured at 100 Hz (matched / se3 / skyquill-tuned): PX4 1.6 / 8.5 / 56 mm,
+    # Hummingbird 5.6 / 23 / 16 mm.
     assert rpt.rmse_m <= 1.2 * se3.rmse_m
     assert rpt.rmse_m < 0.5 * skyquill_tuned.rmse_m
     assert rpt.saturations == {"motor_speed_max": 0, "motor_speed_min": 0}
@@ -132,7 +136,7 @@ def test_matched_rpt_names_a_bad_vehicle() -> None:
 
     with pytest.raises(InputError, match="vehicle: got 'x500'"):
         matched_rpt("x500")  # type: ignore[arg-type]
-    with pytest.raises(InputError, match="vehicle.kp_att: got -1"):
+    with pytest.raises(InputError, match=r"vehicle\.kp_att: got -1"):
         matched_rpt({**quad_params, "kp_att": -1.0})
 
 

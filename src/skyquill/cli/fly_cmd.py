@@ -49,7 +49,7 @@ def fly(
         str,
         typer.Option(
             help="Outer loop: rpt, pid-ff, pid (or se3 with --sim rotorpy). With --sim "
-            "rotorpy, rpt's feed-forward is matched to RotorPy's vehicle (lag, rotor drag)."
+            "rotorpy, rpt is matched to RotorPy's vehicle (lag, rotor drag, height loop)."
         ),
     ] = "rpt",
     sim: Annotated[str, typer.Option(help="Simulator: skyquill or rotorpy.")] = "skyquill",
@@ -176,7 +176,7 @@ def _fly_controller(name: str, sim: str) -> OuterLoop | Literal["se3"]:
     ``rpt`` is RPT with its feed-forward matched to the vehicle that is flown:
     skyquill's own on ``--sim skyquill``, RotorPy's preset on ``--sim rotorpy``
     (:func:`~skyquill.sim.rotorpy_adapter.matched_rpt`; the skyquill-tuned
-    feed-forward tracked a 1 m circle to 56 mm there, the matched one to 2.3 mm,
+    feed-forward tracked a 1 m circle to 56 mm there, the matched one to 1.2 mm,
     RotorPy's SE3 to 8.5 mm).
     """
     from skyquill.sim import CascadePID, RPTController
