@@ -105,16 +105,37 @@ def test_disturbances_are_seeded_and_recorded(spiral: Path, tmp_path: Path) -> N
     assert a["rate_hz"] == 250.0
 
 
-@pytest.mark.skipif(
+needs_rotorpy = pytest.mark.skipif(
     importlib.util.find_spec("rotorpy") is None
     or importlib.util.find_spec("skyquill.sim.rotorpy_adapter") is None,
     reason="RotorPy or its adapter is not installed",
 )
+
+
+@needs_rotorpy
 def test_rotorpy_flies_the_same_file(spiral: Path, tmp_path: Path) -> None:
     summary = fly(spiral, tmp_path / "rotorpy", "--sim", "rotorpy", "--rate", "100")
     assert summary["sim"] == "rotorpy" and summary["controller"] == "rpt"
     assert 0.0 < summary["rmse_m"] < 0.5
     assert (tmp_path / "rotorpy" / "plot.png").is_file()
+
+
+@needs_rotorpy
+def test_rotorpy_default_tracks_as_well_as_se3(spiral: Path, tmp_path: Path) -> None:
+    """The default rpt is matched to RotorPy's vehicle: no worse than RotorPy's own SE3."""
+    default = fly(spiral, tmp_path / "rpt", "--sim", "rotorpy", "--rate", "100")
+    se3 = fly(spiral, tmp_path / "se3", "--sim", "rotorpy", "--rate", "100", "--controller", "se3")
+    assert (default["controller"], se3["controller"]) == ("rpt", "se3")
+    assert default["rmse_m"] <= 1.2 * se3["rmse_m"]
+
+
+@needs_rotorpy
+@pytest.mark.parametrize("controller", ["pid-ff", "pid"])
+def test_every_outer_loop_flies_on_rotorpy(spiral: Path, tmp_path: Path, controller: str) -> None:
+    args = ("--sim", "rotorpy", "--rate", "100", "--controller", controller)
+    summary = fly(spiral, tmp_path / controller, *args)
+    assert summary["sim"] == "rotorpy" and summary["controller"] == controller
+    assert summary["saturations"] == {"motor_speed_max": 0, "motor_speed_min": 0}
 
 
 @pytest.mark.parametrize(
@@ -154,3 +175,19 @@ def test_bad_files_exit_2_with_one_message(tmp_path: Path) -> None:
         assert result.exit_code == 2
         assert message in " ".join(result.output.split())
         assert "Traceback" not in result.output
+
+
+@needs_rotorpy
+def test_rotorpy_rpt_without_rotorpy_is_named(
+    spiral: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """rpt on RotorPy reads RotorPy's vehicle before flying: a missing RotorPy exits 2."""
+    import sys
+
+    monkeypatch.setitem(sys.modules, "rotorpy.vehicles.px4_sihsim_quadx_params", None)
+    args = ["fly", str(spiral), "--out", str(tmp_path / "o"), "--sim", "rotorpy"]
+    result = runner.invoke(app, args)
+    assert result.exit_code == 2
+    message = " ".join(result.output.split())
+    assert "--sim rotorpy: RotorPy adapter unavailable (RotorPy is not installed" in message
+    assert not (tmp_path / "o" / "summary.json").exists()

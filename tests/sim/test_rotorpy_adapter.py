@@ -12,8 +12,14 @@ pytest.importorskip("rotorpy")
 from skyquill.errors import InputError, SolverError
 from skyquill.limits import VehicleLimits
 from skyquill.optimize.fit import FitOptions, fit_points
-from skyquill.sim.controllers import CascadePID, RPTController
-from skyquill.sim.rotorpy_adapter import ATTITUDE_GAINS, RotorPyTrajectory, fly_rotorpy
+from skyquill.sim.controllers import PAPER_XY, CascadePID, RPTController
+from skyquill.sim.rotorpy_adapter import (
+    ATTITUDE_GAINS,
+    MATCHED_Z,
+    RotorPyTrajectory,
+    fly_rotorpy,
+    matched_rpt,
+)
 from skyquill.trajectory import SplineTrajectory
 from skyquill.validation import FloatArray
 
@@ -84,6 +90,54 @@ def test_rpt_matched_to_the_rotorpy_vehicle_tracks_to_millimetres(
     matched = fly_rotorpy(circle, RPTController(lag_s=lag, drag_per_mass=0.0))
     assert matched.rmse_m < 0.015  # measured 0.7 cm
     assert matched.rmse_m < 0.5 * paper.rmse_m
+
+
+@pytest.fixture(scope="module")
+def loop_1m() -> SplineTrajectory:
+    """A 1 m circle at writing speed (7.2 s), the loop of the issue."""
+    th = np.linspace(0.0, 2.0 * np.pi, 61)
+    pts = np.column_stack([0.5 * np.cos(th), 0.5 * np.sin(th), np.ones_like(th)])
+    return fit_points(pts, options=OPTIONS).result.trajectory
+
+
+def test_matched_rpt_reads_the_vehicle() -> None:
+    """Lag 2 / sqrt(kp_att); linear drag = rotor drag k_d at hover speed, summed, over mass."""
+    from rotorpy.vehicles.hummingbird_params import quad_params as hummingbird
+
+    px4 = matched_rpt()
+    assert px4.lag_s == pytest.approx(2.0 / np.sqrt(ATTITUDE_GAINS["kp_att"]))
+    assert px4.drag_per_mass == 0.0  # the PX4 preset has no rotor drag
+    hb = matched_rpt("hummingbird")
+    m, k_eta, k_d = hummingbird["mass"], hummingbird["k_eta"], hummingbird["k_d"]
+    omega_hover = np.sqrt(m * G / (4 * k_eta))
+    assert hb.drag_per_mass == pytest.approx(4 * k_d * omega_hover / m)
+    assert hb.drag_per_mass == pytest.approx(0.447, abs=1e-3)
+    assert hb.lag_s == px4.lag_s  # the Hummingbird's kp_att is the one filled in
+    assert np.allclose(px4.k_p, [PAPER_XY.gains()[1], PAPER_XY.gains()[1], MATCHED_Z.gains()[1]])
+
+
+@pytest.mark.parametrize("vehicle", ["px4_sihsim_quadx", "hummingbird"])
+def test_matched_rpt_tracks_a_1m_loop_as_well_as_se3(
+    loop_1m: SplineTrajectory, vehicle: str
+) -> None:
+    """What ``skyquill fly --sim rotorpy`` flies by default, against RotorPy's own SE3."""
+    se3 = fly_rotorpy(loop_1m, "se3", vehicle=vehicle)  # type: ignore[arg-type]
+    rpt = fly_rotorpy(loop_1m, matched_rpt(vehicle), vehicle=vehicle)  # type: ignore[arg-type]
+    skyquill_tuned = fly_rotorpy(loop_1m, RPTController(), vehicle=vehicle)  # type: ignore[arg-type]
+    # Measured at 100 Hz (matched / se3 / skyquill-tuned): PX4 1.6 / 8.5 / 56 mm,
+    # Hummingbird 5.6 / 23 / 16 mm.
+    assert rpt.rmse_m <= 1.2 * se3.rmse_m
+    assert rpt.rmse_m < 0.5 * skyquill_tuned.rmse_m
+    assert rpt.saturations == {"motor_speed_max": 0, "motor_speed_min": 0}
+
+
+def test_matched_rpt_names_a_bad_vehicle() -> None:
+    from rotorpy.vehicles.px4_sihsim_quadx_params import quad_params
+
+    with pytest.raises(InputError, match="vehicle: got 'x500'"):
+        matched_rpt("x500")  # type: ignore[arg-type]
+    with pytest.raises(InputError, match=r"vehicle\.kp_att: got -1"):
+        matched_rpt({**quad_params, "kp_att": -1.0})
 
 
 def test_outer_loop_is_reset_and_any_outer_loop_flies(circle: SplineTrajectory) -> None:

@@ -46,7 +46,11 @@ def fly(
     ],
     out: OutDir,
     controller: Annotated[
-        str, typer.Option(help="Outer loop: rpt, pid-ff, pid (or se3 with --sim rotorpy).")
+        str,
+        typer.Option(
+            help="Outer loop: rpt, pid-ff, pid (or se3 with --sim rotorpy). With --sim "
+            "rotorpy, rpt is matched to RotorPy's vehicle (lag, rotor drag, height loop)."
+        ),
     ] = "rpt",
     sim: Annotated[str, typer.Option(help="Simulator: skyquill or rotorpy.")] = "skyquill",
     wind: Annotated[str, typer.Option(help="Constant wind x,y,z in m/s, e.g. 2,0,0.")] = "0,0,0",
@@ -167,7 +171,14 @@ def _worst(flights: list[dict[str, Any]]) -> dict[str, Any]:
 
 
 def _fly_controller(name: str, sim: str) -> OuterLoop | Literal["se3"]:
-    """The outer loop named on the command line, or ``"se3"`` (RotorPy's own)."""
+    """The outer loop named on the command line, or ``"se3"`` (RotorPy's own).
+
+    ``rpt`` is RPT with its feed-forward matched to the vehicle that is flown:
+    skyquill's own on ``--sim skyquill``, RotorPy's preset on ``--sim rotorpy``
+    (:func:`~skyquill.sim.rotorpy_adapter.matched_rpt`; the skyquill-tuned
+    feed-forward tracked a 1 m circle to 56 mm there, the matched one to 1.2 mm,
+    RotorPy's SE3 to 8.5 mm).
+    """
     from skyquill.sim import CascadePID, RPTController
 
     if name not in FLY_CONTROLLERS:
@@ -181,7 +192,19 @@ def _fly_controller(name: str, sim: str) -> OuterLoop | Literal["se3"]:
                 f"{sim} (se3 is RotorPy's controller: use --sim rotorpy)"
             )
         return "se3"
-    return RPTController() if name == "rpt" else CascadePID(feed_forward=name == "pid-ff")
+    if name != "rpt":
+        return CascadePID(feed_forward=name == "pid-ff")
+    return _rotorpy_rpt() if sim == "rotorpy" else RPTController()
+
+
+def _rotorpy_rpt() -> OuterLoop:
+    """RPT matched to the RotorPy vehicle ``fly`` flies (its default preset)."""
+    try:
+        from skyquill.sim.rotorpy_adapter import matched_rpt
+
+        return matched_rpt()
+    except ImportError as exc:
+        raise InputError(f"--sim rotorpy: RotorPy adapter unavailable ({exc})") from None
 
 
 def _fly_once(trajectory: Trajectory, setup: _Setup) -> Flight:
