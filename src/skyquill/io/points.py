@@ -1,6 +1,7 @@
-"""Read point CSVs (``x,y[,z][,t]``) and write ``trajectory.csv`` / ``summary.json``.
+"""Read point CSVs (``x,y[,z][,t]``) and write the ``trajectory.csv`` table.
 
-``trajectory.csv`` is the format every command shares: columns
+``trajectory.csv`` is the format every command shares (written through
+:mod:`skyquill.io.plan_dir`): columns
 ``t,x,y,z,vx,vy,vz,ax,ay,az,jx,jy,jz``, SI units, z-up world frame; 2-D
 trajectories are written with ``z = 0``.
 """
