@@ -8,7 +8,7 @@ Run from the repository root::
 It writes ``bench/results/cones.json`` and prints one table per problem. BLAS
 is pinned to one thread (``threadpoolctl.threadpool_limits(1)``) for the whole
 run. Each problem is solved with its speed, acceleration and jerk norms held
-three ways (DESIGN.md "One meaning per limit"):
+three ways (docs/architecture.md, "The meaning of each limit"):
 
 * ``cone``: ``NormLimit(sides=None)``, one second-order cone per derivative
   hull point, Clarabel;

@@ -11,7 +11,7 @@ Three shapes:
 
 * :class:`BoxLimit` -- an axis-aligned, possibly asymmetric box.
 * :class:`NormLimit` -- the Euclidean norm over all axes, ``||d^n p/dt^n|| <= r``
-  (``vmax`` is the *speed*, DESIGN.md "One meaning per limit"). The ball is
+  (``vmax`` is the *speed*, docs/architecture.md, "The meaning of each limit"). The ball is
   convex, so holding it on every hull point holds it on the whole curve. With
   ``sides=None`` the engine imposes it exactly, as a second-order cone per
   hull point; with ``sides=m`` through an inscribed polytope (see
@@ -340,7 +340,7 @@ _CEILINGS = {1: 1e3, 2: 1e4, 3: 1e6}
 
 @dataclass(frozen=True)
 class VehicleLimits:
-    """The vehicle's limits: built once at the entry, passed down (DESIGN.md).
+    """The vehicle's limits: built once at the entry, passed down (docs/architecture.md).
 
     ``None`` leaves a limit out. Every value is in SI units and > 0.
 
