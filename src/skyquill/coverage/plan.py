@@ -431,8 +431,10 @@ def plan_coverage(region: Polygon, options: CoverageOptions | None = None) -> Co
         # each part's spiral rest to rest instead, joined by straight legs.
         waypoints, path, timed = _stop_between_parts(region, opts)
         joins = "stop"
-    trajectory, speed_plan = timed
-    limits = limits_report(verify(trajectory, coverage_limits(opts), guaranteed=False))
+    trajectory, speed_plan, check = timed
+    if check is None:  # stop-and-go legs and parts at rest were not checked on the way
+        check = verify(trajectory, coverage_limits(opts), guaranteed=False)
+    limits = limits_report(check)
     return CoveragePlan(
         region=region,
         options=opts,
@@ -446,7 +448,9 @@ def plan_coverage(region: Polygon, options: CoverageOptions | None = None) -> Co
     )
 
 
-_Timed = tuple[Trajectory, SpeedPlan | None]
+#: A timed path: its trajectory, its speed plan (None for stop-and-go) and the dense check
+#: already made of it (None when none was needed to accept it).
+_Timed = tuple[Trajectory, SpeedPlan | None, Verification | None]
 
 
 def coverage_limits(options: CoverageOptions) -> tuple[DerivativeLimit, ...]:
@@ -478,10 +482,10 @@ def _timed_path(waypoints: FloatArray, path: FloatArray, opts: CoverageOptions) 
     if opts.pattern == "zigzag-stop":
         legs = LegLimits(opts.vmax, opts.amax, opts.jmax, per_axis=opts.per_axis)
         flown = stop_and_go(_lifted(waypoints, opts.altitude), legs)
-        return flown.trajectory, None
+        return flown.trajectory, None, None
     n = opts.grid or grid_points(_length(path))
-    speed_plan, trajectory = _timed(spiral_curve(waypoints), opts, n)
-    return trajectory, speed_plan
+    speed_plan, trajectory, check = _timed(spiral_curve(waypoints), opts, n)
+    return trajectory, speed_plan, check
 
 
 def _stop_between_parts(
@@ -504,7 +508,7 @@ def _stop_between_parts(
             pieces.append(_piece(spiral, stop, _densified(spiral)))
     waypoints = np.vstack([p[0] for p in pieces])
     path = np.vstack([p[1] for p in pieces])
-    return waypoints, path, (concatenate([p[2][0] for p in pieces]), None)
+    return waypoints, path, (concatenate([p[2][0] for p in pieces]), None, None)
 
 
 def _piece(
@@ -525,8 +529,11 @@ GRID_LADDER: tuple[tuple[int, Literal["uniform", "adaptive"]], ...] = (
 )
 
 
-def _timed(curve: Any, options: CoverageOptions, n: int) -> tuple[SpeedPlan, Trajectory]:
-    """The speed plan on the first grid of :data:`GRID_LADDER` that verifies, and its trajectory.
+def _timed(
+    curve: Any, options: CoverageOptions, n: int
+) -> tuple[SpeedPlan, Trajectory, Verification]:
+    """The speed plan on the first grid of :data:`GRID_LADDER` that verifies, its trajectory
+    and that check.
 
     The check is the one dense check of the trajectory the plan becomes (the
     one that is written and flown), not of the planner's own setpoints.
@@ -556,9 +563,10 @@ def _timed(curve: Any, options: CoverageOptions, n: int) -> tuple[SpeedPlan, Tra
             seen.append(f"{kind} grid of {factor * n}: {exc}")
             continue
         trajectory = plan.trajectory(options.altitude)
-        excess = verify(trajectory, coverage_limits(options), guaranteed=False).max_excess
+        check = verify(trajectory, coverage_limits(options), guaranteed=False)
+        excess = check.max_excess
         if excess <= MAX_EXCESS:
-            return plan, trajectory
+            return plan, trajectory, check
         seen.append(f"{kind} grid of {factor * n}: excess {100 * excess:.1f} %")
     raise InfeasibleError(
         f"pattern {options.pattern!r}: could not time the path within the limits ("
