@@ -12,7 +12,7 @@ from skyquill.errors import InputError
 from skyquill.export import EXPORTERS, ExportOptions
 from skyquill.io.atomic import write_json
 from skyquill.io.outputs import staged_output
-from skyquill.io.plan_dir import read_plan
+from skyquill.io.plan_dir import plan_files, read_plan
 
 FORMAT_HELP = "; ".join(f"{e.name}: {e.help}" for e in EXPORTERS.values())
 
@@ -44,10 +44,11 @@ def export(
         options = ExportOptions(rate_hz=positive_rate(rate))
         plans = read_plan(plan)
         folder = out.parent
-        inputs = [plan] if plan.is_file() else list(plan.glob("*"))
         with (
             console.status(f"exporting {len(plans)} trajectory(ies) to {format}"),
-            staged_output(folder, f"export {out.name}", force=force, inputs=inputs) as stage,
+            staged_output(
+                folder, f"export {out.name}", force=force, inputs=plan_files(plan)
+            ) as stage,
         ):
             report = chosen(plans, stage / out.name, options)
             summary = report.as_dict() | {

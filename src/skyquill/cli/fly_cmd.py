@@ -69,7 +69,7 @@ def fly(
     """Fly every trajectory of PLAN in closed loop; write summary.json, flight.csv, plot.png."""
     import numpy as np
 
-    from skyquill.io.plan_dir import read_plan
+    from skyquill.io.plan_dir import plan_files, read_plan
     from skyquill.sim import Disturbances, check_rest_ends
     from skyquill.validation import as_seed
 
@@ -94,7 +94,7 @@ def fly(
                 check_rest_ends(planned.trajectory)
         disturbances = Disturbances(wind_mps=wind_mps, gust_std_mps=gust, position_noise_m=noise)
         setup = _Setup(loop, sim, disturbances, seed, rate)
-        with staged_output(out, "fly", force=force, inputs=_plan_files(plan)) as stage:
+        with staged_output(out, "fly", force=force, inputs=plan_files(plan)) as stage:
             flights = [
                 _fly_drone(name, p.trajectory, setup, stage, len(plans) > 1) for name, p in plans
             ]
@@ -153,11 +153,6 @@ def _fly_drone(
         "duration_s": trajectory.duration,
         "flight_rows": rows,
     }
-
-
-def _plan_files(plan: Path) -> list[Path]:
-    """The files ``fly`` reads (never written over): the plan file, or the folder's own."""
-    return [plan] if plan.is_file() else [p for p in plan.glob("trajectory*") if p.is_file()]
 
 
 def _worst(flights: list[dict[str, Any]]) -> dict[str, Any]:

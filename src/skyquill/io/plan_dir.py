@@ -150,20 +150,16 @@ def _csv_difference(written: SampledTrajectory, exact: Trajectory) -> float:
     return float(np.linalg.norm(written.p - exact.evaluate(t), axis=1).max())
 
 
-def read_plan(path: Path) -> list[tuple[str, PlannedTrajectory]]:
-    """The trajectories of a plan directory or of one file, named, in drone order.
+def plan_files(path: Path) -> list[Path]:
+    """The trajectory files a plan consists of, in drone order (what :func:`read_plan` reads).
 
-    Parameters
-    ----------
-    path
-        A plan directory (its ``summary.json`` names the files; a directory
-        without one is searched for ``trajectory.json`` or
-        ``trajectory_<i>.json``), a ``trajectory.json`` or a ``trajectory.csv``.
+    ``path`` is a plan directory (its ``summary.json`` names the files; a
+    directory without one is searched for ``trajectory.json`` or
+    ``trajectory_<i>.json``), a ``trajectory.json`` or a ``trajectory.csv``.
+    Commands that read a plan never write over these.
     """
     if path.is_file():
-        if path.suffix.lower() == ".csv":
-            return [(path.stem, PlannedTrajectory(read_trajectory_csv(path)))]
-        return [(path.stem, read_trajectory_json(path))]
+        return [path]
     if not path.is_dir():
         raise InputError(f"plan: got {str(path)!r}, expected a plan directory or a trajectory file")
     files = _listed(path) or _found(path)
@@ -172,7 +168,17 @@ def read_plan(path: Path) -> list[tuple[str, PlannedTrajectory]]:
             f"plan: got {str(path)!r} without trajectory.json or trajectory_<i>.json, expected "
             "the output directory of fit, write, cover or paint"
         )
-    return [(f.stem, read_trajectory_json(f)) for f in files]
+    return files
+
+
+def read_plan(path: Path) -> list[tuple[str, PlannedTrajectory]]:
+    """The trajectories of a plan directory or of one file (:func:`plan_files`), named."""
+    return [
+        (f.stem, PlannedTrajectory(read_trajectory_csv(f)))
+        if f.suffix.lower() == ".csv"
+        else (f.stem, read_trajectory_json(f))
+        for f in plan_files(path)
+    ]
 
 
 def _listed(directory: Path) -> list[Path]:
