@@ -21,7 +21,6 @@ from skyquill.cli.main import (
     app,
     check_out,
     console,
-    limits_from_flags,
     positive_rate,
     say_done,
     user_errors,
@@ -31,6 +30,7 @@ from skyquill.io.outputs import staged_output
 from skyquill.io.plan_dir import write_plan
 from skyquill.io.points import read_points_csv
 from skyquill.io.trajectory_json import PlannedTrajectory
+from skyquill.limits import VehicleLimits
 from skyquill.optimize.fit import FitOptions, PointFit, fit_points
 from skyquill.validation import FloatArray
 
@@ -142,7 +142,7 @@ def fit(
     with user_errors():
         check_out(out)
         options = FitOptions(
-            limits=limits_from_flags(vmax, amax, jmax, vmax_axis, amax_axis, jmax_axis),
+            limits=VehicleLimits(vmax, amax, jmax, vmax_axis, amax_axis, jmax_axis),
             norm_sides=norm_sides,
             degree=degree,
             weight=weight,

@@ -22,7 +22,7 @@ from rich.console import Console
 from rich.text import Text
 
 from skyquill.errors import InputError, SkyquillError
-from skyquill.limits import VehicleLimits
+from skyquill.io.outputs import check_folder
 from skyquill.validation import FloatArray
 
 app = typer.Typer(
@@ -116,16 +116,7 @@ def say_done(message: str) -> None:
 
 def check_out(out: Path) -> None:
     """Refuse an ``--out`` that cannot be a folder before any work starts (it is made later)."""
-    if out.exists() and not out.is_dir():
-        raise InputError(f"--out: got {str(out)!r}, an existing file; expected a folder")
-    for parent in out.parents:
-        if parent.exists():
-            if not parent.is_dir():
-                raise InputError(
-                    f"--out: got {str(out)!r}, inside {str(parent)!r} which is a file; "
-                    "expected a folder"
-                )
-            break
+    check_folder(out, "--out")
 
 
 def positive_rate(rate: float) -> float:
@@ -133,18 +124,6 @@ def positive_rate(rate: float) -> float:
     if not rate > 0:
         raise InputError(f"--rate: got {rate:g}, expected a positive number of Hz")
     return rate
-
-
-def limits_from_flags(
-    vmax: float,
-    amax: float,
-    jmax: float,
-    vmax_axis: float | None = None,
-    amax_axis: float | None = None,
-    jmax_axis: float | None = None,
-) -> VehicleLimits:
-    """The one :class:`VehicleLimits` of a command's ``--vmax/--amax/--jmax[-axis]`` flags."""
-    return VehicleLimits(vmax, amax, jmax, vmax_axis, amax_axis, jmax_axis)
 
 
 def parse_vector3(option: str, text: str, unit: str) -> FloatArray:

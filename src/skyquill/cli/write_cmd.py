@@ -22,7 +22,6 @@ from skyquill.cli.main import (
     app,
     check_out,
     console,
-    limits_from_flags,
     positive_rate,
     say_done,
     user_errors,
@@ -32,6 +31,7 @@ from skyquill.io.atomic import write_json
 from skyquill.io.outputs import staged_output
 from skyquill.io.plan_dir import trajectory_names, write_plan
 from skyquill.io.trajectory_json import PlannedTrajectory
+from skyquill.limits import VehicleLimits
 
 
 def load_input(
@@ -104,7 +104,7 @@ def write(
         rate = positive_rate(rate)
         options = WritingOptions(
             size_m=size,
-            limits=limits_from_flags(vmax, amax, jmax, vmax_axis, amax_axis, jmax_axis),
+            limits=VehicleLimits(vmax, amax, jmax, vmax_axis, amax_axis, jmax_axis),
             norm_sides=norm_sides,
             best_effort=best_effort,
             tilt_compensation=tilt_compensation,

@@ -59,8 +59,7 @@ def staged_output(
         ``out`` is a file, or a file would replace one that is not the
         command's own (or an input). Nothing is moved then.
     """
-    if out.exists() and not out.is_dir():
-        raise InputError(f"out: got {str(out)!r}, an existing file; expected a folder")
+    check_folder(out)
     out.mkdir(parents=True, exist_ok=True)
     staging = Path(tempfile.mkdtemp(prefix=".staging-", dir=out))
     try:
@@ -68,6 +67,20 @@ def staged_output(
         _commit(staging, out, command, force, inputs)
     finally:
         shutil.rmtree(staging, ignore_errors=True)
+
+
+def check_folder(out: Path, name: str = "out") -> None:
+    """Refuse ``out`` (the argument ``name``) if it is a file or lies inside one."""
+    if out.exists() and not out.is_dir():
+        raise InputError(f"{name}: got {str(out)!r}, an existing file; expected a folder")
+    for parent in out.parents:
+        if parent.exists():
+            if not parent.is_dir():
+                raise InputError(
+                    f"{name}: got {str(out)!r}, inside {str(parent)!r} which is a file; "
+                    "expected a folder"
+                )
+            return
 
 
 def _commit(staging: Path, out: Path, command: str, force: bool, inputs: Sequence[Path]) -> None:
