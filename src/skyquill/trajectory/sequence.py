@@ -72,7 +72,9 @@ class RestToRestSequence:
 
     def piece_at(self, t: FloatArray) -> NDArray[np.intp]:
         """Index of the piece flown at each time ``t`` (N,); a join belongs to the later piece."""
-        times = evaluation_times(t, self.duration)
+        return self._locate(evaluation_times(t, self.duration))
+
+    def _locate(self, times: FloatArray) -> NDArray[np.intp]:
         last = len(self.pieces) - 1
         return np.clip(np.searchsorted(self.starts, times, side="right") - 1, 0, last)
 
@@ -80,7 +82,7 @@ class RestToRestSequence:
         """The ``order``-th time derivative at times ``t`` (N,); returns (N, d)."""
         as_int("order", order, low=0)
         times = evaluation_times(t, self.duration)
-        which = self.piece_at(times)
+        which = self._locate(times)
         out = np.empty((times.size, self.dim))
         starts = self.starts
         for k in np.unique(which):
