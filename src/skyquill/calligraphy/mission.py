@@ -28,7 +28,7 @@ import itertools
 import math
 import time
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 
@@ -280,6 +280,24 @@ class Mission:
     def faithful(self) -> bool:
         """Whether the pen-down path is within the tolerance of the input."""
         return self.deviation.max_m <= self.options.tolerance
+
+    def summary(self) -> dict[str, Any]:
+        """Timing, the dense check, fidelity: a drone's entry in ``summary.json`` (SI units)."""
+        check = self.fit.verification
+        return {
+            "duration_s": self.trajectory.duration,
+            "planning_time_s": self.planning_time_s,
+            "limits": check.limits_report(),
+            "max_speed": check.max_speed,
+            "max_acc": list(check.max_acc),
+            "max_jerk": list(check.max_jerk),
+            "max_excess": check.max_excess,
+            "deviation": self.deviation.as_dict(),
+            "tolerance_m": self.options.tolerance,
+            "faithful": self.faithful,
+            "strokes": len(self.strokes_world),
+            "time_scale": self.time_scale,
+        }
 
 
 def _segment(a: FloatArray, b: FloatArray) -> FloatArray:

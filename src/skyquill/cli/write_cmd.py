@@ -187,22 +187,7 @@ def write_outputs(
 
 
 def _drone_summary(mission: Any, name: str, flight: Any) -> dict[str, Any]:
-    check = mission.fit.verification
-    entry: dict[str, Any] = {
-        "file": name,
-        "duration_s": mission.trajectory.duration,
-        "planning_time_s": mission.planning_time_s,
-        "limits": check.limits_report(),
-        "max_speed": check.max_speed,
-        "max_acc": list(check.max_acc),
-        "max_jerk": list(check.max_jerk),
-        "max_excess": check.max_excess,
-        "deviation": mission.deviation.as_dict(),
-        "tolerance_m": mission.options.tolerance,
-        "faithful": mission.faithful,
-        "strokes": len(mission.strokes_world),
-        "time_scale": mission.time_scale,
-    }
+    entry: dict[str, Any] = {"file": name} | mission.summary()
     if flight is not None:  # flown by plan_show(fly=True): RPT over the contact board
         from skyquill.calligraphy.show import ink_deviation
 

@@ -281,7 +281,7 @@ def _exports(missions: Sequence[Mission]) -> tuple[dict[str, StudioFile], list[s
             [p for _, p in planned],
             rate=CSV_RATE_HZ,
             guaranteed=True,
-            summary={"drones": [_drone_summary(m) for m in missions]},
+            summary={"drones": [m.summary() for m in missions]},
         )
         setpoints = [
             (f"setpoints_{i}.csv", (out / "plan" / d["csv"]).read_bytes())
@@ -324,17 +324,3 @@ def _bundle(parts: Sequence[tuple[str, bytes]], stem: str, description: str) -> 
             archive.writestr(name, data)
     note = " (one file per drone and upload, in a zip)"
     return StudioFile(f"{stem}.zip", buffer.getvalue(), "application/zip", description + note)
-
-
-def _drone_summary(mission: Mission) -> dict[str, Any]:
-    """A drone's verification, deviation and timing (beside the plan's own check)."""
-    check = mission.fit.verification
-    return {
-        "duration_s": mission.trajectory.duration,
-        "planning_time_s": mission.planning_time_s,
-        "limits": check.limits_report(),
-        "max_excess": float(check.max_excess),
-        "deviation": mission.deviation.as_dict(),
-        "faithful": mission.faithful,
-        "time_scale": mission.time_scale,
-    }
