@@ -35,6 +35,7 @@ import numpy as np
 from skyquill.calligraphy.board import Board
 from skyquill.errors import InfeasibleError, InputError
 from skyquill.geometry import polyline_distance
+from skyquill.io.trajectory_json import pen_down
 from skyquill.limits import DerivativeLimit, VehicleLimits
 from skyquill.optimize import Boundary, PointDeviation, SmoothingProblem, resegment, solve
 from skyquill.optimize.solve import FitResult
@@ -256,11 +257,7 @@ class Mission:
 
     def pen(self, t: FloatArray) -> FloatArray:
         """1.0 where the pen is down at times ``t`` (N,), else 0.0."""
-        t = np.asarray(t, dtype=float)
-        down = np.zeros(t.size)
-        for t0, t1 in self.pen_windows:
-            down[(t >= t0) & (t <= t1)] = 1.0
-        return down
+        return pen_down(t, self.pen_windows)
 
     @property
     def brush_offset(self) -> FloatArray:

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -31,7 +32,7 @@ from skyquill.io.json_read import parse_json
 from skyquill.limits import BoxLimit, CylinderLimit, DerivativeLimit, NormLimit
 from skyquill.trajectory import Trajectory
 from skyquill.trajectory.codec import decode, encode
-from skyquill.validation import as_array
+from skyquill.validation import FloatArray, as_array
 
 FORMAT = "skyquill-trajectory"
 VERSION = 2
@@ -62,11 +63,16 @@ class PlannedTrajectory:
 
     def pen(self, t: Any) -> Any:
         """1.0 where the pen is down at times ``t`` (N,), else 0.0."""
-        times = np.asarray(t, dtype=float)
-        down = np.zeros(times.size)
-        for start, end in self.pen_windows_s:
-            down[(times >= start) & (times <= end)] = 1.0
-        return down
+        return pen_down(t, self.pen_windows_s)
+
+
+def pen_down(t: Any, windows: Sequence[tuple[float, float]]) -> FloatArray:
+    """1.0 at the times ``t`` (N,) inside one of the ``(start, end)`` ``windows`` (s), else 0.0."""
+    times = np.asarray(t, dtype=float)
+    down = np.zeros(times.size)
+    for start, end in windows:
+        down[(times >= start) & (times <= end)] = 1.0
+    return down
 
 
 def write_trajectory_json(path: str | Path, planned: PlannedTrajectory) -> None:
