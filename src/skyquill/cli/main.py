@@ -23,6 +23,7 @@ from rich.text import Text
 
 from skyquill.errors import InputError, SkyquillError
 from skyquill.io.outputs import check_folder
+from skyquill.targets import TARGETS, UploadTarget
 from skyquill.validation import FloatArray
 
 app = typer.Typer(
@@ -62,6 +63,22 @@ NormSides = Annotated[
         "exactly (second-order cones)."
     ),
 ]
+Target = Annotated[
+    str | None,
+    typer.Option(
+        help="Plan for a vehicle's trajectory memory: 'crazyflie' (at most 31 polynomial "
+        "pieces per upload, uploads changed while hovering)."
+    ),
+]
+
+
+def upload_target(name: str | None) -> UploadTarget | None:
+    """The :class:`UploadTarget` called ``name`` (``--target``); ``None`` for none."""
+    if name is None:
+        return None
+    if name not in TARGETS:
+        raise InputError(f"--target: got {name!r}, expected one of {', '.join(TARGETS)}")
+    return TARGETS[name]
 
 
 @app.callback()

@@ -15,9 +15,10 @@ from typing import Any, Protocol
 
 import numpy as np
 
-from skyquill.io.trajectory_json import PlannedTrajectory
+from skyquill.io.trajectory_json import PlannedTrajectory, pen_down
 from skyquill.trajectory import Trajectory, dense_times
 from skyquill.validation import as_float
+from skyquill.verify import verify
 
 #: A drone's name (the stem of its trajectory file) and its planned trajectory.
 NamedPlan = tuple[str, PlannedTrajectory]
@@ -58,6 +59,9 @@ class ExportReport:
         One sentence for the command line.
     details
         Format-specific numbers (pieces, uploads, rate, refit deviation, ...).
+    delivered
+        Per drone, the check of what its consumer will fly
+        (:func:`check_delivered`).
     """
 
     format: str
@@ -66,6 +70,7 @@ class ExportReport:
     max_error_m: float
     message: str
     details: dict[str, Any] = field(default_factory=dict)
+    delivered: tuple[DeliveredCheck, ...] = ()
 
     def as_dict(self) -> dict[str, Any]:
         """JSON-ready: ``<out>.summary.json``."""
@@ -76,7 +81,66 @@ class ExportReport:
             "max_error_m": self.max_error_m,
             "message": self.message,
             **self.details,
+            "delivered": [d.as_dict() for d in self.delivered],
         }
+
+
+@dataclass(frozen=True)
+class DeliveredCheck:
+    """One drone's exported trajectory as its consumer will fly it, checked.
+
+    Attributes
+    ----------
+    drone
+        The drone's name.
+    max_error_m
+        Largest distance from the plan over dense samples, m.
+    pen_down_max_error_m
+        The same over the pen-down windows only (0 when the plan has none), m.
+    limit_excess
+        Largest relative excess over the plan's limits found by the dense
+        check of the read-back (0 when every limit holds).
+    limits
+        Per limit: label, largest value, relative excess (``Verification.limits_report``).
+    """
+
+    drone: str
+    max_error_m: float
+    pen_down_max_error_m: float
+    limit_excess: float
+    limits: tuple[dict[str, Any], ...]
+
+    def as_dict(self) -> dict[str, Any]:
+        """JSON-ready."""
+        return {
+            "drone": self.drone,
+            "max_error_m": self.max_error_m,
+            "pen_down_max_error_m": self.pen_down_max_error_m,
+            "limit_excess": self.limit_excess,
+            "limits": list(self.limits),
+        }
+
+
+def check_delivered(
+    drone: str, planned: PlannedTrajectory, back: Trajectory, offset_s: float = 0.0
+) -> DeliveredCheck:
+    """Check ``back`` (the export read back with its consumer's arithmetic) against the plan.
+
+    The dense limit check runs on ``back`` itself, so a limit broken by the
+    format's rounding or resampling shows here; the distances are measured at
+    the plan's dense times (``back`` evaluated at ``t + offset_s``).
+    """
+    t = dense_times(planned.trajectory.breakpoints)
+    error = _distances(planned.trajectory, back, t, offset_s)
+    down = pen_down(t, planned.pen_windows_s).astype(bool)
+    check = verify(back, planned.limits, guaranteed=False)
+    return DeliveredCheck(
+        drone,
+        float(error.max()),
+        float(error[down].max()) if down.any() else 0.0,
+        check.max_excess,
+        tuple(check.limits_report()),
+    )
 
 
 class Exporter(Protocol):
@@ -108,6 +172,11 @@ def max_distance(reference: Trajectory, back: Trajectory, offset_s: float = 0.0)
     elsewhere); times past its end are held at its end.
     """
     t = dense_times(reference.breakpoints)
+    return float(_distances(reference, back, t, offset_s).max())
+
+
+def _distances(
+    reference: Trajectory, back: Trajectory, t: np.ndarray, offset_s: float
+) -> np.ndarray:
     here = np.clip(t + offset_s, 0.0, back.duration)
-    diff = reference.evaluate(t) - back.evaluate(here)
-    return float(np.linalg.norm(diff, axis=1).max())
+    return np.asarray(np.linalg.norm(reference.evaluate(t) - back.evaluate(here), axis=1))

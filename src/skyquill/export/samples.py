@@ -11,7 +11,13 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from skyquill.export.base import ExportOptions, ExportReport, NamedPlan, max_distance, target
+from skyquill.export.base import (
+    ExportOptions,
+    ExportReport,
+    NamedPlan,
+    check_delivered,
+    target,
+)
 from skyquill.io.points import write_trajectory_csv
 from skyquill.io.px4 import px4_setpoints, read_px4_csv
 from skyquill.io.setpoints_json import read_setpoints_json, write_setpoints_json
@@ -47,20 +53,21 @@ class SampledExporter:
         self, plans: Sequence[NamedPlan], out: Path, options: ExportOptions
     ) -> ExportReport:
         """Write each drone's samples, read them back, compare with the plan."""
-        files, error = [], 0.0
+        files, checks = [], []
         for name, planned in plans:
             path = target(out, name, len(plans) > 1, self.suffix)
             back = self.write(planned.trajectory, path, options.rate_hz)
-            error = max(error, max_distance(planned.trajectory, back))
+            checks.append(check_delivered(name, planned, back))
             files.append(path)
         return ExportReport(
             self.name,
             tuple(files),
             exact=False,
-            max_error_m=error,
+            max_error_m=max(c.max_error_m for c in checks),
             message=f"wrote {len(files)} {self.name} file(s) at {options.rate_hz:g} Hz: "
             + ", ".join(f.name for f in files),
             details={"rate_hz": options.rate_hz},
+            delivered=tuple(checks),
         )
 
 
