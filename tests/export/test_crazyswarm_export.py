@@ -23,6 +23,7 @@ from scipy.interpolate import make_interp_spline
 
 from skyquill.errors import InputError
 from skyquill.export import EXPORTERS, ExportOptions
+from skyquill.export.base import check_delivered
 from skyquill.export.crazyswarm import (
     FLOAT32_LIMIT_TOLERANCE,
     read_export,
@@ -97,7 +98,7 @@ def test_two_uploads_fit_rest_and_fly_as_planned(
 ) -> None:
     report, summary = export(tmp_path, two_uploads)
     assert [f.name for f in report.files] == ["cs_part1.csv", "cs_part2.csv", "cs_fly.py"]
-    (drone,) = summary["drones"]
+    (drone,) = summary["drone_uploads"]
     uploads = drone["uploads"]
     assert [u["pieces"] for u in uploads] == [28, 20]
     assert [u["hover_before_s"] for u in uploads] == [0.0, 1.0]
@@ -120,25 +121,17 @@ def test_two_uploads_fit_rest_and_fly_as_planned(
     assert drone["delivered_within_limits"] and "WARNING" not in report.message
     assert summary["delivered"][0]["limit_excess"] == check.limit_excess
     assert report.max_error_m == check.max_error_m
-    # The summary alone gives back what the Crazyflie flies.
+    # The summary and its files alone give back what the exporter checked.
     flown = read_export(tmp_path / "cs.summary.json")["d"]
-    times = np.linspace(0.0, flown.duration, 2000)
-    np.testing.assert_array_equal(flown.evaluate(times), report_flown(report, times))
-
-
-def report_flown(report: Any, t: np.ndarray) -> np.ndarray:
-    """The read-back the exporter checked, re-read here from its files."""
-    return read_export(report.files[0].with_name("cs.summary.json"))["d"].evaluate(t)
+    assert check_delivered("d", two_uploads, flown) == check
 
 
 def test_one_upload_is_one_file_and_drones_are_named(
     tmp_path: Path, one_upload: PlannedTrajectory, two_uploads: PlannedTrajectory
 ) -> None:
-    report, summary = export(
-        tmp_path / "a" if (tmp_path / "a").mkdir() is None else tmp_path, one_upload
-    )
+    report, summary = export(tmp_path, one_upload)
     assert [f.name for f in report.files] == ["cs.csv", "cs_fly.py"]
-    assert summary["drones"][0]["uploads"][0]["hover_before_s"] == 0.0
+    assert summary["drone_uploads"][0]["uploads"][0]["hover_before_s"] == 0.0
     both = EXPORT([("d1", one_upload), ("d2", two_uploads)], tmp_path / "b.csv", ExportOptions())
     assert [f.name for f in both.files] == [
         "b_d1.csv",
@@ -224,7 +217,7 @@ def test_a_missing_part_or_summary_is_refused(
     with pytest.raises(InputError, match=r"crazyswarm file: got '.*cs_part2.csv', expected an"):
         read_export(tmp_path / "cs.summary.json")
     (tmp_path / "x.json").write_text('{"format": "csv"}')
-    with pytest.raises(InputError, match=r"summary: got '.*x.json' \('drones'\), expected a"):
+    with pytest.raises(InputError, match=r"summary: got '.*x.json' \('drone_uploads'\)"):
         read_export(tmp_path / "x.json")
 
 
@@ -251,7 +244,8 @@ class FakeLink:
         link = self
 
         class Memory:
-            trajectory: list[Any] = []
+            def __init__(self) -> None:
+                self.trajectory: list[Any] = []
 
             def write_data_sync(self) -> bool:
                 data = b"".join(p.pack() for p in self.trajectory)
@@ -288,7 +282,7 @@ def load_script(path: Path, monkeypatch: pytest.MonkeyPatch) -> Any:
 def test_the_fly_script_uploads_while_hovering_and_starts_on_time(
     tmp_path: Path, two_uploads: PlannedTrajectory, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    report, summary = export(tmp_path, two_uploads)
+    _, summary = export(tmp_path, two_uploads)
     script = load_script(tmp_path / "cs_fly.py", monkeypatch)
     assert "uploadTrajectory" in script.__doc__ and "startTrajectory" in script.__doc__
     parts = script.parts_of(None, script.SCHEDULE)
@@ -300,17 +294,18 @@ def test_the_fly_script_uploads_while_hovering_and_starts_on_time(
         "go_to", "upload", "define_trajectory", "start_trajectory", "land", "stop",
     ]  # fmt: skip
     uploads = [c for c in link.calls if c[0] == "upload"]
-    for call, u in zip(uploads, summary["drones"][0]["uploads"], strict=True):
+    for call, u in zip(uploads, summary["drone_uploads"][0]["uploads"], strict=True):
         assert call[2] == cflib_bytes(tmp_path / u["file"]) and len(call[2]) <= 4096
     defined = [c for c in link.calls if c[0] == "define_trajectory"]
     assert [c[2:] for c in defined] == [(1, 0, 28), (1, 0, 20)]
     starts = [c[1] for c in link.calls if c[0] == "start_trajectory"]
-    planned = [u["start_s"] for u in summary["drones"][0]["uploads"]]
+    planned = [u["start_s"] for u in summary["drone_uploads"][0]["uploads"]]
     # On the plan's clock: the second upload starts exactly its planned time after the first.
     assert starts[1] - starts[0] == pytest.approx(planned[1] - planned[0])
     # The hover's go_to holds the end of upload 1 before its memory is overwritten.
     hold = next(c for c in link.calls[5:] if c[0] == "go_to")
-    np.testing.assert_allclose(hold[2:5], summary["drones"][0]["uploads"][0]["end"]["position"])
+    first_end = summary["drone_uploads"][0]["uploads"][0]["end"]["position"]
+    np.testing.assert_allclose(hold[2:5], first_end)
     assert hold[1] == pytest.approx(starts[0] + 2.6)
     assert link.calls[-2][1] == pytest.approx(starts[1] + 1.9)  # lands after the last upload
 

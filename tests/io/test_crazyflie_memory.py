@@ -134,7 +134,7 @@ def test_uploads_on_one_clock_hold_between() -> None:
 def test_bad_memory_contents_are_refused() -> None:
     with pytest.raises(InputError, match="data: got 131 B, expected a positive multiple of 132"):
         unpack_pieces(bytes(131))
-    with pytest.raises(InputError, match="data: got 4224 B .32 pieces., expected at most 4096"):
+    with pytest.raises(InputError, match=r"data: got 4224 B \(32 pieces\), expected at most 4096"):
         unpack_pieces(pack_pieces(random_table(32)))
     table = random_table(1)
     table[0, 5] = 1e39
@@ -142,14 +142,14 @@ def test_bad_memory_contents_are_refused() -> None:
         pack_pieces(table)
     table = random_table(2)
     table[1, 0] = -0.5
-    with pytest.raises(InputError, match="durations: got -0.5 at piece 1, expected > 0 s"):
+    with pytest.raises(InputError, match=r"durations: got -0\.5 at piece 1, expected > 0 s"):
         FirmwareTrajectory.from_bytes(pack_pieces(table))
     nan = np.frombuffer(pack_pieces(random_table(1)), dtype="<f4").copy()
     nan[3] = np.nan
     with pytest.raises(InputError, match="coeffs: got a NaN or infinite coefficient"):
         FirmwareTrajectory.from_bytes(nan.tobytes())
     a = FirmwareTrajectory.from_bytes(pack_pieces(random_table(2)))
-    with pytest.raises(InputError, match="starts_s: got .* expected each to start after"):
+    with pytest.raises(InputError, match=r"starts_s: got .* expected each to start after"):
         FlownUploads(np.array([0.0, 0.1]), (a, a), 10.0)
     with pytest.raises(InputError, match="axes: got 4"):
         FlownUploads(np.array([0.0]), (a,), 10.0, axes=4)

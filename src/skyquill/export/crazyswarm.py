@@ -160,7 +160,7 @@ class CrazyswarmExporter:
                 "float32_limit_tolerance": FLOAT32_LIMIT_TOLERANCE,
                 "rest_tolerance": REST_TOLERANCE,
                 "script": script.name,
-                "drones": [d.as_dict() for d in drones],
+                "drone_uploads": [d.as_dict() for d in drones],
             },
             delivered=tuple(d.delivered for d in drones),
         )
@@ -282,7 +282,7 @@ def _schedule(summary: Path) -> _Schedule:
                     for u in d["uploads"]
                 ],
             )
-            for d in data["drones"]
+            for d in data["drone_uploads"]
         ]
     except (OSError, ValueError, KeyError, TypeError) as exc:
         raise InputError(
