@@ -14,7 +14,6 @@ distance check of :func:`~skyquill.export.base.check_delivered` see.
 from __future__ import annotations
 
 import json
-import pprint
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -309,7 +308,7 @@ def write_fly_script(path: Path, drones: Sequence[DroneExport], several: bool) -
     marker = "SCHEDULE: dict[str, list[dict[str, Any]]] = {}\n"
     if marker not in source:  # pragma: no cover - the template and this line go together
         raise RuntimeError("crazyflie_fly.py: the SCHEDULE line is missing")
-    literal = pprint.pformat(schedule, width=96, sort_dicts=False)
+    literal = json.dumps(schedule, indent=4)  # strings, numbers, lists: also a Python literal
     path.write_text(
         source.replace(marker, f"SCHEDULE: dict[str, list[dict[str, Any]]] = {literal}\n"),
         encoding="utf-8",
@@ -348,7 +347,8 @@ def _message(drones: Sequence[DroneExport], script: Path, plans: Sequence[NamedP
     text = (
         f"wrote {uploads} Crazyflie upload(s) for {len(drones)} drone(s) (largest {largest} B "
         f"of {MEMORY_BYTES}) and {script.name}; flown as the firmware evaluates them (float32): "
-        f"within {1e3 * error:.3g} mm of the plan, limit excess {excess:.2g}"
+        f"within {1e3 * error:.3g} mm of the plan, limit excess {excess:.2g} (float32 "
+        f"rounding allowed: {FLOAT32_LIMIT_TOLERANCE:g})"
     )
     if any(not d.within_limits for d in drones):
         text += (
