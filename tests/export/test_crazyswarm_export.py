@@ -106,6 +106,7 @@ def test_two_uploads_fit_rest_and_fly_as_planned(
     for u in uploads:
         data = cflib_bytes(tmp_path / u["file"])
         assert u["bytes"] == len(data) == 132 * u["pieces"] <= 4096
+        assert u["at_rest"]
         for where in ("start", "end"):
             assert np.abs(u[where]["velocity"]).max() <= 1e-6
             assert np.abs(u[where]["acceleration"]).max() <= 1e-6
@@ -183,7 +184,9 @@ def test_a_plan_that_does_not_fit_is_refused_and_nothing_is_written(
 CORRUPTIONS = {
     "truncated": lambda text: text[: len(text) // 2],
     "nan": lambda text: text.replace(text.splitlines()[2].split(",")[3], "nan", 1),
-    "columns": lambda text: text.replace("\n", ",0\n", 2),
+    "columns": lambda text: "\n".join(
+        [*text.splitlines()[:2], text.splitlines()[2] + ",0", *text.splitlines()[3:]]
+    ),
     "negative-duration": lambda text: "\n".join(
         [text.splitlines()[0], "-" + text.splitlines()[1], *text.splitlines()[2:]]
     ),
@@ -192,7 +195,7 @@ CORRUPTIONS = {
 MESSAGES = {
     "truncated": r"cs_part2.csv( line \d+: got \d+ columns, expected 33|: got \d+ pieces, exp)",
     "nan": r"cs_part2.csv line 3, column x\^2: got 'nan', expected a finite",
-    "columns": r"cs_part2.csv: got unknown column",
+    "columns": r"cs_part2.csv line 3: got 34 columns, expected 33",
     "negative-duration": r"cs_part2.csv line 2, column duration: got -0.\d+, expected a dur",
     "row-dropped": r"cs_part2.csv: got 19 pieces, expected 20 \(as exported\)",
 }

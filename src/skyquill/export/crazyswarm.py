@@ -33,6 +33,7 @@ from skyquill.export.base import (
 )
 from skyquill.io.crazyflie_memory import (
     MEMORY_BYTES,
+    PIECE_BYTES,
     FlownUploads,
     end_states,
     flown_uploads,
@@ -96,7 +97,13 @@ class UploadFile:
             "hover_before_s": self.hover_before_s,
             "start": _state(self.start),
             "end": _state(self.end),
+            "at_rest": self.at_rest,
         }
+
+    @property
+    def at_rest(self) -> bool:
+        """Whether velocity and acceleration are within :data:`REST_TOLERANCE` at both ends."""
+        return bool(np.abs(np.vstack([self.start[1:], self.end[1:]])).max() <= REST_TOLERANCE)
 
 
 @dataclass(frozen=True)
@@ -230,7 +237,7 @@ def read_upload(path: Path) -> bytes:
     data = pack_pieces(read_crazyswarm_table(path))
     if len(data) > MEMORY_BYTES:
         raise InputError(
-            f"{path.name}: got {len(data) // 132} pieces ({len(data)} B), expected at most "
+            f"{path.name}: got {len(data) // PIECE_BYTES} pieces ({len(data)} B), expected at most "
             f"{MEMORY_BYTES} B, the Crazyflie's trajectory memory"
         )
     return data
@@ -256,7 +263,8 @@ def read_export(summary: Path) -> dict[str, FlownUploads]:
             data = read_upload(Path(summary).parent / file)
             if len(data) != size:
                 raise InputError(
-                    f"{file}: got {len(data) // 132} pieces, expected {pieces} (as exported)"
+                    f"{file}: got {len(data) // PIECE_BYTES} pieces, expected {pieces} "
+                    "(as exported)"
                 )
             packed.append(data)
         out[drone] = flown_uploads([u[3] for u in uploads], packed, duration_s, axes)
