@@ -1,4 +1,4 @@
-"""Crazyswarm2 / uav_trajectories polynomial CSV: export a spline, import it back.
+"""Crazyswarm2 / uav_trajectories polynomial CSV: one upload per file, exact, and read back.
 
 The format (``uav_trajectories``' ``generate_trajectory`` output, read by
 Crazyswarm2's ``uav_trajectory.Trajectory.loadcsv`` and uploaded with
