@@ -27,7 +27,41 @@ def fitted(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return out
 
 
+@pytest.fixture(scope="module")
+def targeted(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A plan shaped for a Crazyflie: two rest-to-rest moves of 20 and 25 spans, a hover between."""
+    from skyquill.io.plan_dir import write_plan
+    from skyquill.io.trajectory_json import PlannedTrajectory
+    from skyquill.limits import VehicleLimits
+    from skyquill.targets import hover
+    from skyquill.trajectory import RestToRestSequence, SplineTrajectory
+
+    def move(a: list[float], b: list[float], spans: int, duration: float) -> SplineTrajectory:
+        s = np.linspace(0.0, 1.0, spans + 7)
+        ease = s**3 * (10 - 15 * s + 6 * s**2)
+        ease[:4], ease[-4:] = 0.0, 1.0  # rest to order 3 at both ends
+        return SplineTrajectory(np.asarray(a) + ease[:, None] * np.subtract(b, a), 7, duration)
+
+    plan = RestToRestSequence(
+        (move([0, 0, 1], [1, 0, 1], 20, 4.0), hover(np.array([1.0, 0, 1]), 1.0),
+         move([1, 0, 1], [1, 1, 1.5], 25, 5.0))
+    )  # fmt: skip
+    out = tmp_path_factory.mktemp("targeted")
+    limits = VehicleLimits(1.0, 2.0, 10.0).derivative_limits(3)
+    write_plan(out, [PlannedTrajectory(plan, (), limits)], rate=100.0, guaranteed=True, summary={})
+    return out
+
+
 @pytest.mark.parametrize("fmt", ["crazyswarm", "skyc", "px4", "csv", "json"])
+def test_every_format_from_a_targeted_plan(targeted: Path, tmp_path: Path, fmt: str) -> None:
+    out = tmp_path / f"show{EXPORTERS[fmt].suffix}"
+    result = runner.invoke(app, ["export", str(targeted), "--format", fmt, "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    summary = json.loads((tmp_path / "show.summary.json").read_text())
+    assert summary["format"] == fmt and all(Path(f).exists() for f in summary["files"])
+
+
+@pytest.mark.parametrize("fmt", ["skyc", "px4", "csv", "json"])
 def test_every_format_from_a_fit(fitted: Path, tmp_path: Path, fmt: str) -> None:
     out = tmp_path / f"show{EXPORTERS[fmt].suffix}"
     result = runner.invoke(app, ["export", str(fitted), "--format", fmt, "--out", str(out)])
@@ -57,17 +91,14 @@ def test_an_export_never_writes_over_the_plan_it_reads(fitted: Path) -> None:
     assert (fitted / "trajectory.json").read_bytes() == before
 
 
-def test_crazyswarm_splits_long_trajectories_and_says_so(fitted: Path, tmp_path: Path) -> None:
+def test_crazyswarm_refuses_a_plan_that_does_not_fit(fitted: Path, tmp_path: Path) -> None:
     result = runner.invoke(
         app, ["export", str(fitted), "--format", "crazyswarm", "--out", str(tmp_path / "cf.csv")]
     )
-    assert result.exit_code == 0, result.output
-    summary = json.loads((tmp_path / "cf.summary.json").read_text())
-    for name in summary["files"]:
-        rows = Path(name).read_text().strip().splitlines()[1:]
-        assert len(rows) <= 31
-    if len(summary["files"]) > 1:
-        assert "split" in summary["message"]
+    assert result.exit_code == 2
+    text = " ".join(result.output.split())
+    assert "expected at most 31 per upload" in text and "target 'crazyflie'" in text
+    assert not any(tmp_path.iterdir())
 
 
 def test_several_drones_give_several_files_or_one_show(tmp_path: Path) -> None:
@@ -107,24 +138,25 @@ def test_bad_input(tmp_path: Path, fitted: Path) -> None:
     assert result.exit_code == 2 and "NaN" in " ".join(result.output.split())
 
 
-def test_crazyswarm_round_trip_flies_in_the_simulator(fitted: Path, tmp_path: Path) -> None:
-    """Import the (split) Crazyswarm upload and fly it: the same trajectory, the same limits."""
-    from skyquill.io.crazyswarm import read_crazyswarm
+def test_crazyswarm_round_trip_flies_in_the_simulator(targeted: Path, tmp_path: Path) -> None:
+    """Read the uploads back as the Crazyflie flies them (float32) and fly that."""
+    from skyquill.export.crazyswarm import read_export
     from skyquill.io.trajectory_json import read_trajectory_json
     from skyquill.sim import simulate
 
-    runner.invoke(
-        app, ["export", str(fitted), "--format", "crazyswarm", "--out", str(tmp_path / "cf.csv")]
+    result = runner.invoke(
+        app, ["export", str(targeted), "--format", "crazyswarm", "--out", str(tmp_path / "cf.csv")]
     )
-    files = json.loads((tmp_path / "cf.summary.json").read_text())["files"]
-    imported = read_crazyswarm([Path(f) for f in files])
-    original = read_trajectory_json(fitted / "trajectory.json").trajectory
+    assert result.exit_code == 0, result.output
+    summary = json.loads((tmp_path / "cf.summary.json").read_text())
+    assert [Path(f).name for f in summary["files"]] == ["cf_part1.csv", "cf_part2.csv", "cf_fly.py"]
+    assert [u["pieces"] for u in summary["drone_uploads"][0]["uploads"]] == [20, 25]
+    flown = read_export(tmp_path / "cf.summary.json")["trajectory"]
+    original = read_trajectory_json(targeted / "trajectory.json").trajectory
     t = np.linspace(0.0, original.duration, 3000)
-    for order in range(4):
-        assert np.allclose(
-            imported.evaluate(t, order),
-            original.evaluate(t, order),
-            atol=1e-9 * max(1.0, np.abs(original.evaluate(t, order)).max()),
-        )
-    flight = simulate(imported)
+    for order in range(3):
+        scale = max(1.0, np.abs(original.evaluate(t, order)).max())
+        assert np.abs(flown.evaluate(t, order) - original.evaluate(t, order)).max() < 1e-5 * scale
+    assert summary["delivered"][0]["max_error_m"] < 1e-5
+    flight = simulate(flown)
     assert flight.rmse_m < 0.01

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import csv
-import itertools
 import math
 from pathlib import Path
 
@@ -16,9 +15,10 @@ from skyquill.errors import InputError
 from skyquill.io.crazyswarm import (
     COLUMNS,
     HEADER,
-    MAX_PIECES,
     crazyswarm_pieces,
     read_crazyswarm,
+    read_crazyswarm_table,
+    upload_pieces,
     write_crazyswarm,
 )
 from skyquill.trajectory import PiecewisePolynomial, SplineTrajectory, Trajectory
@@ -76,20 +76,18 @@ def test_export_is_exact_against_independent_evaluator(
     tmp_path: Path, degree: int, dim: int
 ) -> None:
     traj = spline(degree, dim, seed=degree * 10 + dim)
-    out = write_crazyswarm(traj, tmp_path / "traj.csv", yaw=0.25)
-    assert out.strategy == "single"
-    assert out.files == (tmp_path / "traj.csv",)
-    assert out.pieces == 20 - degree
-    pieces = reference_pieces(out.files[0])
-    assert len(pieces) == out.pieces
+    path = write_crazyswarm(crazyswarm_pieces(traj, yaw=0.25), tmp_path / "traj.csv")
+    assert path == tmp_path / "traj.csv"
+    pieces = reference_pieces(path)
+    assert len(pieces) == 20 - degree
     assert all(axes[3] == [0.25, 0, 0, 0, 0, 0, 0, 0] for _, axes in pieces)
     # Degree < 7 is zero-padded: no coefficient above the degree.
     assert all(c[j] == 0.0 for _, axes in pieces for c in axes for j in range(degree + 1, 8))
     if dim == 2:
         assert all(axes[2] == [0.0] * 8 for _, axes in pieces)
-        assert "z = 0" in out.message
     t = np.sort(np.random.default_rng(1).uniform(0.0, traj.duration, 2000))
-    back = read_crazyswarm(out.files[0])
+    back = read_crazyswarm(path)
+    np.testing.assert_array_equal(read_crazyswarm_table(path), crazyswarm_pieces(traj, yaw=0.25))
     for order in range(4):
         want = traj.evaluate(t, order)
         if dim == 2:
@@ -120,52 +118,34 @@ def test_pieces_shape_and_columns() -> None:
     assert len(COLUMNS) == 33 and HEADER.startswith("duration,x^0,x^1")
 
 
-def test_split_into_uploads_is_continuous(tmp_path: Path) -> None:
-    traj = spline(5, 3, n_ctrl=105)  # 100 spans
-    out = write_crazyswarm(traj, tmp_path / "long.csv", max_pieces=31)
-    assert out.strategy == "split"
-    assert out.pieces == 100
-    assert out.files == tuple(tmp_path / f"long_part{i}.csv" for i in range(1, 5))
-    assert not (tmp_path / "long.csv").exists()
-    assert "split into 4 uploads of <= 31 pieces" in out.message
-    assert "fly them back to back" in out.message
-    parts = [reference_pieces(p) for p in out.files]
-    assert all(1 <= len(p) <= 31 for p in parts)
-    assert sum(len(p) for p in parts) == 100
-    for before, after in itertools.pairwise(parts):
-        end = sum(d for d, _ in before)
-        for order in range(3):
-            np.testing.assert_allclose(
-                reference_eval(before, end, order),
-                reference_eval(after, 0.0, order),
-                rtol=0,
-                atol=1e-9 * max(1.0, float(np.abs(traj.evaluate(traj.knot_times, order)).max())),
-            )
-    # The parts read back together are the original trajectory.
-    back = read_crazyswarm(out.files)
-    t = np.random.default_rng(2).uniform(0.0, traj.duration, 2000)
-    for order in range(4):
-        tol = 1e-9 * scale(traj, order, t)
-        np.testing.assert_allclose(back.evaluate(t, order), traj.evaluate(t, order), atol=tol)
-
-
-def test_oversized_file_says_so(tmp_path: Path) -> None:
-    traj = spline(3, 3, n_ctrl=43)  # 40 spans
-    out = write_crazyswarm(traj, tmp_path / "big.csv", max_pieces=100)
-    assert out.strategy == "single" and out.pieces == 40
-    assert "cannot be uploaded to a Crazyflie in one go" in out.message
-    assert "WARNING" not in write_crazyswarm(spline(3, 3), tmp_path / "ok.csv").message
-    assert MAX_PIECES == 31
+def test_an_upload_is_its_parts_back_to_back_and_polynomials_are_written_as_they_are(
+    tmp_path: Path,
+) -> None:
+    first, second = spline(7, 3, n_ctrl=12, seed=1), spline(5, 3, n_ctrl=9, seed=2)
+    table = upload_pieces([first, second])
+    assert table.shape == (5 + 4, 33)
+    np.testing.assert_array_equal(table[:5], crazyswarm_pieces(first))
+    # A piecewise polynomial read back from a file is written again unchanged, yaw included.
+    path = write_crazyswarm(crazyswarm_pieces(second, yaw=0.5), tmp_path / "a.csv")
+    again = write_crazyswarm(crazyswarm_pieces(read_crazyswarm(path)), tmp_path / "b.csv")
+    assert again.read_text() == path.read_text()
 
 
 def test_export_rejects_bad_arguments(tmp_path: Path) -> None:
-    with pytest.raises(InputError, match="max_pieces: got 0, expected an integer >= 1"):
-        write_crazyswarm(spline(3, 3), tmp_path / "a.csv", max_pieces=0)
+    with pytest.raises(InputError, match=r"table: got shape \(3, 4\), expected \(P, 33\)"):
+        write_crazyswarm(np.zeros((3, 4)), tmp_path / "a.csv")
+    with pytest.raises(InputError, match="parts: got none, expected at least one trajectory"):
+        upload_pieces([])
+    with pytest.raises(InputError, match="parts: got a str, expected a SplineTrajectory or a"):
+        upload_pieces(["x"])  # type: ignore[list-item]
+    poly9 = PiecewisePolynomial(np.array([0.0, 1.0]), np.ones((1, 10, 3)))
+    with pytest.raises(InputError, match="traj: got degree 9, expected at most 7"):
+        crazyswarm_pieces(poly9)
     with pytest.raises(InputError, match="yaw: got nan, expected a finite number"):
         crazyswarm_pieces(spline(3, 3), yaw=float("nan"))
     with pytest.raises(InputError, match="traj: got a 1-D trajectory, expected 2 or 3 axes"):
         crazyswarm_pieces(spline(3, 1))
-    with pytest.raises(InputError, match="traj: got str, expected a SplineTrajectory"):
+    with pytest.raises(InputError, match="traj: got str, expected a SplineTrajectory or a Piece"):
         crazyswarm_pieces("x")  # type: ignore[arg-type]
 
 
@@ -200,11 +180,9 @@ def test_read_rejects_bad_files(tmp_path: Path, text: str, match: str) -> None:
         read_crazyswarm(write(tmp_path, text))
 
 
-def test_read_rejects_missing_file_and_empty_list(tmp_path: Path) -> None:
+def test_read_rejects_a_missing_file(tmp_path: Path) -> None:
     with pytest.raises(InputError, match=r"crazyswarm file: got '.*nope\.csv', expected an exis"):
         read_crazyswarm(tmp_path / "nope.csv")
-    with pytest.raises(InputError, match="path: got an empty sequence"):
-        read_crazyswarm([])
 
 
 def test_read_accepts_crazyswarm_capitalised_header_and_blank_lines(tmp_path: Path) -> None:

@@ -1,4 +1,4 @@
-"""Crazyswarm2 / uav_trajectories polynomial CSV: export a spline, import it back.
+"""Crazyswarm2 / uav_trajectories polynomial CSV: one upload per file, exact, and read back.
 
 The format (``uav_trajectories``' ``generate_trajectory`` output, read by
 Crazyswarm2's ``uav_trajectory.Trajectory.loadcsv`` and uploaded with
@@ -17,28 +17,25 @@ the file are skyquill's numbers.
 
 A clamped uniform B-spline of degree ``k <= 7`` is a polynomial of degree ``k``
 on each knot span, so the export is exact: one piece per span, coefficients of
-``tau^(k+1) .. tau^7`` zero. The Crazyflie keeps at most :data:`MAX_PIECES`
-pieces in its 4 KB trajectory memory (132 B a piece); a longer trajectory is
-split into several consecutive uploads, and :class:`CrazyswarmExport` says so.
+``tau^(k+1) .. tau^7`` zero; a :class:`PiecewisePolynomial` of degree ``<= 7``
+is written piece by piece. One file is one upload: deciding the uploads
+(at most 31 pieces each, changing only where the vehicle is at rest) is
+:func:`skyquill.targets.plan_uploads`' job, and what the Crazyflie does with
+the numbers is :mod:`skyquill.io.crazyflie_memory`'s.
 """
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
-from dataclasses import dataclass
 from pathlib import Path
-from typing import Literal
 
 import numpy as np
 
 from skyquill.errors import InputError
 from skyquill.io.table import read_table
-from skyquill.trajectory import PiecewisePolynomial, SplineTrajectory
-from skyquill.validation import FloatArray, as_float, as_int
+from skyquill.trajectory import PiecewisePolynomial, SplineTrajectory, Trajectory
+from skyquill.validation import FloatArray, as_float
 
-#: Pieces the Crazyflie can hold at once: 4096 B of trajectory memory / 132 B a piece.
-MAX_PIECES = 31
 #: Coefficients per axis in the file (degree 7).
 N_COEFFS = 8
 #: Axes in the file, in column order.
@@ -49,38 +46,17 @@ COLUMNS: tuple[str, ...] = ("duration", *(f"{a}^{j}" for a in AXES for j in rang
 HEADER = ",".join(COLUMNS)
 
 
-@dataclass(frozen=True)
-class CrazyswarmExport:
-    """What :func:`write_crazyswarm` wrote.
-
-    Attributes
-    ----------
-    files
-        The CSV files, one per upload, in flight order.
-    pieces
-        Total number of polynomial pieces over all files.
-    strategy
-        ``"single"`` (one file) or ``"split"`` (several uploads flown back to back).
-    message
-        One sentence on what was done, for the CLI to print and ``summary.json``.
-    """
-
-    files: tuple[Path, ...]
-    pieces: int
-    strategy: Literal["single", "split"]
-    message: str
-
-
-def crazyswarm_pieces(traj: SplineTrajectory, yaw: float = 0.0) -> FloatArray:
-    """The rows of the Crazyswarm CSV for ``traj``: one per knot span, exact.
+def crazyswarm_pieces(traj: SplineTrajectory | PiecewisePolynomial, yaw: float = 0.0) -> FloatArray:
+    """The rows of the Crazyswarm CSV for ``traj``: one per knot span or piece, exact.
 
     Parameters
     ----------
     traj
-        Spline of degree 1 to 7 with 2 or 3 axes, z-up world frame, metres.
-        A 2-D trajectory gets ``z = 0``.
+        Spline or piecewise polynomial of degree at most 7 with 2 or 3 axes,
+        z-up world frame, metres. A 2-D trajectory gets ``z = 0``.
     yaw
-        Constant yaw, rad (the ``yaw^0`` column; higher yaw coefficients are 0).
+        Constant yaw, rad (the ``yaw^0`` column), used when ``traj`` carries
+        no yaw polynomial of its own.
 
     Returns
     -------
@@ -88,146 +64,87 @@ def crazyswarm_pieces(traj: SplineTrajectory, yaw: float = 0.0) -> FloatArray:
         Column 0 is the piece duration, s; then 8 coefficients (``tau^0`` to
         ``tau^7``, lowest first) for each of x, y, z (m) and yaw (rad).
     """
-    if not isinstance(traj, SplineTrajectory):
-        raise InputError(
-            f"traj: got {type(traj).__name__}, expected a SplineTrajectory "
-            "(the export is exact only for piecewise polynomials)"
-        )
-    if traj.dim not in (2, 3):
-        raise InputError(f"traj: got a {traj.dim}-D trajectory, expected 2 or 3 axes")
     yaw = as_float("yaw", yaw)
-    breaks, coeffs = traj.to_piecewise_polynomial()  # (L+1,), (L, k+1, d)
+    breaks, coeffs, yaw_coeffs = _power_basis(traj)
     n_pieces, n_coef, dim = coeffs.shape
+    if n_coef > N_COEFFS:
+        raise InputError(
+            f"traj: got degree {n_coef - 1}, expected at most {N_COEFFS - 1} (the Crazyflie "
+            "evaluates degree-7 polynomials)"
+        )
     poly = np.zeros((n_pieces, N_COEFFS, 4))  # zero padding: degree < 7, z of 2-D, yaw
     poly[:, :n_coef, :dim] = coeffs
     poly[:, 0, 3] = yaw
+    if yaw_coeffs is not None:
+        poly[:, :, 3] = 0.0
+        poly[:, : yaw_coeffs.shape[1], 3] = yaw_coeffs[:, :N_COEFFS]
     # Axis-major columns: x^0..x^7, y^0..y^7, ...
     return np.column_stack([np.diff(breaks), poly.transpose(0, 2, 1).reshape(n_pieces, -1)])
 
 
-def _part_path(path: Path, i: int) -> Path:
-    return path.with_name(f"{path.stem}_part{i}.csv")
+def _power_basis(
+    traj: SplineTrajectory | PiecewisePolynomial,
+) -> tuple[FloatArray, FloatArray, FloatArray | None]:
+    """Breaks (L + 1,), coefficients (L, K, d) and yaw coefficients (L, K_yaw) or None."""
+    if isinstance(traj, SplineTrajectory):
+        breaks, coeffs = traj.to_piecewise_polynomial()
+        yaw = None
+    elif isinstance(traj, PiecewisePolynomial):
+        breaks, coeffs, yaw = traj.breaks, traj.coeffs, traj.yaw_coeffs
+        if yaw is not None and yaw.shape[1] > N_COEFFS and np.any(yaw[:, N_COEFFS:]):
+            raise InputError(
+                f"traj: got a yaw polynomial of degree {yaw.shape[1] - 1}, expected at most "
+                f"{N_COEFFS - 1}"
+            )
+    else:
+        raise InputError(
+            f"traj: got {type(traj).__name__}, expected a SplineTrajectory or a "
+            "PiecewisePolynomial (the export is exact only for piecewise polynomials)"
+        )
+    if traj.dim not in (2, 3):
+        raise InputError(f"traj: got a {traj.dim}-D trajectory, expected 2 or 3 axes")
+    return breaks, coeffs, yaw
 
 
-def _write_table(path: Path, table: FloatArray) -> None:
-    # '%.17g' is round-trip precision for float64.
+def upload_pieces(parts: Sequence[Trajectory], yaw: float = 0.0) -> FloatArray:
+    """The rows of one upload: the pieces of ``parts`` (flown back to back), shape (P, 33).
+
+    ``parts`` are the :attr:`~skyquill.targets.Upload.parts` of an upload,
+    each a :class:`SplineTrajectory` or :class:`PiecewisePolynomial`
+    (:func:`crazyswarm_pieces`); an empty sequence is refused.
+    """
+    if not parts:
+        raise InputError("parts: got none, expected at least one trajectory")
+    tables = []
+    for part in parts:
+        if not isinstance(part, SplineTrajectory | PiecewisePolynomial):
+            raise InputError(
+                f"parts: got a {type(part).__name__}, expected a SplineTrajectory or a "
+                "PiecewisePolynomial"
+            )
+        tables.append(crazyswarm_pieces(part, yaw))
+    return np.concatenate(tables)
+
+
+def write_crazyswarm(table: FloatArray, path: str | Path) -> Path:
+    """Write the rows ``table`` (P, 33) (:func:`upload_pieces`) as one Crazyswarm CSV.
+
+    Values are printed with ``%.17g`` (float64 round trip), so the file holds
+    exactly the polynomials it was given; ``path`` is returned.
+    """
+    table = np.asarray(table, dtype=float)
+    if table.ndim != 2 or table.shape[1] != len(COLUMNS) or table.shape[0] < 1:
+        raise InputError(
+            f"table: got shape {table.shape}, expected (P, {len(COLUMNS)}) with P >= 1"
+        )
+    path = Path(path)
     lines = [HEADER, *(",".join(f"{v:.17g}" for v in row) for row in table)]
     path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    return path
 
 
-def write_crazyswarm(
-    traj: SplineTrajectory,
-    path: str | Path,
-    max_pieces: int = MAX_PIECES,
-    yaw: float = 0.0,
-) -> CrazyswarmExport:
-    """Write ``traj`` as Crazyswarm CSV, split into uploads the Crazyflie can hold.
-
-    Parameters
-    ----------
-    traj
-        Spline of degree 1 to 7, 2 or 3 axes, z-up world frame (no conversion:
-        Crazyswarm's world frame is z-up too), metres.
-    path
-        Output file. With more than ``max_pieces`` pieces the trajectory is
-        split into ``n`` consecutive uploads written to
-        ``<stem>_part1.csv .. <stem>_part<n>.csv`` next to ``path`` (and
-        ``path`` itself is not written); each part starts at its own local
-        time 0, and the parts have (nearly) equal piece counts.
-    max_pieces
-        Most pieces per file, >= 1; default the Crazyflie's :data:`MAX_PIECES`.
-        A larger value is honoured, but the message then says the vehicle
-        cannot hold such a file in one upload.
-    yaw
-        Constant yaw, rad.
-
-    Returns
-    -------
-    CrazyswarmExport
-        The files, the piece count, ``"single"`` or ``"split"`` and a message.
-
-    Notes
-    -----
-    Splitting keeps the trajectory exact: the pieces are the same, only grouped
-    into uploads. At each join the end state of one upload equals the start of
-    the next up to derivative ``k - 1`` (the spline is ``C^(k-1)``), so the
-    uploads flown back to back fly the original trajectory. The alternative the
-    issue mentions, refitting with fewer knots, changes the trajectory and would
-    have to be re-verified against the limits; it is not done here.
-    """
-    table = crazyswarm_pieces(traj, yaw)
-    max_pieces = as_int("max_pieces", max_pieces, low=1)
-    path = Path(path)
-    n_pieces = table.shape[0]
-    notes = ""
-    if traj.dim == 2:
-        notes += (
-            " The trajectory is 2-D and was written with z = 0 m: fly it relative to a "
-            "hover point (Crazyswarm2 start_trajectory(relative=True)) or lift it first."
-        )
-    if max_pieces > MAX_PIECES and min(n_pieces, max_pieces) > MAX_PIECES:
-        notes += (
-            f" WARNING: a file holds more than {MAX_PIECES} pieces, more than the Crazyflie's "
-            f"4 KB trajectory memory holds ({MAX_PIECES} pieces of 132 B); it cannot be "
-            "uploaded to a Crazyflie in one go."
-        )
-    if n_pieces <= max_pieces:
-        _write_table(path, table)
-        return CrazyswarmExport(
-            files=(path,),
-            pieces=n_pieces,
-            strategy="single",
-            message=(
-                f"wrote {n_pieces} piece(s) of degree {traj.degree} (exact) to {path}, "
-                f"one upload of <= {max_pieces} pieces." + notes
-            ),
-        )
-    n_files = math.ceil(n_pieces / max_pieces)
-    files = []
-    for i, part in enumerate(np.array_split(table, n_files), start=1):
-        part_path = _part_path(path, i)
-        _write_table(part_path, part)
-        files.append(part_path)
-    return CrazyswarmExport(
-        files=tuple(files),
-        pieces=n_pieces,
-        strategy="split",
-        message=(
-            f"{n_pieces} pieces exceed {max_pieces} per upload: split into {n_files} uploads "
-            f"of <= {max_pieces} pieces ({files[0].name} .. {files[-1].name}); fly them back "
-            "to back; each piece's end state equals the next one's start "
-            f"(C^{traj.degree - 1})." + notes
-        ),
-    )
-
-
-def _read_table(path: Path) -> FloatArray:
-    """The pieces of one file, shape (P, 33), columns :data:`COLUMNS`; durations > 0."""
-    table = read_table(path, required=COLUMNS, unknown="refuse", min_rows=1, name="crazyswarm file")
-    durations = table.column("duration")
-    if np.any(durations <= 0.0):
-        r = int(np.argmax(durations <= 0.0))
-        raise InputError(
-            f"{table.name} line {table.lines[r]}, column duration: got {durations[r]:g}, "
-            "expected a duration > 0 s"
-        )
-    return table.data
-
-
-def read_crazyswarm(path: str | Path | Sequence[str | Path]) -> PiecewisePolynomial:
-    """Read one Crazyswarm CSV, or several uploads flown back to back.
-
-    Parameters
-    ----------
-    path
-        A file, or a sequence of files (e.g. the ``_part<i>.csv`` uploads of
-        :func:`write_crazyswarm`) whose pieces are concatenated in time.
-
-    Returns
-    -------
-    PiecewisePolynomial
-        3 axes in the z-up world frame (Crazyswarm's frame; nothing converted),
-        metres, time from 0; yaw via :meth:`PiecewisePolynomial.evaluate_yaw`.
+def read_crazyswarm_table(path: str | Path) -> FloatArray:
+    """The pieces of one Crazyswarm CSV, shape (P, 33), columns :data:`COLUMNS`.
 
     Raises
     ------
@@ -239,16 +156,44 @@ def read_crazyswarm(path: str | Path | Sequence[str | Path]) -> PiecewisePolynom
         no rows), a duration <= 0 (naming file and line), or piece durations
         that do not add up to increasing times.
     """
-    paths = [Path(path)] if isinstance(path, str | Path) else [Path(p) for p in path]
-    if not paths:
-        raise InputError("path: got an empty sequence, expected at least one CSV file")
-    table = np.concatenate([_read_table(p) for p in paths])
-    n = table.shape[0]
-    breaks = np.concatenate([[0.0], np.cumsum(table[:, 0])])
+    table = read_table(path, required=COLUMNS, unknown="refuse", min_rows=1, name="crazyswarm file")
+    durations = table.column("duration")
+    if np.any(durations <= 0.0):
+        r = int(np.argmax(durations <= 0.0))
+        raise InputError(
+            f"{table.name} line {table.lines[r]}, column duration: got {durations[r]:g}, "
+            "expected a duration > 0 s"
+        )
+    breaks = np.concatenate([[0.0], np.cumsum(durations)])
     if not np.all(np.isfinite(breaks)) or np.any(np.diff(breaks) <= 0.0):
         raise InputError(
-            f"{', '.join(map(str, paths))}: piece durations do not add up to a finite, "
-            "strictly increasing time (durations too large or too small relative to the total)"
+            f"{table.name}: piece durations do not add up to a finite, strictly increasing "
+            "time (durations too large or too small relative to the total)"
         )
+    return np.array(table.select(COLUMNS))
+
+
+def read_crazyswarm(path: str | Path) -> PiecewisePolynomial:
+    """Read one Crazyswarm CSV (one upload) in float64, as Crazyswarm2's ``loadcsv`` does.
+
+    Parameters
+    ----------
+    path
+        The file.
+
+    Returns
+    -------
+    PiecewisePolynomial
+        3 axes in the z-up world frame (Crazyswarm's frame; nothing converted),
+        metres, time from 0; yaw via :meth:`PiecewisePolynomial.evaluate_yaw`.
+
+    Raises
+    ------
+    InputError
+        As :func:`read_crazyswarm_table`.
+    """
+    table = read_crazyswarm_table(path)
+    n = table.shape[0]
+    breaks = np.concatenate([[0.0], np.cumsum(table[:, 0])])
     poly = table[:, 1:].reshape(n, 4, N_COEFFS).transpose(0, 2, 1)  # (P, 8, 4)
     return PiecewisePolynomial(breaks, poly[:, :, :3].copy(), poly[:, :, 3].copy())

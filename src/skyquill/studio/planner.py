@@ -298,7 +298,15 @@ def _exports(missions: Sequence[Mission]) -> tuple[dict[str, StudioFile], list[s
         notes = []
         for name, stem in STUDIO_FORMATS.items():
             exporter = EXPORTERS[name]
-            report = exporter(planned, out / f"{name}{exporter.suffix}", ExportOptions(CSV_RATE_HZ))
+            try:
+                report = exporter(
+                    planned, out / f"{name}{exporter.suffix}", ExportOptions(CSV_RATE_HZ)
+                )
+            except InputError as exc:
+                # A plan the format cannot hold (a Crazyswarm export of a plan that does not
+                # fit the Crazyflie's uploads) is a missing download, not a failed plan.
+                notes.append(f"{stem}: download unavailable: {exc}")
+                continue
             notes.append(report.message.replace(str(out) + "/", ""))
             parts = [(f.name, f.read_bytes()) for f in report.files]
             files.append(_bundle(parts, stem, exporter.help))
