@@ -168,7 +168,7 @@ class _Reader:
             shift += 7
             if byte < 0x80:
                 return float(value * FRAME_MS)
-            if shift > 35:
+            if shift >= 35:
                 raise InputError(f"{self.where}: got a duration over 5 bytes at byte {self.index}")
 
     def advance(self, ms: float) -> None:
