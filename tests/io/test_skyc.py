@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import copy
+import io
 import json
 import math
 import tempfile
@@ -238,3 +239,16 @@ def test_random_show_json_gives_a_show_or_an_input_error(doc: object) -> None:
             read_show_json(path)
         except InputError as exc:
             assert "show.json" in str(exc)
+
+
+def test_a_truncated_or_nan_show_is_an_input_error(tmp_path: Path) -> None:
+    path = write_skyc([drone(spline(3))], tmp_path / "t.skyc")
+    whole = path.read_bytes()
+    show = json.loads(zipfile.ZipFile(io.BytesIO(whole)).read("show.json"))
+    path.write_bytes(whole[: len(whole) // 2])
+    with pytest.raises(InputError, match=r"t\.skyc: "):
+        read_show_json(path)
+    show["swarm"]["drones"][0]["settings"]["trajectory"]["points"][1][1][0] = math.nan
+    nan = _archive(tmp_path / "nan.skyc", json.dumps(show).encode())  # json writes NaN
+    with pytest.raises(InputError, match=r"points\[1\]\[1\]: got \[nan"):
+        read_show_json(nan)
