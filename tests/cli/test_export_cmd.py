@@ -52,7 +52,7 @@ def targeted(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return out
 
 
-@pytest.mark.parametrize("fmt", ["crazyswarm", "skyc", "px4", "csv", "json"])
+@pytest.mark.parametrize("fmt", ["crazyswarm", "skyc", "skybrush-csv", "px4", "csv", "json"])
 def test_every_format_from_a_targeted_plan(targeted: Path, tmp_path: Path, fmt: str) -> None:
     out = tmp_path / f"show{EXPORTERS[fmt].suffix}"
     result = runner.invoke(app, ["export", str(targeted), "--format", fmt, "--out", str(out)])
@@ -61,7 +61,7 @@ def test_every_format_from_a_targeted_plan(targeted: Path, tmp_path: Path, fmt: 
     assert summary["format"] == fmt and all(Path(f).exists() for f in summary["files"])
 
 
-@pytest.mark.parametrize("fmt", ["skyc", "px4", "csv", "json"])
+@pytest.mark.parametrize("fmt", ["skyc", "skybrush-csv", "px4", "csv", "json"])
 def test_every_format_from_a_fit(fitted: Path, tmp_path: Path, fmt: str) -> None:
     out = tmp_path / f"show{EXPORTERS[fmt].suffix}"
     result = runner.invoke(app, ["export", str(fitted), "--format", fmt, "--out", str(out)])
@@ -160,3 +160,22 @@ def test_crazyswarm_round_trip_flies_in_the_simulator(targeted: Path, tmp_path: 
     assert summary["delivered"][0]["max_error_m"] < 1e-5
     flight = simulate(flown)
     assert flight.rmse_m < 0.01
+
+
+def test_the_light_colour_reaches_the_skybrush_formats(fitted: Path, tmp_path: Path) -> None:
+    out = tmp_path / "lit.zip"
+    args = ["export", str(fitted), "--format", "skybrush-csv", "--out", str(out)]
+    result = runner.invoke(app, [*args, "--light", "10,20,30"])
+    assert result.exit_code == 0, result.output
+    summary = json.loads((tmp_path / "lit.summary.json").read_text())
+    assert summary["lights_exact_to_ms"] and summary["format"] == "skybrush-csv"
+
+
+@pytest.mark.parametrize("light", ["10,20", "1,2,256", "red", "1,-2,3", "1.5,2,3"])
+def test_a_bad_light_colour_is_named(fitted: Path, tmp_path: Path, light: str) -> None:
+    out = tmp_path / "s.skyc"
+    args = ["export", str(fitted), "--format", "skyc", "--out", str(out), "--light", light]
+    result = runner.invoke(app, args)
+    assert result.exit_code == 2
+    assert f"--light: got {light!r}, expected R,G,B with three integers in 0..255" in result.output
+    assert not out.exists()

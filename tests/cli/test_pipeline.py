@@ -23,6 +23,7 @@ from skyquill.export import EXPORTERS
 from skyquill.export.crazyswarm import read_export
 from skyquill.io.px4 import read_px4_csv
 from skyquill.io.setpoints_json import read_setpoints_json
+from skyquill.io.skybrush_csv import read_csv_zip
 from skyquill.io.skyc import read_show_json, show_trajectories
 from skyquill.io.trajectory_csv import read_trajectory_csv
 from skyquill.io.trajectory_json import read_trajectory_json
@@ -68,14 +69,22 @@ READERS: dict[str, Callable[[list[Path]], list[Trajectory]]] = {
         read_export(files[0].with_name(f"{files[0].stem.split('_')[0]}.summary.json")).values()
     ),
     "skyc": lambda files: show_trajectories(read_show_json(files[0])),
+    "skybrush-csv": lambda files: [d.trajectory() for d in read_csv_zip(files[0])],
     "px4": lambda files: [read_px4_csv(f) for f in files],
     "csv": lambda files: [read_trajectory_csv(f) for f in files],
     "json": lambda files: [read_setpoints_json(f).trajectory for f in files],
 }
 #: Largest distance of a read-back export from the plan, m: exact formats to the float
-#: rounding of the files (Crazyswarm: float32, as the Crazyflie evaluates it; Skybrush's cubic
-#: approximation: 1 mm); sampled formats to the Hermite interpolation between 100 Hz rows.
-TOLERANCE_M = {"crazyswarm": 1e-5, "skyc": 1.2e-3, "px4": 1e-3, "csv": 1e-3, "json": 1e-3}
+#: rounding of the files (Skybrush, as its drones play it: cubics on its ms/mm grid, 2 mm);
+#: sampled formats to the interpolation between 100 Hz rows.
+TOLERANCE_M = {
+    "crazyswarm": 1e-5,
+    "skyc": 2e-3,
+    "skybrush-csv": 1e-3,
+    "px4": 1e-3,
+    "csv": 1e-3,
+    "json": 1e-3,
+}
 #: Refitting a trajectory that is not a B-spline (paint's straight legs, coverage's retimed
 #: paths) inside the plan's limits adds its deviation: a coverage path that runs at its jerk
 #: limit (up to the LP's 2 % over it) is followed a few cm behind (3.3 cm on the L field).

@@ -17,10 +17,16 @@ from skyquill.trajectory import RetimedPath, SplineTrajectory, Trajectory
 from skyquill.verify import verify
 
 LIMITS = VehicleLimits(2.0, 4.0, 20.0).derivative_limits(3)
-#: Exact formats to float rounding (Crazyswarm: float32, as the Crazyflie evaluates it);
-#: Skybrush's cubic approximation to 1 mm; sampled formats to the interpolation between their
-#: 100 Hz rows.
-TOLERANCE_M = {"crazyswarm": 1e-5, "skyc": 1.1e-3, "px4": 1e-3, "csv": 1e-3, "json": 1e-3}
+#: Exact formats to float rounding; Skybrush's cubics on its ms/mm grid to 2 mm; sampled
+#: formats to the interpolation between their 100 Hz rows.
+TOLERANCE_M = {
+    "crazyswarm": 1e-5,
+    "skyc": 2e-3,
+    "skybrush-csv": 1e-3,
+    "px4": 1e-3,
+    "csv": 1e-3,
+    "json": 1e-3,
+}
 
 
 def _spline() -> SplineTrajectory:

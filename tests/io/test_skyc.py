@@ -1,9 +1,9 @@
-"""Skybrush .skyc export, checked by an independent Bézier evaluator."""
+"""Skybrush .skyc shows: written, read back, and every malformed show named."""
 
 from __future__ import annotations
 
 import copy
-import itertools
+import io
 import json
 import math
 import tempfile
@@ -18,9 +18,10 @@ from hypothesis import strategies as st
 
 from skyquill.errors import InputError
 from skyquill.io import skyc
-from skyquill.io.skyc import MAX_SEGMENT_S, read_show_json, validate_show, write_skyc
+from skyquill.io.skybrush_keyframes import skybrush_keyframes
+from skyquill.io.skybrush_lights import encode_light_program, program_bytes
+from skyquill.io.skyc import SkycDrone, read_show_json, show_trajectories, validate_show, write_skyc
 from skyquill.trajectory import SplineTrajectory
-from skyquill.validation import FloatArray
 
 
 def spline(degree: int, seed: int = 0, n_ctrl: int = 14, duration: float = 8.0) -> SplineTrajectory:
@@ -29,137 +30,50 @@ def spline(degree: int, seed: int = 0, n_ctrl: int = 14, duration: float = 8.0) 
     return SplineTrajectory(ctrl, degree, duration)
 
 
-def bezier_positions(points: list[Any], t: FloatArray) -> FloatArray:
-    """Evaluate Skybrush keyframes at times ``t`` by de Casteljau (independent of skyc.py).
-
-    ``points[i] = [t_i, p_i, controls_i]``: the segment from ``t_{i-1}`` to
-    ``t_i`` has control points ``p_{i-1}, *controls_i, p_i``.
-    """
-    times = np.array([float(p[0]) for p in points])
-    out = np.empty((t.size, 3))
-    for n, tn in enumerate(t):
-        i = int(np.clip(np.searchsorted(times, tn, side="right"), 1, len(points) - 1))
-        ctrl = [np.array(points[i - 1][1])] + [np.array(c) for c in points[i][2]]
-        ctrl.append(np.array(points[i][1]))
-        s = (tn - times[i - 1]) / (times[i] - times[i - 1])
-        while len(ctrl) > 1:
-            ctrl = [(1 - s) * a + s * b for a, b in itertools.pairwise(ctrl)]
-        out[n] = ctrl[0]
-    return out
+def drone(traj: SplineTrajectory, name: str = "d", lights: bytes | None = None) -> SkycDrone:
+    return SkycDrone(name, skybrush_keyframes(traj), lights)
 
 
-def drone_points(show: dict[str, Any], i: int) -> list[Any]:
-    points: list[Any] = show["swarm"]["drones"][i]["settings"]["trajectory"]["points"]
-    return points
+def test_a_show_holds_trajectories_lights_yaw_and_validation(tmp_path: Path) -> None:
+    trajs = [spline(5, seed=s) for s in range(3)]
+    program = encode_light_program([(1.0, 2.0)], (1, 2, 3), 8.0)
+    drones = [drone(t, f"d{i}", program if i == 0 else None) for i, t in enumerate(trajs)]
+    path = write_skyc(drones, tmp_path / "three.skyc", validation={"maxAltitude": 2.5}, title="3")
+    with zipfile.ZipFile(path) as archive:
+        assert archive.namelist() == ["show.json"]
+    show = read_show_json(path)
+    assert show["meta"]["title"] == "3" and show["environment"]["type"] == "indoor"
+    assert show["settings"]["validation"] == {"maxAltitude": 2.5}
+    for i, entry in enumerate(show["swarm"]["drones"]):
+        settings = entry["settings"]
+        assert settings["name"] == f"d{i}"
+        assert settings["trajectory"]["takeoffTime"] == 0.0
+        assert settings["home"] == settings["trajectory"]["points"][0][1]
+        assert settings["yawControl"] == {
+            "version": 1,
+            "setpoints": [[0.0, 0.0], [8.0, 0.0]],
+            "autoYaw": False,
+        }
+        assert ("lights" in settings) == (i == 0)
+    assert program_bytes("l", show["swarm"]["drones"][0]["settings"]["lights"]) == program
+    t = np.linspace(0.0, 8.0, 20_001)
+    for back, traj in zip(show_trajectories(show), trajs, strict=True):
+        assert np.linalg.norm(back.evaluate(t) - traj.evaluate(t), axis=1).max() <= 2e-3
 
 
-def dense(traj: SplineTrajectory) -> FloatArray:
-    return np.linspace(0.0, traj.duration, 20_001)
-
-
-@pytest.mark.parametrize("degree", [1, 2, 3])
-def test_degree_up_to_3_is_exact(tmp_path: Path, degree: int) -> None:
-    traj = spline(degree)
-    result = write_skyc([traj], tmp_path / "show.skyc")
-    assert result.exact
-    assert result.max_error_m <= 1e-12
-    assert result.segments == len(traj.knot_times) - 1  # one cubic per knot span
-    show = read_show_json(result.path)
-    t = dense(traj)
-    err = np.linalg.norm(bezier_positions(drone_points(show, 0), t) - traj.evaluate(t), axis=1)
-    assert err.max() <= 1e-9
-
-
-def test_degree_5_within_tolerance_and_reported(tmp_path: Path) -> None:
-    traj = spline(5, seed=1)
-    tol = 1e-3
-    result = write_skyc([traj], tmp_path / "show.skyc", tolerance=tol)
-    assert not result.exact
-    assert 0.0 < result.max_error_m <= tol
-    assert "approximated" in result.message
-    show = read_show_json(result.path)
-    t = dense(traj)
-    err = np.linalg.norm(bezier_positions(drone_points(show, 0), t) - traj.evaluate(t), axis=1)
-    assert err.max() <= tol
-    # the reported error is what an independent dense check finds, to a few percent
-    assert err.max() == pytest.approx(result.max_error_m, rel=0.05)
-
-
-def test_tighter_tolerance_gives_more_segments(tmp_path: Path) -> None:
-    traj = spline(5, seed=2)
-    coarse = write_skyc([traj], tmp_path / "a.skyc", tolerance=1e-2)
-    fine = write_skyc([traj], tmp_path / "b.skyc", tolerance=1e-5)
-    assert fine.segments > coarse.segments
-    assert fine.max_error_m <= 1e-5
-
-
-def test_several_drones_homes_and_structure(tmp_path: Path) -> None:
-    trajs = [spline(3, seed=s) for s in range(3)]
-    homes = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]])
-    result = write_skyc(trajs, tmp_path / "three.skyc", homes=homes, title="three")
-    with zipfile.ZipFile(result.path) as archive:
-        assert "show.json" in archive.namelist()
-    show = read_show_json(result.path)
-    assert show["version"] == 1
-    assert show["environment"]["type"] == "indoor"
-    assert show["meta"]["title"] == "three"
-    drones = show["swarm"]["drones"]
-    assert len(drones) == 3
-    for i, (drone, traj) in enumerate(zip(drones, trajs, strict=True)):
-        settings = drone["settings"]
-        assert settings["home"] == homes[i].tolist()
-        trajectory = settings["trajectory"]
-        assert trajectory["version"] == 1
-        assert trajectory["takeoffTime"] == 0.0
-        assert trajectory["points"][0][2] == []
-        assert trajectory["points"][0][0] == 0.0
-        assert trajectory["points"][-1][0] == pytest.approx(traj.duration)
-        t = dense(traj)
-        got = bezier_positions(trajectory["points"], t)
-        assert np.abs(got - traj.evaluate(t)).max() <= 1e-9
-
-
-def test_default_home_is_start_position(tmp_path: Path) -> None:
-    traj = spline(3)
-    show = read_show_json(write_skyc([traj], tmp_path / "s.skyc").path)
-    home = show["swarm"]["drones"][0]["settings"]["home"]
-    np.testing.assert_allclose(home, traj.evaluate(np.zeros(1))[0], atol=1e-12)
-
-
-def test_long_spans_are_split_to_the_segment_limit(tmp_path: Path) -> None:
-    traj = spline(3, n_ctrl=5, duration=300.0)  # 2 spans of 150 s
-    result = write_skyc([traj], tmp_path / "long.skyc")
-    points = drone_points(read_show_json(result.path), 0)
-    steps = np.diff([p[0] for p in points])
-    assert steps.max() <= MAX_SEGMENT_S
-    t = dense(traj)
-    assert np.abs(bezier_positions(points, t) - traj.evaluate(t)).max() <= 1e-9
-
-
-@pytest.mark.parametrize(
-    ("kwargs", "match"),
-    [
-        ({"trajectories": []}, "trajectories: got nothing"),
-        ({"tolerance": 0.0}, r"tolerance: got 0"),
-        ({"tolerance": math.nan}, r"tolerance: got nan"),
-        ({"homes": np.zeros((2, 3))}, r"homes: got an array of shape \(2, 3\)"),
-        ({"trajectories": ["x"]}, r"trajectories\[0\]"),
-    ],
-)
-def test_bad_arguments(tmp_path: Path, kwargs: dict[str, Any], match: str) -> None:
-    args: dict[str, Any] = {"trajectories": [spline(3)], **kwargs}
-    with pytest.raises(InputError, match=match):
-        write_skyc(args.pop("trajectories"), tmp_path / "x.skyc", **args)
-
-
-def test_2d_trajectory_rejected(tmp_path: Path) -> None:
-    flat = SplineTrajectory(np.random.default_rng(0).uniform(size=(6, 2)), 3, 2.0)
-    with pytest.raises(InputError, match=r"trajectories\[0\]: got a 2-D trajectory"):
-        write_skyc([flat], tmp_path / "x.skyc")
+def test_nothing_to_write_is_refused(tmp_path: Path) -> None:
+    with pytest.raises(InputError, match="drones: got nothing"):
+        write_skyc([], tmp_path / "x.skyc")
+    with pytest.raises(InputError, match="title: got int"):
+        write_skyc([drone(spline(3))], tmp_path / "x.skyc", title=3)  # type: ignore[arg-type]
+    with pytest.raises(InputError, match=r"settings.validation.minDistance: got -1"):
+        write_skyc([drone(spline(3))], tmp_path / "x.skyc", validation={"minDistance": -1.0})
 
 
 def valid_show(tmp_path: Path) -> dict[str, Any]:
-    return read_show_json(write_skyc([spline(3), spline(3, 1)], tmp_path / "v.skyc").path)
+    lights = encode_light_program([(1.0, 2.0)], (9, 9, 9), 8.0)
+    drones = [drone(spline(3), "a", lights), drone(spline(3, 1), "b", lights)]
+    return read_show_json(write_skyc(drones, tmp_path / "v.skyc", validation={"minDistance": 1}))
 
 
 def _set(show: dict[str, Any], path: tuple[Any, ...], value: Any) -> dict[str, Any]:
@@ -188,6 +102,31 @@ TRAJ = ("swarm", "drones", 1, "settings", "trajectory")
         ((*TRAJ, "points", 2, 2, 1), [1, 2], r"trajectory.points\[2\]\[2\]\[1\]"),
         ((*TRAJ, "points", 0, 2), [[0, 0, 0]], r"points\[0\]\[2\]: got 1 control point"),
         ((*TRAJ, "points", 1), [1.0, [0, 0, 0]], r"points\[1\]: got"),
+        (
+            (*TRAJ, "points", 1, 0),
+            0.0004,
+            r"points\[1\]\[0\]: got 0.0004 after 0.0, expected .* 1 ms",
+        ),
+        ((*TRAJ, "points", 2, 2), [[0, 0, 0]] * 3, r"points\[2\]\[2\]: got 3 control points"),
+        ((*TRAJ, "takeoffTime"), -1, r"takeoffTime: got -1, expected a finite time >= 0"),
+        ((*TRAJ, "home"), [0, 0], r"trajectory.home: got \[0, 0\]"),
+        (
+            ("swarm", "drones", 1, "settings", "lights", "data"),
+            "@@",
+            r"drones\[1\].settings.lights.data",
+        ),
+        (
+            ("swarm", "drones", 1, "settings", "yawControl", "setpoints"),
+            [[0]],
+            r"yawControl.setpoints",
+        ),
+        (
+            ("swarm", "drones", 1, "settings", "yawControl", "autoYaw"),
+            1,
+            r"yawControl.autoYaw: got 1",
+        ),
+        (("settings", "validation", "maxAltitude"), "high", r"validation.maxAltitude: got 'high'"),
+        (("settings",), [], r"show.json: settings: got list"),
     ],
 )
 def test_validate_show_names_the_bad_field(
@@ -300,3 +239,16 @@ def test_random_show_json_gives_a_show_or_an_input_error(doc: object) -> None:
             read_show_json(path)
         except InputError as exc:
             assert "show.json" in str(exc)
+
+
+def test_a_truncated_or_nan_show_is_an_input_error(tmp_path: Path) -> None:
+    path = write_skyc([drone(spline(3))], tmp_path / "t.skyc")
+    whole = path.read_bytes()
+    show = json.loads(zipfile.ZipFile(io.BytesIO(whole)).read("show.json"))
+    path.write_bytes(whole[: len(whole) // 2])
+    with pytest.raises(InputError, match=r"t\.skyc: "):
+        read_show_json(path)
+    show["swarm"]["drones"][0]["settings"]["trajectory"]["points"][1][1][0] = math.nan
+    nan = _archive(tmp_path / "nan.skyc", json.dumps(show).encode())  # json writes NaN
+    with pytest.raises(InputError, match=r"points\[1\]\[1\]: got \[nan"):
+        read_show_json(nan)

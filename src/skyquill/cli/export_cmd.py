@@ -17,6 +17,14 @@ from skyquill.io.plan_dir import plan_files, read_plan
 FORMAT_HELP = "; ".join(f"{e.name}: {e.help}" for e in EXPORTERS.values())
 
 
+def _rgb(text: str) -> tuple[int, int, int]:
+    """``R,G,B`` as three integers in 0..255; the error names the flag."""
+    parts = text.split(",")
+    if len(parts) == 3 and all(p.strip().isdigit() and int(p) <= 255 for p in parts):
+        return (int(parts[0]), int(parts[1]), int(parts[2]))
+    raise InputError(f"--light: got {text!r}, expected R,G,B with three integers in 0..255")
+
+
 @app.command()
 def export(
     plan: Annotated[
@@ -28,7 +36,18 @@ def export(
     ],
     out: Annotated[Path, typer.Option("--out", help="File to write (one per drone if several).")],
     format: Annotated[str, typer.Option(help=FORMAT_HELP)] = "csv",
-    rate: Annotated[float, typer.Option(help="Sample rate of px4/csv/json, Hz.")] = 100.0,
+    rate: Annotated[
+        float, typer.Option(help="Sample rate of px4/csv/json/skybrush-csv, Hz.")
+    ] = 100.0,
+    light: Annotated[
+        str,
+        typer.Option(
+            "--light",
+            metavar="R,G,B",
+            help="Light colour while the pen is down (skyc, skybrush-csv), 0..255 each; "
+            "off while it is up.",
+        ),
+    ] = "255,255,255",
     force: Force = False,
 ) -> None:
     """Export the planned trajectories of PLAN; read them back; report to <out>.summary.json."""
@@ -41,7 +60,7 @@ def export(
                 f"--out: got {str(out)!r}, expected a file ending in {chosen.suffix} for "
                 f"--format {format}"
             )
-        options = ExportOptions(rate_hz=positive_rate(rate))
+        options = ExportOptions(rate_hz=positive_rate(rate), light_rgb=_rgb(light))
         plans = read_plan(plan)
         folder = out.parent
         with (

@@ -10,9 +10,12 @@ from skyquill.errors import InputError
 from skyquill.export.base import Exporter, ExportOptions, ExportReport, NamedPlan
 from skyquill.export.crazyswarm import EXPORTER as CRAZYSWARM
 from skyquill.export.samples import CSV, JSON, PX4
+from skyquill.export.skybrush_csv import EXPORTER as SKYBRUSH_CSV
 from skyquill.export.skyc import EXPORTER as SKYC
 
-EXPORTERS: dict[str, Exporter] = {e.name: e for e in (CRAZYSWARM, SKYC, PX4, CSV, JSON)}
+EXPORTERS: dict[str, Exporter] = {
+    e.name: e for e in (CRAZYSWARM, SKYC, SKYBRUSH_CSV, PX4, CSV, JSON)
+}
 
 
 def exporter(name: str) -> Exporter:

@@ -15,6 +15,7 @@ from typing import Any, Protocol
 
 import numpy as np
 
+from skyquill.io.skybrush_lights import check_rgb
 from skyquill.io.trajectory_json import PlannedTrajectory, pen_down
 from skyquill.trajectory import Trajectory, dense_times
 from skyquill.validation import as_float
@@ -32,12 +33,17 @@ class ExportOptions:
     ----------
     rate_hz
         Sample rate of the sampled formats, Hz.
+    light_rgb
+        The light colour while the pen is down (Skybrush formats), three integers 0..255;
+        the light is off while the pen is up.
     """
 
     rate_hz: float = 100.0
+    light_rgb: tuple[int, int, int] = (255, 255, 255)
 
     def __post_init__(self) -> None:
         as_float("rate_hz", self.rate_hz, positive=True)
+        object.__setattr__(self, "light_rgb", check_rgb("light_rgb", self.light_rgb))
 
 
 @dataclass(frozen=True)

@@ -1,14 +1,45 @@
-"""Skybrush ``.skyc`` show (cubic Bézier segments), read back as Skybrush plays it."""
+"""Skybrush ``.skyc`` show: keyframes on Skybrush's ms and mm grid, lights, yaw, validation.
+
+Each drone's plan becomes cubic Bézier keyframes on the grid Skybrush's server stores
+(:mod:`skyquill.io.skybrush_keyframes`), a light program that is on in the chosen colour
+while the pen is down (:mod:`skyquill.io.skybrush_lights`), a constant yaw of 0, and the
+show gets the validation settings its plan implies (:mod:`.skybrush_validation`). The
+written file is then read back and played with Skybrush's own arithmetic
+(:mod:`skyquill.io.skybrush_playback`): the distance from the plan and the dense limit check
+are measured on what the drones will fly, and the lights on what they will show.
+"""
 
 from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
-from skyquill.export.base import ExportOptions, ExportReport, NamedPlan, max_distance
-from skyquill.export.refit import as_spline
-from skyquill.io.skyc import read_show_json, show_trajectories, write_skyc
+import numpy as np
+
+from skyquill.export.base import (
+    DeliveredCheck,
+    ExportOptions,
+    ExportReport,
+    NamedPlan,
+    check_delivered,
+)
+from skyquill.export.skybrush_validation import validation_settings
+from skyquill.io.skybrush_keyframes import skybrush_keyframes
+from skyquill.io.skybrush_lights import (
+    encode_light_program,
+    frame_windows,
+    light_colors,
+    light_slices,
+    program_bytes,
+)
+from skyquill.io.skybrush_playback import played_show, played_trajectory
+from skyquill.io.skyc import SkycDrone, read_show_json, write_skyc
+from skyquill.io.trajectory_json import pen_down
+
+#: A limit excess below this counts as none (float rounding of the read-back), relative.
+EXCESS_TOLERANCE = 1e-9
 
 
 @dataclass(frozen=True)
@@ -17,25 +48,106 @@ class SkycExporter:
 
     name: str = "skyc"
     suffix: str = ".skyc"
-    help: str = "Skybrush show (.skyc), one drone per trajectory"
+    help: str = "Skybrush show (.skyc), one drone per trajectory, lit while the pen is down"
 
     def __call__(
         self, plans: Sequence[NamedPlan], out: Path, options: ExportOptions
     ) -> ExportReport:
-        """Write, reopen the archive, rebuild each drone's curve, compare."""
-        fitted = [as_spline(p.trajectory, p.limits) for _, p in plans]
-        show = write_skyc([f.spline for f in fitted], out.with_suffix(".skyc"))
-        back = show_trajectories(read_show_json(show.path))
-        error = max(max_distance(p.trajectory, b) for (_, p), b in zip(plans, back, strict=True))
-        refit = max(f.max_deviation_m for f in fitted)
+        """Write the show, read it back as the drones play it, check it against the plans."""
+        drones = [
+            SkycDrone(
+                name,
+                skybrush_keyframes(plan.trajectory),
+                encode_light_program(
+                    plan.pen_windows_s, options.light_rgb, plan.trajectory.duration
+                ),
+            )
+            for name, plan in plans
+        ]
+        # The validation settings are measured on what the drones will fly.
+        flown = [
+            played_trajectory(d.name, {"points": d.keyframes.points()}).trajectory() for d in drones
+        ]
+        validation = validation_settings([p.limits for _, p in plans], flown)
+        path = write_skyc(drones, out.with_suffix(self.suffix), validation=validation)
+        show = read_show_json(path)
+        played = [p.trajectory() for p in played_show(show)]
+        delivered = tuple(
+            check_delivered(name, plan, back)
+            for (name, plan), back in zip(plans, played, strict=True)
+        )
+        lights = [
+            _light_mismatch(show, i, plan.pen_windows_s, options.light_rgb, back.duration)
+            for i, ((_, plan), back) in enumerate(zip(plans, played, strict=True))
+        ]
+        details = _details(drones, delivered, lights, validation)
         return ExportReport(
             self.name,
-            (show.path,),
-            exact=show.exact and refit == 0.0,
-            max_error_m=error,
-            message=show.message,
-            details={"segments": show.segments, "refit_max_deviation_m": refit},
+            (path,),
+            exact=False,
+            max_error_m=max(d.max_error_m for d in delivered),
+            message=_message(path, details),
+            details=details,
+            delivered=delivered,
         )
+
+
+def _light_mismatch(
+    show: dict[str, Any],
+    index: int,
+    windows_s: Sequence[tuple[float, float]],
+    rgb: tuple[int, int, int],
+    duration_s: float,
+) -> dict[str, Any]:
+    """Where the light Skybrush shows differs from the pen, on every millisecond of the show."""
+    where = f"show.json: swarm.drones[{index}].settings.lights"
+    data = program_bytes(where, show["swarm"]["drones"][index]["settings"]["lights"])
+    t_ms = np.arange(0.0, np.ceil(duration_s * 1000) + 1)
+    lit = np.all(light_colors(light_slices(where, data, t_ms[-1]), t_ms) == rgb, axis=1)
+    wrong = lit != pen_down(t_ms / 1000, windows_s).astype(bool)
+    # the longest run of wrong milliseconds: how far a switch is from the pen's
+    runs = np.diff(np.flatnonzero(np.diff(np.concatenate([[0], wrong.astype(int), [0]]))))[::2]
+    return {
+        "windows": len(windows_s),
+        "lit_windows": len(frame_windows(windows_s)),
+        "max_offset_ms": int(runs.max()) if runs.size else 0,
+    }
+
+
+def _details(
+    drones: Sequence[SkycDrone],
+    delivered: Sequence[DeliveredCheck],
+    lights: Sequence[dict[str, Any]],
+    validation: dict[str, float],
+) -> dict[str, Any]:
+    excess = max(d.limit_excess for d in delivered)
+    return {
+        "segments": sum(d.keyframes.units.shape[0] for d in drones),
+        "keyframe_grid": "integer ms, coordinates in whole units of scale mm",
+        "scale_mm": [d.keyframes.scale for d in drones],
+        "keyframe_fit_max_m": max(d.keyframes.fit_error_m for d in drones),
+        "pen_down_max_error_m": max(d.pen_down_max_error_m for d in delivered),
+        "limit_excess": excess,
+        "limits_hold": bool(excess <= EXCESS_TOLERANCE),
+        "lights": {"frame_ms": 20, "per_drone": list(lights)},
+        "yaw_deg": 0.0,
+        "validation": validation,
+    }
+
+
+def _message(path: Path, details: dict[str, Any]) -> str:
+    excess = details["limit_excess"]
+    limits = (
+        "the limits hold on it"
+        if details["limits_hold"]
+        else f"it exceeds the plan's limits by up to {100 * excess:.3g} % (see delivered)"
+    )
+    offset = max(light["max_offset_ms"] for light in details["lights"]["per_drone"])
+    return (
+        f"wrote {len(details['scale_mm'])} drone(s), {details['segments']} Bézier segment(s) on "
+        f"Skybrush's ms/mm grid to {path.name}; as Skybrush plays it, {limits}; lights switch "
+        f"within {offset} ms of the pen (20 ms light frames)"
+    )
 
 
 EXPORTER = SkycExporter()

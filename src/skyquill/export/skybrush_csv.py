@@ -1,0 +1,93 @@
+"""Skybrush Studio's zipped CSV (``Time_msec,x_m,y_m,z_m,Red,Green,Blue``, one file per drone).
+
+Rows every ``1 / rate_hz`` s on the millisecond grid, plus rows one millisecond either side
+of every pen-window end (rounded to the ms), so the light switches on the millisecond the
+pen does even though Studio fades colours linearly between rows. Read back as Studio reads
+it (:mod:`skyquill.io.skybrush_csv`: positions interpolated linearly), then checked: the
+distance from the plan, the speed limit (a linear interpolation has no acceleration between
+rows and an impulse at each, so only the speed check means something), the lights.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from skyquill.export.base import ExportOptions, ExportReport, NamedPlan, check_delivered
+from skyquill.io.skybrush_csv import CsvDrone, read_csv_zip, write_csv_zip
+from skyquill.io.trajectory_json import PlannedTrajectory, pen_down
+
+
+def _ms_windows(windows_s: Sequence[tuple[float, float]]) -> list[tuple[int, int]]:
+    return [(round(a * 1000), round(b * 1000)) for a, b in windows_s]
+
+
+def _row_times(plan: PlannedTrajectory, rate_hz: float) -> NDArray[np.int64]:
+    end = max(1, math.ceil(plan.trajectory.duration * 1000 - 1e-6))
+    step = max(1, round(1000 / rate_hz))
+    edges = [e for a, b in _ms_windows(plan.pen_windows_s) for e in (a - 1, a, b, b + 1)]
+    times = np.concatenate([np.arange(0, end, step), [end], edges])
+    return np.unique(np.clip(times, 0, end)).astype(np.int64)
+
+
+def csv_drone(
+    name: str, plan: PlannedTrajectory, rate_hz: float, rgb: tuple[int, int, int]
+) -> CsvDrone:
+    """The rows of one drone: lit in ``rgb`` on every millisecond of a pen window, else black."""
+    t_ms = _row_times(plan, rate_hz)
+    positions = plan.trajectory.evaluate(np.minimum(t_ms / 1000, plan.trajectory.duration))
+    lit = pen_down(t_ms, _ms_windows(plan.pen_windows_s)).astype(bool)
+    colors = np.where(lit[:, None], np.array(rgb), 0).astype(np.int64)
+    return CsvDrone(name, t_ms, positions, colors)
+
+
+def _lights_exact(back: CsvDrone, plan: PlannedTrajectory, rgb: tuple[int, int, int]) -> bool:
+    lit = np.all(back.colors == np.array(rgb), axis=1)
+    return bool(np.array_equal(lit, pen_down(back.t_ms, _ms_windows(plan.pen_windows_s)) > 0))
+
+
+@dataclass(frozen=True)
+class SkybrushCsvExporter:
+    """One ZIP of per-drone CSVs, as Skybrush Studio exports and imports them."""
+
+    name: str = "skybrush-csv"
+    suffix: str = ".zip"
+    help: str = "Skybrush Studio zipped CSV (Time_msec,x_m,y_m,z_m,Red,Green,Blue), one per drone"
+
+    def __call__(
+        self, plans: Sequence[NamedPlan], out: Path, options: ExportOptions
+    ) -> ExportReport:
+        """Write the rows, read the archive back as Studio does, check each drone."""
+        rgb = options.light_rgb
+        rows = [csv_drone(name, plan, options.rate_hz, rgb) for name, plan in plans]
+        path = write_csv_zip(rows, out.with_suffix(self.suffix))
+        back = {d.name: d for d in read_csv_zip(path)}
+        delivered = tuple(
+            check_delivered(name, plan, back[name].trajectory()) for name, plan in plans
+        )
+        details: dict[str, Any] = {
+            "rows": sum(d.t_ms.size for d in rows),
+            "rate_hz": options.rate_hz,
+            "interpolation": "linear between rows (Skybrush Studio's import): only the speed "
+            "limit is meaningful on it",
+            "lights_exact_to_ms": all(_lights_exact(back[n], p, rgb) for n, p in plans),
+        }
+        error = max(d.max_error_m for d in delivered)
+        return ExportReport(
+            self.name,
+            (path,),
+            exact=False,
+            max_error_m=error,
+            message=f"wrote {len(rows)} drone CSV(s), {details['rows']} rows, to {path.name}",
+            details=details,
+            delivered=delivered,
+        )
+
+
+EXPORTER = SkybrushCsvExporter()

@@ -1,0 +1,90 @@
+"""The ``settings.validation`` of a Skybrush show, filled from the plan.
+
+Skybrush Live warns when a show leaves these bounds (skybrush-io/live
+``src/features/validation/selectors.ts``: ``maxAltitude``, ``maxVelocityXY``,
+``maxVelocityZ`` downwards and ``maxVelocityZUp`` upwards, the same three for the
+acceleration, ``minDistance``; the types in skybrush-io/skybrush.js
+``packages/show-format/src/types.ts``). The speeds and accelerations come from the plan's
+limits, stated as Skybrush states them (horizontal norm, vertical up and down); the altitude
+and the distance between drones are measured on the trajectories, rounded outwards to the
+millimetre so that the show passes its own validation.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from collections.abc import Sequence
+
+import numpy as np
+
+from skyquill.limits import BoxLimit, CylinderLimit, DerivativeLimit, NormLimit
+from skyquill.trajectory import Trajectory, dense_times
+
+#: Names of the bounds per derivative order: (horizontal, down, up).
+KEYS = {
+    1: ("maxVelocityXY", "maxVelocityZ", "maxVelocityZUp"),
+    2: ("maxAccelerationXY", "maxAccelerationZ", "maxAccelerationZUp"),
+}
+
+
+def _bounds(limit: DerivativeLimit) -> tuple[float, float, float] | None:
+    """(horizontal, down, up) bounds a 3-D limit implies, or ``None`` for another dimension."""
+    if isinstance(limit, NormLimit):
+        return (limit.radius,) * 3 if limit.dim == 3 else None
+    if isinstance(limit, CylinderLimit):
+        if limit.z_lower is None or limit.z_upper is None:
+            return None
+        return limit.radius, -limit.z_lower, limit.z_upper
+    if isinstance(limit, BoxLimit) and limit.dim == 3:
+        reach = np.maximum(np.abs(limit.lower), np.abs(limit.upper))
+        return float(np.hypot(reach[0], reach[1])), float(-limit.lower[2]), float(limit.upper[2])
+    return None
+
+
+def _times(trajectories: Sequence[Trajectory]) -> np.ndarray:
+    """Common show times: the dense times of every trajectory, merged."""
+    return np.unique(np.concatenate([dense_times(t.breakpoints) for t in trajectories]))
+
+
+def _positions(trajectory: Trajectory, t: np.ndarray) -> np.ndarray:
+    # A drone that has finished holds its last position.
+    return trajectory.evaluate(np.minimum(t, trajectory.duration))
+
+
+def validation_settings(
+    limits: Sequence[Sequence[DerivativeLimit]], trajectories: Sequence[Trajectory]
+) -> dict[str, float]:
+    """Skybrush's validation settings for a show.
+
+    Parameters
+    ----------
+    limits
+        Each drone's limits.
+    trajectories
+        Each drone's trajectory as it will fly, z up, m, on the show clock.
+
+    Returns
+    -------
+    dict
+        ``maxAltitude`` (m), the speed and acceleration bounds that the limits imply (the
+        tightest over all drones; a bound no limit implies is left out), and ``minDistance``
+        (m) when there are two drones or more.
+    """
+    settings: dict[str, float] = {}
+    for order, keys in KEYS.items():
+        found = [_bounds(lim) for lims in limits for lim in lims if lim.order == order]
+        implied = [b for b in found if b is not None]
+        for i, key in enumerate(keys):
+            if implied:
+                settings[key] = min(b[i] for b in implied)
+    t = _times(trajectories)
+    positions = [_positions(traj, t) for traj in trajectories]
+    settings["maxAltitude"] = math.ceil(max(float(p[:, 2].max()) for p in positions) * 1000) / 1000
+    if len(positions) > 1:
+        closest = min(
+            float(np.linalg.norm(a - b, axis=1).min())
+            for a, b in itertools.combinations(positions, 2)
+        )
+        settings["minDistance"] = math.floor(closest * 1000) / 1000
+    return settings

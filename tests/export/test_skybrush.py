@@ -1,0 +1,160 @@
+"""Skybrush exports of a written character: what the drones play is what was verified.
+
+The must-show of issue 14: 永 planned by ``plan_writing``, exported to ``.skyc`` and played
+back with Skybrush's own arithmetic (the server's ms and mm rounding, the firmware's float32
+Bézier evaluation; ``skyquill.io.skybrush_playback``, checked against a literal copy of that
+code in ``tests/io/test_skybrush_playback.py``): within 2 mm of the plan over the whole show
+(28 mm before), lit exactly in the pen windows rounded to the 20 ms light frame, validation
+settings consistent with the plan.
+"""
+
+from __future__ import annotations
+
+import itertools
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from skyquill.calligraphy.mission import plan_writing
+from skyquill.export import EXPORTERS, ExportOptions
+from skyquill.export.base import NamedPlan
+from skyquill.io.skybrush_csv import read_csv_zip
+from skyquill.io.skybrush_lights import frame_windows, light_colors, light_slices, program_bytes
+from skyquill.io.skyc import read_show_json, show_trajectories
+from skyquill.io.trajectory_json import PlannedTrajectory, pen_down
+from skyquill.limits import VehicleLimits
+from skyquill.strokes import hanzi_strokes
+from skyquill.trajectory import SplineTrajectory, dense_times
+from skyquill.verify import verify
+
+RGB = (255, 40, 0)
+#: The second drone writes the same character this far to the side, m.
+OFFSET_M = np.array([1.5, 0.0, 0.0])
+
+
+@pytest.fixture(scope="module")
+def plans() -> list[NamedPlan]:
+    mission = plan_writing(hanzi_strokes("永"))
+    first = PlannedTrajectory(
+        mission.vehicle_trajectory(), tuple(mission.pen_windows), mission.fit.problem.limits
+    )
+    traj = first.trajectory
+    assert isinstance(traj, SplineTrajectory)
+    moved = SplineTrajectory(traj.control_points + OFFSET_M, traj.degree, traj.duration)
+    return [("left", first), ("right", PlannedTrajectory(moved, first.pen_windows_s, first.limits))]
+
+
+def test_the_show_plays_within_2_mm_of_the_plan(plans: list[NamedPlan], tmp_path: Path) -> None:
+    report = EXPORTERS["skyc"](plans, tmp_path / "yong.skyc", ExportOptions(light_rgb=RGB))
+    show = read_show_json(report.files[0])
+    for (name, plan), back, checked in zip(
+        plans, show_trajectories(show), report.delivered, strict=True
+    ):
+        t = dense_times(plan.trajectory.breakpoints)
+        error = np.linalg.norm(back.evaluate(t) - plan.trajectory.evaluate(t), axis=1)
+        assert error.max() <= 2e-3  # 28 mm with the old 0.0999 s keyframes
+        assert checked.drone == name and checked.max_error_m == pytest.approx(error.max())
+        # keyframes on whole milliseconds, coordinates on whole millimetres
+        points = next(d for d in show["swarm"]["drones"] if d["settings"]["name"] == name)
+        points = points["settings"]["trajectory"]["points"]
+        times = np.array([p[0] for p in points])
+        assert np.array_equal(times, np.round(times * 1000) / 1000)
+        values = np.array([c for p in points for c in [p[1], *p[2]]]) * 1000
+        assert np.abs(values - np.round(values)).max() < 1e-9
+    assert report.max_error_m <= 2e-3
+    summary = report.as_dict()
+    assert len(summary["delivered"]) == 2 and summary["scale_mm"] == [1, 1]
+
+
+def test_the_limits_on_the_played_curve_are_reported(
+    plans: list[NamedPlan], tmp_path: Path
+) -> None:
+    report = EXPORTERS["skyc"](plans, tmp_path / "yong.skyc", ExportOptions())
+    excess = max(d.limit_excess for d in report.delivered)
+    assert report.details["limit_excess"] == excess
+    assert report.details["limits_hold"] == (excess <= 1e-9)
+    # measured on 永: the played cubics stay inside speed, acceleration and jerk limits
+    assert report.details["limits_hold"] and "the limits hold" in report.message
+
+
+def test_an_excess_is_said_not_hidden(tmp_path: Path) -> None:
+    ctrl = np.random.default_rng(1).normal(scale=0.3, size=(14, 3)) + np.array([0.0, 0.0, 1.0])
+    ctrl[:3], ctrl[-3:] = ctrl[0], ctrl[-1]
+    traj = SplineTrajectory(ctrl, 5, 5.0)
+    own = verify(traj, VehicleLimits(100.0, 100.0, 1000.0).derivative_limits(3))
+    # limits at the plan's own maxima: any rounding of the played curve crosses one
+    tight = VehicleLimits(*(r["max_value"] for r in own.limits_report())).derivative_limits(3)
+    plan = [("d", PlannedTrajectory(traj, (), tight))]
+    report = EXPORTERS["skyc"](plan, tmp_path / "tight.skyc", ExportOptions())
+    assert not report.details["limits_hold"] and report.details["limit_excess"] > 0
+    assert "exceeds the plan's limits by up to" in report.message
+
+
+def test_the_lights_are_on_exactly_in_the_pen_windows(
+    plans: list[NamedPlan], tmp_path: Path
+) -> None:
+    report = EXPORTERS["skyc"](plans, tmp_path / "yong.skyc", ExportOptions(light_rgb=RGB))
+    show = read_show_json(report.files[0])
+    windows = plans[0][1].pen_windows_s
+    for i in range(2):
+        data = program_bytes("l", show["swarm"]["drones"][i]["settings"]["lights"])
+        t_ms = np.arange(0.0, 20_100.0)
+        lit = np.all(light_colors(light_slices("l", data, 20_100), t_ms) == RGB, axis=1)
+        expected = np.zeros_like(lit)
+        for a, b in frame_windows(windows):
+            expected[a * 20 : b * 20] = True
+        assert np.array_equal(lit, expected)  # to the millisecond, on Skybrush's 20 ms frames
+        lit_s = t_ms / 1000
+        wrong = lit != pen_down(lit_s, windows).astype(bool)
+        assert wrong.sum() <= 2 * len(windows) * 10  # each switch within half a frame
+    assert all(d["max_offset_ms"] <= 10 for d in report.details["lights"]["per_drone"])
+    assert report.details["lights"]["per_drone"][0]["lit_windows"] == len(windows)
+    yaw = show["swarm"]["drones"][0]["settings"]["yawControl"]
+    assert {s[1] for s in yaw["setpoints"]} == {0.0} and yaw["autoYaw"] is False
+
+
+def test_the_validation_settings_follow_the_plan(plans: list[NamedPlan], tmp_path: Path) -> None:
+    report = EXPORTERS["skyc"](plans, tmp_path / "yong.skyc", ExportOptions())
+    show = read_show_json(report.files[0])
+    validation = show["settings"]["validation"]
+    assert validation == report.details["validation"]
+    vmax, amax = 1.0, 2.0  # plan_writing's default limits (norms)
+    assert validation["maxVelocityXY"] == validation["maxVelocityZ"] == vmax
+    assert validation["maxVelocityZUp"] == vmax
+    assert validation["maxAccelerationXY"] == validation["maxAccelerationZUp"] == amax
+    played = show_trajectories(show)
+    t = np.linspace(0.0, min(p.duration for p in played), 40_001)
+    positions = [p.evaluate(t) for p in played]
+    top = max(float(p[:, 2].max()) for p in positions)
+    assert top <= validation["maxAltitude"] <= top + 1e-3
+    closest = min(
+        float(np.linalg.norm(a - b, axis=1).min()) for a, b in itertools.combinations(positions, 2)
+    )
+    assert closest - 2e-3 <= validation["minDistance"] <= closest
+    assert validation["minDistance"] == pytest.approx(1.5, abs=2e-3)
+
+
+def test_the_zipped_csv_round_trips_with_lights_to_the_ms(
+    plans: list[NamedPlan], tmp_path: Path
+) -> None:
+    report = EXPORTERS["skybrush-csv"](
+        plans, tmp_path / "yong.zip", ExportOptions(rate_hz=50.0, light_rgb=RGB)
+    )
+    assert report.details["lights_exact_to_ms"] and report.max_error_m <= 1e-3
+    drones = read_csv_zip(report.files[0])
+    assert [d.name for d in drones] == ["left", "right"] and len(report.delivered) == 2
+    windows = plans[0][1].pen_windows_s
+    for drone in drones:
+        lit = np.all(drone.colors == RGB, axis=1)
+        for a, b in windows:
+            a_ms, b_ms = round(a * 1000), round(b * 1000)
+            rows = {int(t): bool(on) for t, on in zip(drone.t_ms, lit, strict=True)}
+            assert rows[a_ms - 1] is False and rows[a_ms] is True
+            assert rows[b_ms] is True and rows[b_ms + 1] is False
+        assert np.array_equal(
+            lit, pen_down(drone.t_ms, [(round(a * 1e3), round(b * 1e3)) for a, b in windows]) > 0
+        )
+    summary = json.loads(json.dumps(report.as_dict()))
+    assert summary["delivered"][0]["limits"][0]["relative_excess"] == 0.0  # the speed

@@ -1,0 +1,135 @@
+"""Skybrush Studio's zipped CSV: round trip, and every corruption an InputError naming where."""
+
+from __future__ import annotations
+
+import tempfile
+import zipfile
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from skyquill.errors import InputError
+from skyquill.io import skybrush_csv
+from skyquill.io.skybrush_csv import HEADER, CsvDrone, read_csv_zip, write_csv_zip
+
+
+def drone(name: str = "d1", n: int = 50) -> CsvDrone:
+    t = np.arange(n, dtype=np.int64) * 10
+    p = np.column_stack([np.sin(t / 300), np.cos(t / 300), 1 + t / 1e4])
+    c = np.where((t >= 100)[:, None] & (t <= 200)[:, None], [255, 40, 0], 0).astype(np.int64)
+    return CsvDrone(name, t, p, c)
+
+
+def test_round_trip_to_the_micrometre(tmp_path: Path) -> None:
+    drones = [drone("d1"), drone("d2", 30)]
+    path = write_csv_zip(drones, tmp_path / "show.zip")
+    with zipfile.ZipFile(path) as archive:
+        assert archive.namelist() == ["d1.csv", "d2.csv"]
+        assert archive.read("d1.csv").decode().splitlines()[0] == ",".join(HEADER)
+    back = read_csv_zip(path)
+    for a, b in zip(drones, back, strict=True):
+        assert a.name == b.name and np.array_equal(a.t_ms, b.t_ms)
+        assert np.abs(a.positions - b.positions).max() <= 5e-7
+        assert np.array_equal(a.colors, b.colors)
+    # Studio interpolates linearly between rows
+    traj = back[0].trajectory()
+    np.testing.assert_allclose(
+        traj.evaluate(np.array([0.015])), [(back[0].positions[1] + back[0].positions[2]) / 2]
+    )
+
+
+def _zip(path: Path, members: dict[str, bytes]) -> Path:
+    with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as archive:
+        for name, data in members.items():
+            archive.writestr(name, data)
+    return path
+
+
+GOOD = b"Time_msec,x_m,y_m,z_m,Red,Green,Blue\n0,0,0,1,0,0,0\n10,0.1,0,1,255,0,0\n"
+
+
+@pytest.mark.parametrize(
+    ("members", "match"),
+    [
+        ({}, r"s.zip: got 0 member\(s\), expected 1 to 5000"),
+        ({"a.txt": GOOD}, r"got the member 'a.txt', expected only .csv files"),
+        ({"a.csv": GOOD, "x/a.csv": GOOD}, r"got repeated drone names"),
+        (
+            {"a.csv": b"time,x,y,z\n0,0,0,0\n1,0,0,0\n"},
+            r"a.csv: got the header \['time', 'x', 'y', 'z'\]",
+        ),
+        ({"a.csv": GOOD + b"20,0.2,0,1,255\n"}, r"a.csv: line 4: got 5 values, expected 7"),
+        (
+            {"a.csv": GOOD + b"20,nan,0,1,0,0,0\n"},
+            r"line 4: got x, y, z = \['nan', '0', '1'\], expected finite",
+        ),
+        ({"a.csv": GOOD + b"20,1e9,0,1,0,0,0\n"}, r"expected finite numbers within 100000 m"),
+        (
+            {"a.csv": GOOD + b"5,0.2,0,1,0,0,0\n"},
+            r"line 4: got Time_msec 5 after 10, expected strictly",
+        ),
+        (
+            {"a.csv": GOOD + b"10.5,0.2,0,1,0,0,0\n"},
+            r"Time_msec: got '10.5', expected a whole number",
+        ),
+        ({"a.csv": GOOD + b"20,0.2,0,1,256,0,0\n"}, r"Red, Green, Blue = \['256', '0', '0'\]"),
+        ({"a.csv": GOOD + b"20,0.2,0,1,1.5,0,0\n"}, r"line 4: got .*expected numbers"),
+        ({"a.csv": GOOD + "20,0.2,0,1,0,0,0 é\n".encode()}, r"a.csv: got a non-ASCII byte"),
+        (
+            {"a.csv": GOOD.splitlines(keepends=True)[0] + b"0,0,0,1,0,0,0\n"},
+            r"got 1 row\(s\), expected at least 2",
+        ),
+    ],
+)
+def test_a_corrupt_archive_is_named(tmp_path: Path, members: dict[str, bytes], match: str) -> None:
+    with pytest.raises(InputError, match=match):
+        read_csv_zip(_zip(tmp_path / "s.zip", members))
+
+
+def test_not_a_zip_missing_or_truncated(tmp_path: Path) -> None:
+    with pytest.raises(InputError, match=r"expected an existing .zip file"):
+        read_csv_zip(tmp_path / "none.zip")
+    (tmp_path / "n.zip").write_text("hello", encoding="utf-8")
+    with pytest.raises(InputError, match=r"n.zip: got a file that is not a ZIP"):
+        read_csv_zip(tmp_path / "n.zip")
+    whole = _zip(tmp_path / "t.zip", {"a.csv": GOOD * 200}).read_bytes()
+    (tmp_path / "t.zip").write_bytes(whole[: len(whole) // 2])  # cut: the directory is gone
+    with pytest.raises(InputError, match=r"t.zip: "):
+        read_csv_zip(tmp_path / "t.zip")
+
+
+def test_a_zip_bomb_is_refused_before_inflating(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setattr(skybrush_csv, "MAX_MEMBER_BYTES", 10_000)
+    bomb = _zip(tmp_path / "b.zip", {"a.csv": GOOD + b"\n" * 1_000_000})
+    assert bomb.stat().st_size < 10_000
+    with pytest.raises(
+        InputError, match=r"b.zip: a.csv: got 1,000,0\d\d bytes, expected at most 10,000"
+    ):
+        read_csv_zip(bomb)
+
+
+def test_bad_drones_are_refused_on_writing(tmp_path: Path) -> None:
+    with pytest.raises(InputError, match=r"drones: got nothing"):
+        write_csv_zip([], tmp_path / "x.zip")
+    with pytest.raises(InputError, match=r"drones: got the name '../x'"):
+        write_csv_zip([drone("../x")], tmp_path / "x.zip")
+    with pytest.raises(InputError, match=r"drones: got repeated names"):
+        write_csv_zip([drone(), drone()], tmp_path / "x.zip")
+
+
+@settings(max_examples=100, deadline=None)
+@given(raw=st.binary(max_size=120), zipped=st.booleans())
+def test_random_bytes_give_an_input_error(raw: bytes, zipped: bool) -> None:
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "r.zip"
+        if zipped:
+            _zip(path, {"a.csv": raw})
+        else:
+            path.write_bytes(b"PK\x03\x04" + raw)
+        with pytest.raises(InputError, match=r"r\.zip"):
+            read_csv_zip(path)

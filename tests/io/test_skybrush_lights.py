@@ -1,0 +1,97 @@
+"""Skybrush light programs: written for the pen windows, read back by a copy of its player."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from skyquill.errors import InputError
+from skyquill.io import skybrush_lights as lights
+from skyquill.io.skybrush_lights import (
+    check_rgb,
+    encode_light_program,
+    frame_windows,
+    light_colors,
+    light_slices,
+    lights_json,
+    program_bytes,
+)
+
+RGB = (255, 40, 0)
+
+
+def lit(program: bytes, end_ms: float) -> np.ndarray:
+    t = np.arange(0.0, end_ms + 1)
+    return np.all(light_colors(light_slices("p", program, end_ms), t) == RGB, axis=1)
+
+
+def test_the_light_is_on_exactly_in_the_frame_rounded_pen_windows() -> None:
+    windows = [(0.5, 1.234), (2.0, 2.011), (10.0, 12.5)]  # 12.5 s: a duration over 127 frames
+    program = encode_light_program(windows, RGB, 14.0)
+    on = lit(program, 14_000)
+    expected = np.zeros_like(on)
+    for a, b in frame_windows(windows):
+        expected[a * 20 : b * 20] = True  # the slice [a, b) frames; at b the next slice wins
+    assert np.array_equal(on, expected)
+    assert frame_windows(windows) == [(25, 62), (100, 101), (500, 625)]
+    # every switch within half a frame of the pen
+    for (a, b), (fa, fb) in zip(windows, frame_windows(windows), strict=True):
+        assert abs(fa * 20 - a * 1000) <= 10 and abs(fb * 20 - b * 1000) <= 10
+
+
+def test_short_windows_vanish_and_touching_ones_merge() -> None:
+    assert frame_windows([(1.0, 1.005)]) == []
+    assert frame_windows([(1.0, 1.2), (1.2, 1.5)]) == [(50, 75)]
+
+
+def test_a_fade_and_a_loop_are_read_as_skybrush_reads_them() -> None:
+    # fade to white in 50 frames (1 s), then twice: set red 1 frame, black 1 frame; end
+    program = bytes([11, 50, 12, 2, 4, 255, 0, 0, 1, 6, 1, 13, 0])
+    slices = light_slices("p", program, 10_000)
+    colors = light_colors(slices, np.array([500.0, 1000.0, 1010.0, 1030.0, 1050.0, 1070.0, 5000.0]))
+    np.testing.assert_allclose(colors[0], [127.5] * 3)
+    np.testing.assert_allclose(
+        colors[1:], [[255, 0, 0], [255, 0, 0], [0, 0, 0], [255, 0, 0], [0, 0, 0], [0, 0, 0]]
+    )
+
+
+def test_the_json_object_round_trips() -> None:
+    program = encode_light_program([(0.1, 0.3)], RGB, 1.0)
+    assert program_bytes("l", lights_json(program)) == program
+
+
+@pytest.mark.parametrize(
+    ("program", "match"),
+    [
+        (bytes([4, 255, 0]), r"ends inside a command at byte 3"),
+        (bytes([99]), r"got light command 99 at byte 0"),
+        (bytes([13]), r"got a loop end at byte 1"),
+        (bytes([12, 0, 1, 13]), r"still running after 1,000 commands"),
+        (bytes([2, 255, 255, 255, 255, 255, 1]), r"duration over 5 bytes"),
+    ],
+)
+def test_a_broken_program_is_an_input_error(
+    program: bytes, match: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setattr(lights, "MAX_STEPS", 1000)  # a loop of nothing runs forever
+    with pytest.raises(InputError, match=match):
+        light_slices("p", program, 1e9)
+
+
+@pytest.mark.parametrize(
+    ("lights", "match"),
+    [
+        ({"version": 2, "data": ""}, r"l: got"),
+        ({"version": 1, "data": "not base64!"}, r"l.data: got 'not base64!', expected base64"),
+        ({"version": 1, "data": 5}, r"l.data: got 5, expected a base64 string"),
+    ],
+)
+def test_a_broken_lights_object_is_an_input_error(lights: object, match: str) -> None:
+    with pytest.raises(InputError, match=match):
+        program_bytes("l", lights)
+
+
+@pytest.mark.parametrize("rgb", [(256, 0, 0), (0, 0), (1.0, 2, 3), "red", (True, 0, 0), (-1, 0, 0)])
+def test_a_bad_colour_is_named(rgb: object) -> None:
+    with pytest.raises(InputError, match=r"light_rgb: got .*expected three integers in 0..255"):
+        check_rgb("light_rgb", rgb)
