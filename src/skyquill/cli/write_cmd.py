@@ -156,7 +156,7 @@ def write_outputs(
     strokes_json: list[Any] = []
     for mission, (name, _) in zip(missions, names, strict=True):
         vehicle = mission.vehicle_trajectory()
-        limits = mission.fit.problem.limits
+        limits = mission.limits
         planned.append(PlannedTrajectory(vehicle, tuple(mission.pen_windows), limits))
         strokes_json.append([(s + mission.brush_offset).tolist() for s in mission.strokes_world])
         flight = show.flights[len(per_drone)] if show.flights else None
