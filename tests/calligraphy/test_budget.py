@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -142,3 +144,21 @@ def test_a_show_of_targeted_missions_checks_separation() -> None:
     assert show.min_separation_m >= 1.0
     for m in show.missions:
         assert all(u.pieces <= 31 for u in plan_uploads(m.vehicle_trajectory(), CRAZYFLIE))
+
+
+def test_one_strategy_alone_is_measured() -> None:
+    """中 does not fit one upload at 1 %: alone, that strategy says so; best effort returns it."""
+    alone = WritingOptions(size_m=SIZE_M, target=CRAZYFLIE, target_strategies=("one-upload",))
+    with pytest.raises(InfeasibleError, match="one upload of 31 pieces strays") as info:
+        plan_writing(hanzi_strokes("中"), Board(), alone)
+    assert "split at" not in str(info.value)
+    mission = plan_writing(hanzi_strokes("中"), Board(), replace(alone, best_effort=True))
+    assert mission.target is not None and mission.target.strategy == "one-upload"
+    assert [u.pieces for u in mission.target.uploads] == [31]
+    assert not mission.faithful
+
+
+@pytest.mark.parametrize("strategies", [(), ("split", "split"), ("knots",)])
+def test_target_strategies_are_checked(strategies: tuple[str, ...]) -> None:
+    with pytest.raises(InputError, match="target_strategies: got"):
+        WritingOptions(target_strategies=strategies)  # type: ignore[arg-type]

@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, replace
-from typing import Any, Literal
+from typing import Any
 
 import numpy as np
 
@@ -35,6 +35,7 @@ from skyquill.calligraphy.mission import (
     Mission,
     RoutePlan,
     RouteSamples,
+    TargetStrategy,
     WritingOptions,
     measure_deviation,
     plan_route,
@@ -46,9 +47,6 @@ from skyquill.targets import Upload, UploadTarget, hover, plan_uploads
 from skyquill.trajectory import RestToRestSequence, Trajectory
 from skyquill.validation import FloatArray
 
-Strategy = Literal["one-upload", "split"]
-#: The ways to fit a target, in the order they are tried.
-STRATEGIES: tuple[Strategy, ...] = ("one-upload", "split")
 #: How far a pen-up point may lie from the lifted stroke end it is found by, m.
 LIFT_MATCH_M = 1e-9
 
@@ -62,14 +60,15 @@ class TargetPlan:
     target
         The vehicle's budget.
     strategy
-        The first of :data:`STRATEGIES` that fitted.
+        The first of ``options.target_strategies`` that fitted (or, with
+        ``best_effort``, the last tried).
     uploads
         The uploads, in flight order, as :func:`~skyquill.targets.plan_uploads` cuts
         the tip trajectory (the vehicle's is the same, offset).
     """
 
     target: UploadTarget
-    strategy: Strategy
+    strategy: TargetStrategy
     uploads: tuple[Upload, ...]
 
     def as_dict(self) -> dict[str, Any]:
@@ -128,21 +127,37 @@ def plan_for_target(
     assert target is not None
     inner = replace(opts, degree=target.max_degree)
     budget = replace(samples, max_spans=target.max_pieces)
-    whole = _attempt(budget, times, board, inner)
-    if whole is not None and whole.faithful(inner):
-        plan = _refined(budget, whole, inner)
-        trajectory: Trajectory = plan.fit.trajectory
-        return _mission((plan,), (trajectory, plan.windows), samples, board, opts, start=start)
-    cuts = _cuts(budget, board)
-    groups = _groups(budget, cuts, board, inner)
-    if all(g.plan is not None and g.plan.faithful(inner) for g in groups) or opts.best_effort:
-        plans = [
-            _refined(_sub(budget, cuts, g.first, g.stop), g.plan, inner) for g in groups if g.plan
-        ]
-        if len(plans) == len(groups):
-            joined = _joined(plans, target)
-            return _mission(tuple(plans), joined, samples, board, opts, start=start)
+    whole: RoutePlan | None = None
+    groups: list[_Group] | None = None
+    fallback: Mission | None = None  # the last strategy's plan beyond the tolerance
+    if "one-upload" in opts.target_strategies:
+        whole = _attempt(budget, times, board, inner)
+        if whole is not None:
+            plan = _refined(budget, whole, inner)
+            trajectory: Trajectory = plan.fit.trajectory
+            fallback = _mission((plan,), (trajectory, plan.windows), samples, board, opts)
+            if whole.faithful(inner):
+                return _timed(fallback, start)
+    if "split" in opts.target_strategies:
+        cuts = _cuts(budget, board)
+        groups = _groups(budget, cuts, board, inner)
+        if all(g.plan is not None for g in groups):
+            plans = tuple(
+                _refined(_sub(budget, cuts, g.first, g.stop), g.plan, inner)
+                for g in groups
+                if g.plan is not None
+            )
+            fallback = _mission(plans, _joined(plans, target), samples, board, opts)
+            if all(g.plan is not None and g.plan.faithful(inner) for g in groups):
+                return _timed(fallback, start)
+    if opts.best_effort and fallback is not None:
+        return _timed(fallback, start)
     raise _no_fit(whole, groups, inner)
+
+
+def _timed(mission: Mission, start: float) -> Mission:
+    """``mission`` with its planning time: from ``start`` (``time.perf_counter()``) to now."""
+    return replace(mission, planning_time_s=time.perf_counter() - start)
 
 
 def _attempt(
@@ -227,7 +242,7 @@ def _groups(
 
 
 def _joined(
-    plans: list[RoutePlan], target: UploadTarget
+    plans: tuple[RoutePlan, ...], target: UploadTarget
 ) -> tuple[Trajectory, tuple[tuple[float, float], ...]]:
     """The groups flown in order with hovers between, and their pen windows on its clock."""
     pieces: list[Trajectory] = []
@@ -251,15 +266,14 @@ def _mission(
     samples: RouteSamples,
     board: Board,
     opts: WritingOptions,
-    *,
-    start: float,
 ) -> Mission:
     """The mission of ``plans`` (one: one upload, several: split); ``planned``: tip, pen windows."""
     assert opts.target is not None
     trajectory, windows = planned
     uploads = plan_uploads(trajectory, opts.target)  # the contract: raises if it does not fit
     strokes = samples.strokes_world
-    strategy: Strategy = "one-upload" if len(plans) == 1 else "split"
+    # A split into one group would be the whole route again: it is tried as one upload.
+    strategy: TargetStrategy = "one-upload" if len(plans) == 1 else "split"
     brush = opts.brush_length_m if any(p.compensated for p in plans) else 0.0
     deviation = measure_deviation(trajectory, windows, strokes, brush)
     return Mission(
@@ -270,40 +284,52 @@ def _mission(
         windows,
         deviation,
         max(p.scale for p in plans),
-        time.perf_counter() - start,
+        0.0,  # set when it is returned (_timed)
         opts,
         TargetPlan(opts.target, strategy, uploads),
     )
 
 
-def _no_fit(whole: RoutePlan | None, groups: list[_Group], opts: WritingOptions) -> InfeasibleError:
+def _no_fit(
+    whole: RoutePlan | None, groups: list[_Group] | None, opts: WritingOptions
+) -> InfeasibleError:
     """What was measured, and the tolerances that would fit with it."""
     target = opts.target
     assert target is not None
     tol = opts.tolerance
     fits: list[str] = []
-    if whole is None:
-        one = f"one upload of {target.max_pieces} pieces cannot meet the limits"
-    else:
-        one = (
-            f"one upload of {target.max_pieces} pieces strays "
-            f"{1e3 * whole.deviation.max_m:.3g} mm ({whole.scale:.3g}x slower)"
-        )
-        fits.append(f"{1e3 * whole.deviation.max_m:.3g} mm in one upload")
-    failing = [g for g in groups if g.plan is None or not g.plan.faithful(opts)]
-    strokes = ", ".join(str(g.first) for g in failing)
-    split = f"split at the pen-up points into {len(groups)} uploads, {target.hover_s:g} s hovers"
-    if any(g.plan is None for g in failing):
-        split += f", stroke(s) {strokes} alone cannot meet the limits"
-    else:
-        worst = max(g.plan.deviation.max_m for g in failing if g.plan is not None)
-        split += f", stroke(s) {strokes} alone stray up to {1e3 * worst:.3g} mm"
-        fits.append(f"{1e3 * worst:.3g} mm with {len(groups)} uploads")
+    tried: list[str] = []
+    if "one-upload" in opts.target_strategies:
+        if whole is None:
+            tried.append(f"one upload of {target.max_pieces} pieces cannot meet the limits")
+        else:
+            stray = f"{1e3 * whole.deviation.max_m:.3g} mm"
+            tried.append(
+                f"one upload of {target.max_pieces} pieces strays {stray} "
+                f"({whole.scale:.3g}x slower)"
+            )
+            fits.append(f"{stray} in one upload")
+    if groups is not None:
+        tried.append(_split_measured(groups, opts, fits))
     would = f"a tolerance of {' or '.join(fits)}, " if fits else ""
     return InfeasibleError(
         f"strokes: no plan for a {target.name} ({target.max_pieces} pieces of degree "
         f"{target.max_degree} per upload) within {opts.limits.describe()} and the tolerance "
-        f"of {1e3 * tol:.3g} mm: {one}; {split}; expected within {1e3 * tol:.3g} mm; "
+        f"of {1e3 * tol:.3g} mm: {'; '.join(tried)}; expected within {1e3 * tol:.3g} mm; "
         f"{would}a larger size or best_effort would fit",
         ("fidelity", "target"),
     )
+
+
+def _split_measured(groups: list[_Group], opts: WritingOptions, fits: list[str]) -> str:
+    """The split's account; appends the tolerance that would fit it to ``fits``."""
+    target = opts.target
+    assert target is not None
+    failing = [g for g in groups if g.plan is None or not g.plan.faithful(opts)]
+    strokes = ", ".join(str(g.first) for g in failing)
+    split = f"split at the pen-up points into {len(groups)} uploads, {target.hover_s:g} s hovers"
+    if any(g.plan is None for g in failing):
+        return f"{split}, stroke(s) {strokes} alone cannot meet the limits"
+    worst = max(g.plan.deviation.max_m for g in failing if g.plan is not None)
+    fits.append(f"{1e3 * worst:.3g} mm with {len(groups)} uploads")
+    return f"{split}, stroke(s) {strokes} alone stray up to {1e3 * worst:.3g} mm"

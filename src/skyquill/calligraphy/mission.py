@@ -76,6 +76,9 @@ MAX_SPANS = 20_000
 #: Solves of the tilt compensation's fixed-point iteration.
 TILT_PASSES = 3
 GRAVITY = 9.81  # m/s^2
+#: The ways to fit a vehicle's upload budget (:mod:`skyquill.calligraphy.budget`).
+TargetStrategy = Literal["one-upload", "split"]
+TARGET_STRATEGIES: tuple[TargetStrategy, ...] = ("one-upload", "split")
 
 
 @dataclass(frozen=True)
@@ -136,6 +139,10 @@ class WritingOptions:
         upload, uploads changed at rest with a hover between them
         (:mod:`skyquill.calligraphy.budget`). ``None``: one spline at
         ``knot_interval``.
+    target_strategies
+        The ways to fit ``target`` tried, in order (default
+        :data:`TARGET_STRATEGIES`, cheapest flight first): ``"one-upload"`` and
+        ``"split"``; one alone measures it (the budget benchmark).
     """
 
     size_m: float = 0.5
@@ -156,6 +163,7 @@ class WritingOptions:
     max_stretches: int = 8
     best_effort: bool = False
     target: UploadTarget | None = None
+    target_strategies: tuple[TargetStrategy, ...] = TARGET_STRATEGIES
 
     def __post_init__(self) -> None:
         if not isinstance(self.limits, VehicleLimits):
@@ -163,6 +171,16 @@ class WritingOptions:
         if self.target is not None and not isinstance(self.target, UploadTarget):
             raise InputError(
                 f"target: got {type(self.target).__name__}, expected UploadTarget or None"
+            )
+        strategies = tuple(self.target_strategies)
+        if (
+            not strategies
+            or len(set(strategies)) < len(strategies)
+            or not set(strategies) <= set(TARGET_STRATEGIES)
+        ):
+            raise InputError(
+                f"target_strategies: got {strategies!r}, expected some of "
+                f"{TARGET_STRATEGIES!r}, each once"
             )
         self.limits.timing_bounds()  # the route is timed with a speed and an acceleration
         for name in ("size_m", "knot_interval", "stretch_factor"):
