@@ -17,6 +17,10 @@ ends at rest:
   tolerance, the timing is stretched and the problem solved again -- the
   factor is reported.
 
+With ``WritingOptions.target`` the flight is planned to fit a vehicle's
+trajectory memory instead (:mod:`skyquill.calligraphy.budget`): one spline of
+few long knot spans, or several flown one after another with hovers between.
+
 The plan is of the brush tip; the vehicle flies it offset by the brush
 (:meth:`Mission.vehicle_trajectory`). The pen is down (``pen = 1``) from a stroke's first
 sample time to its last.
@@ -485,7 +489,9 @@ def plan_writing(
         :data:`MAX_SPANS` knot spans (before it is assembled).
     InfeasibleError
         The limits cannot be met, or the pen-down path stays beyond the
-        tolerance, even after ``max_stretches`` stretches.
+        tolerance, even after ``max_stretches`` stretches; with
+        ``options.target``, no way of fitting its uploads does
+        (:func:`skyquill.calligraphy.budget.plan_for_target`).
     """
     start = time.perf_counter()
     if strokes.n_points > MAX_INPUT_POINTS:
