@@ -52,7 +52,7 @@ def main() -> None:
                     "planning_time_s": float(np.median(times)),
                     "writing_time_s": mission.trajectory.duration,
                     "deviation_max_m": mission.deviation.max_m,
-                    "max_excess": mission.fit.verification.max_excess,
+                    "max_excess": mission.verification.max_excess,
                     "faithful": mission.faithful,
                     "time_scale": mission.time_scale,
                 }

@@ -57,8 +57,8 @@ def measure(mission: Mission) -> dict[str, Any]:
         "rms_acc_pen_down_mps2": float(np.sqrt(np.mean(acc[down] ** 2))),
         "fitting_error_max_m": mission.deviation.max_m,
         "fitting_error_mean_m": mission.deviation.mean_m,
-        "cost": mission.fit.cost,
-        "max_excess": mission.fit.verification.max_excess,
+        "cost": mission.fits[0].cost,
+        "max_excess": mission.verification.max_excess,
         "planning_time_s": mission.planning_time_s,
     }
 

@@ -147,8 +147,8 @@ def yong_case(kind: str, bounds: tuple[float, float, float], runs: int) -> dict[
         "gradient_at_final_times": grad_stats,
         "n_active_rows": grad.n_active,
         "n_active_cones": grad.n_active_cones,
-        "duration_s": mission.fit.trajectory.duration,
-        "max_excess": mission.fit.verification.max_excess,
+        "duration_s": mission.trajectory.duration,
+        "max_excess": mission.verification.max_excess,
         "max_deviation_m": mission.deviation.max_m,
     }
 

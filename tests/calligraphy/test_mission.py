@@ -43,7 +43,7 @@ def test_one_continuous_flight_from_home_to_home(h_mission) -> None:  # type: ig
     tip_home = HOME - [0.0, 0.0, 0.3]  # the brush hangs 0.3 m below the vehicle
     assert np.allclose(ends, [tip_home, tip_home], atol=1e-9)
     assert np.allclose(traj.evaluate(np.array([0.0, traj.duration]), 1), 0.0, atol=1e-9)
-    assert h_mission.fit.verification.max_excess <= 1e-9
+    assert h_mission.verification.max_excess <= 1e-9
 
 
 def test_pen_windows_are_on_the_board_and_within_tolerance(h_mission) -> None:  # type: ignore[no-untyped-def]
@@ -111,13 +111,13 @@ def test_text_and_hanzi_are_written_faithfully() -> None:
     for strokes in (text_strokes("Hi"), hanzi_strokes("永")):
         mission = plan_writing(strokes)
         assert mission.faithful, strokes.source
-        assert mission.fit.verification.max_excess <= 1e-9
+        assert mission.verification.max_excess <= 1e-9
 
 
 def test_polytope_norm_limits() -> None:
     limits = VehicleLimits(0.8, 1.0, 5.0)
     mission = plan_writing(H, options=WritingOptions(limits=limits, norm_sides=8))
-    check = mission.fit.verification
+    check = mission.verification
     assert check.max_excess <= 1e-9 and mission.faithful
 
 
@@ -157,10 +157,10 @@ def test_resegmentation_lowers_the_cost_and_keeps_fidelity(mode: str) -> None:
     strokes = hanzi_strokes("永")
     before = plan_writing(strokes, options=WritingOptions(resegment="off"))
     after = plan_writing(strokes, options=WritingOptions(resegment=mode))  # type: ignore[arg-type]
-    assert after.faithful and after.fit.verification.max_excess <= 1e-9
+    assert after.faithful and after.verification.max_excess <= 1e-9
     if mode == "fixed":
         assert after.trajectory.duration == pytest.approx(before.trajectory.duration, rel=1e-12)
-        assert after.fit.cost < before.fit.cost
+        assert after.fits[0].cost < before.fits[0].cost
     else:
         assert after.trajectory.duration < before.trajectory.duration
 
@@ -198,7 +198,7 @@ def test_random_strokes_through_the_whole_pipeline(paths: list[list[tuple[float,
     except SkyquillError as exc:
         assert str(exc)
         return
-    assert mission.fit.verification.max_excess <= 1e-9
+    assert mission.verification.max_excess <= 1e-9
     assert np.isfinite(mission.deviation.max_m)
 
 

@@ -98,3 +98,45 @@ def test_wall_board(tmp_path: Path) -> None:
     assert np.allclose([p[1] for s in strokes for p in s], -0.3)
     bad = runner.invoke(app, ["write", "Hi", "--board", "wall", "--fly", "--out", str(tmp_path)])
     assert bad.exit_code == 2
+
+
+def _held_out(tmp_path: Path) -> Path:
+    """丁 and 十, not bundled: hanzi-writer-data files (medians in the 1024 em box, y up)."""
+    folder = tmp_path / "hanzi"
+    folder.mkdir()
+    hook = [[500, 700], [505, 300], [480, 90], [400, 150]]
+    medians = {
+        "丁": [[[120, 700], [500, 710], [900, 700]], hook],
+        "十": [[[100, 450], [500, 460], [920, 450]], [[510, 880], [505, 450], [500, 60]]],
+    }
+    for char, strokes in medians.items():
+        (folder / f"{char}.json").write_text(json.dumps({"medians": strokes}), encoding="utf-8")
+    return folder
+
+
+def test_write_for_a_crazyflie_fits_every_upload(tmp_path: Path) -> None:
+    hanzi = _held_out(tmp_path)
+    out = tmp_path / "o"
+    args = ["write", "丁十", "--hanzi", str(hanzi), "--drones", "2", "--size", "0.3"]
+    result = runner.invoke(app, [*args, "--target", "crazyflie", "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    assert "upload(s) for crazyflie" in " ".join(result.output.split())
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["target"]["name"] == "crazyflie"
+    assert summary["target"]["max_upload_pieces"] <= 31
+    assert summary["target"]["max_upload_bytes"] <= 4096
+    for drone, written in zip(summary["drones"], summary["plan"]["drones"], strict=True):
+        uploads = drone["target"]["uploads"]
+        assert all(u["pieces"] <= 31 and u["bytes"] <= 4096 for u in uploads)
+        assert [u["hover_before_s"] for u in uploads] == [0.0] + [1.0] * (len(uploads) - 1)
+        assert drone["faithful"] and drone["max_excess"] <= 1e-9
+        # What was written and read back is the plan, densely within the limits.
+        assert written["verification"]["max_excess"] <= 1e-9
+        assert written["kind"] == ("bspline" if len(uploads) == 1 else "sequence")
+
+
+def test_write_target_unknown(tmp_path: Path) -> None:
+    args = ["write", "Hi", "--target", "tello", "--out", str(tmp_path / "o")]
+    result = runner.invoke(app, args)
+    assert result.exit_code == 2, result.output
+    assert "--target: got 'tello', expected one of crazyflie" in " ".join(result.output.split())

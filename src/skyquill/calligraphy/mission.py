@@ -17,6 +17,10 @@ ends at rest:
   tolerance, the timing is stretched and the problem solved again -- the
   factor is reported.
 
+With ``WritingOptions.target`` the flight is planned to fit a vehicle's
+trajectory memory instead (:mod:`skyquill.calligraphy.budget`): one spline of
+few long knot spans, or several flown one after another with hovers between.
+
 The plan is of the brush tip; the vehicle flies it offset by the brush
 (:meth:`Mission.vehicle_trajectory`). The pen is down (``pen = 1``) from a stroke's first
 sample time to its last.
@@ -28,6 +32,7 @@ import itertools
 import math
 import time
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
@@ -42,10 +47,13 @@ from skyquill.optimize.solve import FitResult
 from skyquill.optimize.timing import allocate_path_times
 from skyquill.strokes import Strokes, turning_points
 from skyquill.strokes.model import MAX_STROKES
-from skyquill.trajectory import SplineTrajectory
+from skyquill.targets import UploadTarget
+from skyquill.trajectory import RestToRestSequence, SplineTrajectory, Trajectory
 from skyquill.validation import FloatArray, as_array, as_float, as_int
+from skyquill.verify import Verification, verify
 
 if TYPE_CHECKING:  # the simulator is imported only to fly
+    from skyquill.calligraphy.budget import TargetPlan
     from skyquill.sim import ContactBoard
 
 #: Spacing of the samples that hold lifts and transits near their straight lines, m.
@@ -72,6 +80,9 @@ MAX_SPANS = 20_000
 #: Solves of the tilt compensation's fixed-point iteration.
 TILT_PASSES = 3
 GRAVITY = 9.81  # m/s^2
+#: The ways to fit a vehicle's upload budget (:mod:`skyquill.calligraphy.budget`).
+TargetStrategy = Literal["one-upload", "split"]
+TARGET_STRATEGIES: tuple[TargetStrategy, ...] = ("one-upload", "split")
 
 
 @dataclass(frozen=True)
@@ -125,6 +136,17 @@ class WritingOptions:
         Return the last plan even when its pen-down path is beyond the
         tolerance (``Mission.faithful`` is then False); by default that is an
         :class:`~skyquill.errors.InfeasibleError` with the measured deviation.
+    target
+        Plan for a vehicle's trajectory memory (``--target``): splines of the
+        target's degree (``degree`` is then ignored), at most
+        :attr:`~skyquill.targets.UploadTarget.max_pieces` knot spans per
+        upload, uploads changed at rest with a hover between them
+        (:mod:`skyquill.calligraphy.budget`). ``None``: one spline at
+        ``knot_interval``.
+    target_strategies
+        The ways to fit ``target`` tried, in order (default
+        :data:`TARGET_STRATEGIES`, cheapest flight first): ``"one-upload"`` and
+        ``"split"``; one alone measures it (the budget benchmark).
     """
 
     size_m: float = 0.5
@@ -144,10 +166,26 @@ class WritingOptions:
     stretch_factor: float = 1.25
     max_stretches: int = 8
     best_effort: bool = False
+    target: UploadTarget | None = None
+    target_strategies: tuple[TargetStrategy, ...] = TARGET_STRATEGIES
 
     def __post_init__(self) -> None:
         if not isinstance(self.limits, VehicleLimits):
             raise InputError(f"limits: got {type(self.limits).__name__}, expected VehicleLimits")
+        if self.target is not None and not isinstance(self.target, UploadTarget):
+            raise InputError(
+                f"target: got {type(self.target).__name__}, expected UploadTarget or None"
+            )
+        strategies = tuple(self.target_strategies)
+        if (
+            not strategies
+            or len(set(strategies)) < len(strategies)
+            or not set(strategies) <= set(TARGET_STRATEGIES)
+        ):
+            raise InputError(
+                f"target_strategies: got {strategies!r}, expected some of "
+                f"{TARGET_STRATEGIES!r}, each once"
+            )
         self.limits.timing_bounds()  # the route is timed with a speed and an acceleration
         for name in ("size_m", "knot_interval", "stretch_factor"):
             as_float(name, getattr(self, name), positive=True)
@@ -223,8 +261,13 @@ class Mission:
 
     Attributes
     ----------
-    fit
-        The engine's result; ``fit.trajectory`` is the brush-tip trajectory.
+    fits
+        The engine's results, one per planned part of the flight in flight
+        order (one unless the plan was split into uploads).
+    trajectory
+        The brush-tip trajectory: the one fit's spline, or, split into
+        uploads, a :class:`~skyquill.trajectory.RestToRestSequence` of the
+        fits' splines with hovers between them.
     board
         Where it writes.
     strokes_world
@@ -234,14 +277,18 @@ class Mission:
     deviation
         Fidelity of the pen-down path.
     time_scale
-        Stretch applied to the initial timing.
+        Stretch applied to the initial timing (the largest over the parts).
     planning_time_s
         Wall time of the whole planning.
     options
         The options it was planned with.
+    target
+        How the plan fits ``options.target`` (strategy and uploads); ``None``
+        without a target.
     """
 
-    fit: FitResult
+    fits: tuple[FitResult, ...]
+    trajectory: Trajectory
     board: Board
     strokes_world: tuple[FloatArray, ...]
     pen_windows: tuple[tuple[float, float], ...]
@@ -249,11 +296,19 @@ class Mission:
     time_scale: float
     planning_time_s: float
     options: WritingOptions
+    target: TargetPlan | None = None
 
     @property
-    def trajectory(self) -> SplineTrajectory:
-        """The brush-tip trajectory."""
-        return self.fit.trajectory
+    def limits(self) -> tuple[DerivativeLimit, ...]:
+        """The limits the engine imposed (the same on every part)."""
+        return self.fits[0].problem.limits
+
+    @cached_property
+    def verification(self) -> Verification:
+        """The dense check of the whole trajectory against :attr:`limits`."""
+        if self.trajectory is self.fits[0].trajectory:
+            return self.fits[0].verification
+        return verify(self.trajectory, self.limits)
 
     def pen(self, t: FloatArray) -> FloatArray:
         """1.0 where the pen is down at times ``t`` (N,), else 0.0."""
@@ -264,14 +319,13 @@ class Mission:
         """Vehicle position minus tip position (3,), m."""
         return self.options.brush_length_m * self.board.normal
 
-    def vehicle_trajectory(self) -> SplineTrajectory:
+    def vehicle_trajectory(self) -> Trajectory:
         """The vehicle's trajectory: the tip's, offset by the brush along the board normal.
 
         A constant offset of every control point offsets the curve (partition
         of unity), so limits and smoothness are unchanged.
         """
-        tip = self.trajectory
-        return SplineTrajectory(tip.control_points + self.brush_offset, tip.degree, tip.duration)
+        return offset_trajectory(self.trajectory, self.brush_offset)
 
     @property
     def faithful(self) -> bool:
@@ -280,8 +334,8 @@ class Mission:
 
     def summary(self) -> dict[str, Any]:
         """Timing, the dense check, fidelity: a drone's entry in ``summary.json`` (SI units)."""
-        check = self.fit.verification
-        return {
+        check = self.verification
+        entry = {
             "duration_s": self.trajectory.duration,
             "planning_time_s": self.planning_time_s,
             "limits": check.limits_report(),
@@ -295,6 +349,21 @@ class Mission:
             "strokes": len(self.strokes_world),
             "time_scale": self.time_scale,
         }
+        if self.target is not None:
+            entry["target"] = self.target.as_dict()
+        return entry
+
+
+def offset_trajectory(traj: Trajectory, offset: FloatArray) -> Trajectory:
+    """``traj`` moved by ``offset`` (d,), m: a spline or a sequence of splines."""
+    if isinstance(traj, SplineTrajectory):
+        return SplineTrajectory(traj.control_points + offset, traj.degree, traj.duration)
+    if isinstance(traj, RestToRestSequence):
+        return RestToRestSequence(tuple(offset_trajectory(p, offset) for p in traj.pieces))
+    raise InputError(
+        f"traj: got a {type(traj).__name__}, expected a SplineTrajectory or a "
+        "RestToRestSequence of them"
+    )
 
 
 def _segment(a: FloatArray, b: FloatArray) -> FloatArray:
@@ -420,7 +489,9 @@ def plan_writing(
         :data:`MAX_SPANS` knot spans (before it is assembled).
     InfeasibleError
         The limits cannot be met, or the pen-down path stays beyond the
-        tolerance, even after ``max_stretches`` stretches.
+        tolerance, even after ``max_stretches`` stretches; with
+        ``options.target``, no way of fitting its uploads does
+        (:func:`skyquill.calligraphy.budget.plan_for_target`).
     """
     start = time.perf_counter()
     if strokes.n_points > MAX_INPUT_POINTS:
@@ -446,7 +517,77 @@ def plan_writing(
     times = allocate_path_times(points, vmax, 0.5 * amax)
     threshold = opts.turning_threshold_m or 0.25 * opts.tolerance
     corners = _turning_samples(strokes_world, board, points, roles, threshold)
-    samples = _Samples(points, roles, corners, strokes_world)
+    samples = RouteSamples(points, roles, corners, strokes_world)
+    if opts.target is not None:
+        # budget builds on this module's route planning, hence imported here.
+        from skyquill.calligraphy.budget import plan_for_target
+
+        return plan_for_target(samples, times, board, opts, start)
+    plan = plan_route(samples, times, board, opts)
+    if not plan.faithful(opts) and not opts.best_effort:
+        raise fidelity_error(plan, opts)
+    if not plan.compensated and opts.resegment != "off" and opts.resegment_iterations > 0:
+        plan = resegmented(samples, plan, opts)
+    return Mission(
+        (plan.fit,),
+        plan.fit.trajectory,
+        board,
+        strokes_world,
+        plan.windows,
+        plan.deviation,
+        plan.scale,
+        time.perf_counter() - start,
+        opts,
+    )
+
+
+@dataclass(frozen=True)
+class RouteSamples:
+    """A route to fly: samples (N, 3), roles (N,), corner indices, the input strokes.
+
+    ``roles[i]`` is the index into ``strokes_world`` of the stroke sample ``i``
+    belongs to, or -1 for lifts and transits; ``max_spans`` caps the knot spans
+    of its spline (``None``: as many as ``knot_interval`` asks).
+    """
+
+    points: FloatArray
+    roles: FloatArray
+    corners: FloatArray
+    strokes_world: tuple[FloatArray, ...]
+    max_spans: int | None = None
+
+
+@dataclass(frozen=True)
+class RoutePlan:
+    """One spline along a route: the fit, pen windows (s), fidelity, stretch, sample times (s)."""
+
+    fit: FitResult
+    windows: tuple[tuple[float, float], ...]
+    deviation: Deviation
+    scale: float
+    times: FloatArray
+    compensated: bool
+
+    def faithful(self, opts: WritingOptions) -> bool:
+        """Whether the pen-down path is within ``opts.tolerance``."""
+        return self.deviation.max_m <= opts.tolerance
+
+
+def plan_route(
+    samples: RouteSamples, times: FloatArray, board: Board, opts: WritingOptions
+) -> RoutePlan:
+    """One rest-to-rest spline along ``samples`` at ``times`` over ``board``, stretched to fit.
+
+    The timing is stretched by ``opts.stretch_factor`` while the limits cannot
+    be met or the pen-down path is beyond the tolerance, at most
+    ``opts.max_stretches`` times; the last plan is returned even if it is not
+    faithful (the caller decides). No re-segmentation (:func:`resegmented`).
+
+    Raises
+    ------
+    InfeasibleError
+        The limits cannot be met even after ``max_stretches`` stretches.
+    """
     compensate = opts.tilt_compensation and board.kind == "horizontal" and opts.brush_length_m > 0
     scale = 1.0
     for attempt in range(opts.max_stretches + 1):
@@ -466,40 +607,44 @@ def plan_writing(
         if deviation.max_m <= opts.tolerance or last:
             break
         scale *= opts.stretch_factor  # slower: less tracking error and less brush swing
-    if deviation.max_m > opts.tolerance and not opts.best_effort:
-        raise InfeasibleError(
-            f"strokes: the pen-down path stays {1e3 * deviation.max_m:.3g} mm from the input "
-            f"after {opts.max_stretches} stretches ({scale:.3g}x slower) within "
-            f"{opts.limits.describe()}, expected within the "
-            f"tolerance of {1e3 * opts.tolerance:.3g} mm (1 % of the size unless tolerance_m "
-            "is given); a larger size, a lower speed limit (the route is timed by it) or "
-            "best_effort",
-            ("fidelity",),
-        )
-    if not compensate and opts.resegment != "off" and opts.resegment_iterations > 0:
-        fit, windows, deviation, _ = _resegment(
-            samples, scaled_times, (fit, windows, deviation), opts
-        )
-    return Mission(
-        fit, board, strokes_world, windows, deviation, scale, time.perf_counter() - start, opts
+    return RoutePlan(fit, windows, deviation, scale, scaled_times, compensate)
+
+
+def fidelity_error(plan: RoutePlan, opts: WritingOptions) -> InfeasibleError:
+    """The error for a plan whose pen-down path stays beyond the tolerance."""
+    return InfeasibleError(
+        f"strokes: the pen-down path stays {1e3 * plan.deviation.max_m:.3g} mm from the input "
+        f"after {opts.max_stretches} stretches ({plan.scale:.3g}x slower) within "
+        f"{opts.limits.describe()}, expected within the "
+        f"tolerance of {1e3 * opts.tolerance:.3g} mm (1 % of the size unless tolerance_m "
+        "is given); a larger size, a lower speed limit (the route is timed by it) or "
+        "best_effort",
+        ("fidelity",),
     )
 
 
-@dataclass(frozen=True)
-class _Samples:
-    """The mission's route: samples (N, 3), roles (N,), corner indices, the input strokes."""
-
-    points: FloatArray
-    roles: FloatArray
-    corners: FloatArray
-    strokes_world: tuple[FloatArray, ...]
+def resegmented(samples: RouteSamples, plan: RoutePlan, opts: WritingOptions) -> RoutePlan:
+    """``plan`` after time re-segmentation (paper 000 §5.4), if that stays faithful."""
+    fit, windows, deviation, times = _resegment(
+        samples, plan.times, (plan.fit, plan.windows, plan.deviation), opts
+    )
+    return RoutePlan(fit, windows, deviation, plan.scale, times, plan.compensated)
 
 
 def _plan_at(
-    samples: _Samples, times: FloatArray, opts: WritingOptions, *, resegment: bool
+    samples: RouteSamples, times: FloatArray, opts: WritingOptions, *, resegment: bool
 ) -> tuple[FitResult, tuple[tuple[float, float], ...], Deviation, FloatArray]:
     """Solve at ``times``, then re-segment if asked; the times it ends with."""
-    fit = solve(_problem(samples.points, samples.roles, samples.corners, times, opts))
+    fit = solve(
+        _problem(
+            samples.points,
+            samples.roles,
+            samples.corners,
+            times,
+            opts,
+            max_spans=samples.max_spans,
+        )
+    )
     windows = _pen_windows(samples.roles, times, len(samples.strokes_world))
     deviation = measure_deviation(fit.trajectory, windows, samples.strokes_world)
     if not resegment or opts.resegment == "off" or opts.resegment_iterations == 0:
@@ -508,7 +653,7 @@ def _plan_at(
 
 
 def _resegment(
-    samples: _Samples,
+    samples: RouteSamples,
     times: FloatArray,
     current: tuple[FitResult, tuple[tuple[float, float], ...], Deviation],
     opts: WritingOptions,
@@ -545,7 +690,7 @@ def _resegment(
     return result.result, windows, deviation, result.times
 
 
-def swung_tip(traj: SplineTrajectory, t: FloatArray, brush_length_m: float) -> FloatArray:
+def swung_tip(traj: Trajectory, t: FloatArray, brush_length_m: float) -> FloatArray:
     """Where the hanging brush's tip really is (N, 3): ``P + L (e_z - b3)``.
 
     ``P`` is the planned (untilted) tip, ``b3`` the thrust direction the
@@ -557,7 +702,7 @@ def swung_tip(traj: SplineTrajectory, t: FloatArray, brush_length_m: float) -> F
 
 
 def _compensate_tilt(
-    samples: _Samples,
+    samples: RouteSamples,
     times: FloatArray,
     fit: FitResult,
     windows: tuple[tuple[float, float], ...],
@@ -610,9 +755,12 @@ def _problem(
     opts: WritingOptions,
     *,
     n_ctrl: int | None = None,
+    max_spans: int | None = None,
 ) -> SmoothingProblem:
     duration = float(times[-1])
     spans = n_ctrl - opts.degree if n_ctrl else max(1, math.ceil(duration / opts.knot_interval))
+    if max_spans is not None:
+        spans = min(spans, max_spans)
     if spans > MAX_SPANS:
         raise InputError(
             f"knot_interval: got {opts.knot_interval:g} s for a {duration:.4g} s flight, i.e. "
@@ -647,7 +795,7 @@ def _pen_windows(roles: FloatArray, times: FloatArray, n: int) -> tuple[tuple[fl
 
 
 def measure_deviation(
-    traj: SplineTrajectory,
+    traj: Trajectory,
     windows: tuple[tuple[float, float], ...],
     strokes_world: tuple[FloatArray, ...],
     brush_length_m: float = 0.0,
@@ -675,7 +823,7 @@ def measure_deviation(
 
 
 def check_separation(
-    trajectories: list[SplineTrajectory], minimum_m: float = 1.0, rate_hz: float = 50.0
+    trajectories: list[Trajectory], minimum_m: float = 1.0, rate_hz: float = 50.0
 ) -> float:
     """Smallest pairwise distance over the whole flight, m; raise if below ``minimum_m``.
 

@@ -17,6 +17,7 @@ from skyquill.cli.main import (
     JmaxAxis,
     NormSides,
     OutDir,
+    Target,
     Vmax,
     VmaxAxis,
     app,
@@ -24,6 +25,7 @@ from skyquill.cli.main import (
     console,
     positive_rate,
     say_done,
+    upload_target,
     user_errors,
 )
 from skyquill.errors import InputError
@@ -92,6 +94,7 @@ def write(
         str | None,
         typer.Option(help="dask.distributed scheduler address (or 'local') for large shows."),
     ] = None,
+    target: Target = None,
     force: Force = False,
 ) -> None:
     """Plan pen-up / pen-down writing flights; write CSVs, input_strokes.json, plot, summary."""
@@ -108,6 +111,7 @@ def write(
             norm_sides=norm_sides,
             best_effort=best_effort,
             tilt_compensation=tilt_compensation,
+            target=upload_target(target),
         )
         if drones < 1:
             raise InputError(f"--drones: got {drones}, expected at least 1")
@@ -131,7 +135,18 @@ def write(
     say_done(
         f"{out}: {summary['duration_s']:.1f} s of flight, planned in "
         f"{summary['planning_time_s']:.2f} s, deviation {1e3 * summary['deviation']['max_m']:.2f}"
-        f" mm, max excess {summary['max_excess']:.1e}"
+        f" mm, max excess {summary['max_excess']:.1e}{_uploads_note(summary)}"
+    )
+
+
+def _uploads_note(summary: dict[str, Any]) -> str:
+    """``", 2 uploads for crazyflie (31, 31 pieces)"`` with a target, else nothing."""
+    if "target" not in summary:
+        return ""
+    pieces = [u["pieces"] for d in summary["drones"] for u in d["target"]["uploads"]]
+    return (
+        f", {len(pieces)} upload(s) for {summary['target']['name']} "
+        f"({', '.join(map(str, pieces))} pieces)"
     )
 
 
@@ -156,7 +171,7 @@ def write_outputs(
     strokes_json: list[Any] = []
     for mission, (name, _) in zip(missions, names, strict=True):
         vehicle = mission.vehicle_trajectory()
-        limits = mission.fit.problem.limits
+        limits = mission.limits
         planned.append(PlannedTrajectory(vehicle, tuple(mission.pen_windows), limits))
         strokes_json.append([(s + mission.brush_offset).tolist() for s in mission.strokes_world])
         flight = show.flights[len(per_drone)] if show.flights else None
@@ -208,6 +223,22 @@ def _merge(drones: list[dict[str, Any]]) -> dict[str, Any]:
         "max_excess": max(d["max_excess"] for d in drones),
         "deviation": {k: max(d["deviation"][k] for d in drones) for k in drones[0]["deviation"]},
         "strokes": sum(d["strokes"] for d in drones),
+    } | _merge_targets(drones)
+
+
+def _merge_targets(drones: list[dict[str, Any]]) -> dict[str, Any]:
+    """With ``--target``: the target and the largest upload over drones (details per drone)."""
+    if "target" not in drones[0]:
+        return {}
+    uploads = [u for d in drones for u in d["target"]["uploads"]]
+    return {
+        "target": {
+            "name": drones[0]["target"]["name"],
+            "strategies": [d["target"]["strategy"] for d in drones],
+            "uploads_per_drone": [len(d["target"]["uploads"]) for d in drones],
+            "max_upload_pieces": max(u["pieces"] for u in uploads),
+            "max_upload_bytes": max(u["bytes"] for u in uploads),
+        }
     }
 
 

@@ -215,7 +215,7 @@ def _drone_plan(
     t = _view_times(traj.duration)
     v, a, j = (np.abs(traj.evaluate(t, n)).max(axis=1) for n in (1, 2, 3))
     lo, hi = part.bounds()
-    check = mission.fit.verification
+    check = mission.verification
     fields: dict[str, Any] = {
         "board_u0": float(board.origin[0] - first_board.origin[0]),
         "source_lo": (float(lo[0]), float(lo[1])),
@@ -270,7 +270,7 @@ def _exports(missions: Sequence[Mission]) -> tuple[dict[str, StudioFile], list[s
     planned = [
         (
             f"drone_{i}",
-            PlannedTrajectory(m.vehicle_trajectory(), tuple(m.pen_windows), m.fit.problem.limits),
+            PlannedTrajectory(m.vehicle_trajectory(), tuple(m.pen_windows), m.limits),
         )
         for i, m in enumerate(missions, start=1)
     ]

@@ -42,7 +42,7 @@ def plot_missions(missions: list[Mission], path: str | Path, title: str = "") ->
     worst = max(m.deviation.max_m for m in missions)
     fig.suptitle(
         f"{title}  max deviation {1e3 * worst:.2f} mm, max excess "
-        f"{max(m.fit.verification.max_excess for m in missions):.1e}"
+        f"{max(m.verification.max_excess for m in missions):.1e}"
     )
     fig.savefig(path, dpi=100)
     plt.close(fig)
