@@ -19,9 +19,10 @@ from skyquill.verify import verify
 EXAMPLES = Path(__file__).parents[2] / "examples" / "coverage"
 
 
-def test_the_l_field_spiral_is_flown_in_uploads_with_hovers() -> None:
+def test_the_l_field_is_flown_in_uploads_with_hovers() -> None:
     region = load_region(EXAMPLES / "l_field.geojson")
-    options = CoverageOptions(target=CRAZYFLIE)
+    # A 1.5 m swath: 50 m of stop-and-go zigzag, two uploads (the spiral too, but its LP is slow).
+    options = CoverageOptions(pattern="zigzag-stop", width=1.5, target=CRAZYFLIE)
     plan = plan_coverage(region, options)
     delivered = plan.delivered
     assert delivered is not None and delivered.budget.strategy == "split"

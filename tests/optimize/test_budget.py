@@ -9,6 +9,7 @@ import pytest
 
 from skyquill.errors import InfeasibleError
 from skyquill.io.points import read_points_csv
+from skyquill.optimize import budget
 from skyquill.optimize.budget import _split_point
 from skyquill.optimize.fit import FitOptions, fit_points
 from skyquill.targets import CRAZYFLIE, is_hover, plan_uploads
@@ -47,16 +48,21 @@ def test_a_long_spiral_is_split_into_uploads_within_the_tolerance() -> None:
     assert err.max() <= 0.005 and err.max() == pytest.approx(fit.max_deviation_m)
 
 
-def test_too_many_uploads_are_refused_with_what_would_fit() -> None:
+def test_too_many_uploads_are_refused_with_what_would_fit(monkeypatch: pytest.MonkeyPatch) -> None:
     points, _ = read_points_csv(EXAMPLES / "spiral.csv")
-    with pytest.raises(InfeasibleError, match=r"needs more than 50 uploads .* m of path would fit"):
-        fit_points(points, None, FitOptions(target=CRAZYFLIE, tolerance_m=0.002))
+    monkeypatch.setattr(budget, "MAX_UPLOADS", 1)  # the spiral needs 2 at 5 mm
+    with pytest.raises(
+        InfeasibleError,
+        match=r"target: the 3\.683 m path needs more than 1 uploads of 31 pieces within 5 mm, "
+        r"expected at most 1; no part of it fitted in one upload yet, so less than 1\.84 m would",
+    ):
+        fit_points(points, None, FitOptions(target=CRAZYFLIE, tolerance_m=0.005))
 
 
 def test_the_split_falls_at_the_slowest_point_of_the_middle_third() -> None:
     arc = np.linspace(0.0, 9.0, 10)
     times = np.cumsum(np.ones(10)) - 1.0
-    times[5:] += 2.0  # slow between points 4 and 6: point 5 is slowest... and 4
+    times[5:] += 2.0  # slow from point 4 to point 6: point 5 is the slowest
     times[6:] += 2.0
     assert _split_point(arc, times) == 5
     # Too few points inside the middle third: the one nearest the middle.

@@ -146,12 +146,14 @@ def split_into_uploads(
     target: UploadTarget,
     limits: tuple[DerivativeLimit, ...],
     *,
-    max_uploads: int = MAX_UPLOADS,
+    max_uploads: int | None = None,
 ) -> BudgetPlan:
     """Cut ``points`` (N, d), m, into chunks each fitted within ``tolerance_m`` in one upload.
 
     A chunk that misses the tolerance is bisected (see the module's
     docstring); a chunk of two points is a straight rest-to-rest move, exact.
+
+    ``max_uploads``: the ceiling (``None``: :data:`MAX_UPLOADS`).
 
     Raises
     ------
@@ -159,6 +161,7 @@ def split_into_uploads(
         More than ``max_uploads`` chunks would be needed; the message says how
         much of the path fits in that many.
     """
+    ceiling = MAX_UPLOADS if max_uploads is None else max_uploads
     arc = _arc_length(points)
     done: dict[int, tuple[int, ChunkFit]] = {}  # first point -> (last point, fit)
     pending = [(0, points.shape[0] - 1)]
@@ -170,8 +173,8 @@ def split_into_uploads(
         else:
             middle = _split_point(arc[first : last + 1] - arc[first], chunk.times) + first
             pending += [(middle, last), (first, middle)]
-        if len(done) + len(pending) > max_uploads:
-            raise _too_many_uploads(arc, done, tolerance_m, max_uploads, target)
+        if len(done) + len(pending) > ceiling:
+            raise _too_many_uploads(arc, done, tolerance_m, ceiling, target)
     firsts = sorted(done)
     bounds = (*firsts, points.shape[0] - 1)
     chunks = tuple(done[f][1] for f in firsts)
@@ -248,12 +251,15 @@ def _too_many_uploads(
     target: UploadTarget,
 ) -> InfeasibleError:
     fitted = sum(arc[last] - arc[first] for first, (last, _) in done.items())
-    per_upload = fitted / max(len(done), 1)
+    fits = (
+        f"the uploads fitted so far hold {fitted / len(done):.3g} m each, so about "
+        f"{fitted / len(done) * max_uploads:.3g} m of path would fit"
+        if done
+        else f"no part of it fitted in one upload yet, so less than {arc[-1] / 2:.3g} m would"
+    )
     return InfeasibleError(
         f"target: the {arc[-1]:.4g} m path needs more than {max_uploads} uploads of "
         f"{target.max_pieces} pieces within {tolerance_m * 1e3:.4g} mm, expected at most "
-        f"{max_uploads}; the uploads fitted so far hold {per_upload:.3g} m each, so about "
-        f"{per_upload * max_uploads:.3g} m of path would fit (a shorter path, a larger "
-        "tolerance, or several missions)",
+        f"{max_uploads}; {fits} (a shorter path, a larger tolerance, or several missions)",
         ("target",),
     )
