@@ -87,3 +87,26 @@ def test_a_self_intersecting_region_is_refused(tmp_path: Path) -> None:
     result = CliRunner().invoke(app, ["cover", str(bowtie), "--out", str(tmp_path / "o")])
     assert result.exit_code == 2
     assert "region" in result.output or "bowtie" in result.output
+
+
+def test_cover_for_a_crazyflie_writes_uploads_into_the_summary(tmp_path: Path) -> None:
+    out = tmp_path / "out"
+    args = ["cover", str(EXAMPLES / "square_10m.geojson"), "--out", str(out)]
+    result = CliRunner().invoke(app, [*args, "--pattern", "zigzag-stop", "--target", "crazyflie"])
+    assert result.exit_code == 0, result.output
+    summary = json.loads((out / "summary.json").read_text())
+    target = summary["target"]
+    assert target["name"] == "crazyflie" and target["path_tolerance_m"] == pytest.approx(0.1)
+    assert all(u["pieces"] <= 31 for u in target["uploads"])
+    assert target["max_path_deviation_m"] <= target["path_tolerance_m"]
+    # The refit holds the limits through the hull: a guaranteed check, excess 0.
+    assert summary["plan"]["limits_guaranteed"]
+    assert summary["plan"]["drones"][0]["verification"]["max_excess"] <= 1e-9
+
+
+def test_cover_refuses_an_unknown_target_in_one_line(tmp_path: Path) -> None:
+    args = ["cover", str(EXAMPLES / "square_10m.geojson"), "--out", str(tmp_path / "o")]
+    result = CliRunner().invoke(app, [*args, "--target", "tello"])
+    assert result.exit_code == 2
+    assert "--target: got 'tello', expected one of crazyflie" in " ".join(result.output.split())
+    assert "Traceback" not in result.output

@@ -67,6 +67,10 @@ def test_fit_writes_trajectory_plot_and_summary(tmp_path: Path) -> None:
         (["fit", str(EXAMPLES / "segments.csv"), "--rate", "0"], "--rate: got 0"),
         (["fit", str(EXAMPLES / "segments.csv"), "--hull", "round"], "--hull: got 'round'"),
         (["fit", str(EXAMPLES / "segments.csv"), "--solver", "cplex"], "solver: got 'cplex'"),
+        (
+            ["fit", str(EXAMPLES / "segments.csv"), "--target", "tello"],
+            "--target: got 'tello', expected one of crazyflie",
+        ),
     ],
 )
 def test_user_errors_exit_2_with_one_line(tmp_path: Path, args: list[str], message: str) -> None:
@@ -116,3 +120,23 @@ def test_bad_timing(tmp_path: Path, args: list[str], message: str) -> None:
     )
     assert result.exit_code == 2
     assert message in " ".join(result.output.split())
+
+
+def test_fit_for_a_crazyflie_writes_uploads_into_the_summary(tmp_path: Path) -> None:
+    from skyquill.io.trajectory_json import read_trajectory_json
+    from skyquill.targets import CRAZYFLIE, plan_uploads
+
+    out = tmp_path / "fit"
+    args = ["fit", str(EXAMPLES / "spiral.csv"), "--out", str(out), "--timing", "path"]
+    result = runner.invoke(app, [*args, "--tolerance", "0.005", "--target", "crazyflie"])
+    assert result.exit_code == 0, result.output
+    summary = json.loads((out / "summary.json").read_text())
+    target = summary["target"]
+    assert target["name"] == "crazyflie" and target["strategy"] == "split"
+    assert summary["degree"] == 7 and summary["max_deviation_m"] <= 0.005
+    written = read_trajectory_json(out / "trajectory.json").trajectory
+    uploads = plan_uploads(written, CRAZYFLIE)
+    assert [u["pieces"] for u in target["uploads"]] == [u.pieces for u in uploads]
+    assert all(u.pieces <= 31 for u in uploads) and len(uploads) >= 2
+    assert [u["hover_before_s"] for u in target["uploads"]][1:] == [1.0] * (len(uploads) - 1)
+    assert summary["plan"]["drones"][0]["verification"]["max_excess"] <= 1e-9

@@ -10,11 +10,13 @@ import typer
 from skyquill.cli.main import (
     Force,
     OutDir,
+    Target,
     Vmax,
     app,
     check_out,
     console,
     say_done,
+    upload_target,
     user_errors,
 )
 from skyquill.errors import InputError
@@ -59,9 +61,14 @@ def cover(
     ] = None,
     rate: Annotated[float, typer.Option(help="Setpoint rate, Hz.")] = 50.0,
     altitude: Annotated[float, typer.Option(help="Flight height, m.")] = 2.0,
+    target: Target = None,
     force: Force = False,
 ) -> None:
-    """Plan a coverage flight of REGION; write summary.json, trajectory.csv and plot.png."""
+    """Plan a coverage flight of REGION; write summary.json, trajectory.csv and plot.png.
+
+    With --target the planned path is re-fitted into the vehicle's uploads (degree-7
+    pieces, within 5 % of the swath of the path, hovering between uploads).
+    """
     from skyquill.coverage.plan import (
         CoverageOptions,
         coverage_limits,
@@ -88,6 +95,7 @@ def cover(
             delta=delta,
             rate=rate,
             altitude=altitude,
+            target=upload_target(target),
         )
         with console.status("planning the coverage flight"):
             if min_coverage is None:
@@ -106,12 +114,14 @@ def cover(
                 stage,
                 [planned],
                 rate=rate,
-                guaranteed=False,
+                # The refit for a target holds the limits through the hull; the LP does not.
+                guaranteed=plan.delivered is not None,
                 summary=plan.summary() | {"region": str(region)},
                 plot=lambda path: plot_coverage(plan, path),
             )
+    uploads = "" if plan.delivered is None else f", {len(plan.delivered.budget.uploads)} upload(s)"
     say_done(
-        f"{plan.options.pattern}: {plan.duration:.2f} s, {plan.path_length:.1f} m, "
+        f"{plan.options.pattern}: {plan.duration:.2f} s, {plan.path_length:.1f} m{uploads}, "
         f"coverage {plan.coverage:.4f}, max excess {summary['plan']['max_excess']:.4f}, "
         f"planned in {plan.planning_time:.2f} s -> {out}"
     )

@@ -16,6 +16,7 @@ from skyquill.cli.main import (
     JmaxAxis,
     NormSides,
     OutDir,
+    Target,
     Vmax,
     VmaxAxis,
     app,
@@ -23,6 +24,7 @@ from skyquill.cli.main import (
     console,
     positive_rate,
     say_done,
+    upload_target,
     user_errors,
 )
 from skyquill.errors import InputError
@@ -31,18 +33,24 @@ from skyquill.io.plan_dir import write_plan
 from skyquill.io.points import read_points_csv
 from skyquill.io.trajectory_json import PlannedTrajectory
 from skyquill.limits import VehicleLimits
+from skyquill.optimize.budget import lifted
 from skyquill.optimize.fit import FitOptions, PointFit, fit_points
 from skyquill.validation import FloatArray
 
 
 def fit_summary(fit: PointFit, options: FitOptions, rate: float) -> dict[str, Any]:
-    """The ``summary.json`` of a fit (SI units)."""
-    r, check = fit.result, fit.result.verification
-    return {
-        "duration_s": r.trajectory.duration,
-        "solve_time_s": r.solve_time_s,
-        "cost": r.cost,
-        "cost_terms": r.cost_terms,
+    """The ``summary.json`` of a fit (SI units).
+
+    With a target split into uploads, solve time, cost and control points
+    add up over the uploads' fits, and ``"target"`` lists the uploads.
+    """
+    r, check = fit.result, fit.verification
+    fits = [c.result for c in fit.budget.chunks] if fit.budget is not None else [r]
+    summary = {
+        "duration_s": fit.trajectory.duration,
+        "solve_time_s": sum(f.solve_time_s for f in fits),
+        "cost": sum(f.cost for f in fits),
+        "cost_terms": {key: sum(f.cost_terms[key] for f in fits) for key in r.cost_terms},
         "max_speed": check.max_speed,
         "max_acc": list(check.max_acc),
         "max_jerk": list(check.max_jerk),
@@ -54,7 +62,7 @@ def fit_summary(fit: PointFit, options: FitOptions, rate: float) -> dict[str, An
         "solver": r.solver,
         "time_scale": fit.time_scale,
         "degree": r.trajectory.degree,
-        "n_control_points": int(r.trajectory.control_points.shape[0]),
+        "n_control_points": sum(int(f.trajectory.control_points.shape[0]) for f in fits),
         "n_points": int(fit.points.shape[0]),
         "rate_hz": rate,
         "limits": check.limits_report(),
@@ -64,6 +72,7 @@ def fit_summary(fit: PointFit, options: FitOptions, rate: float) -> dict[str, An
         else f"inscribed polytope of {options.norm_sides} sides",
         "dense_samples": check.n_samples,
     }
+    return summary if fit.budget is None else summary | {"target": fit.budget.summary()}
 
 
 def run_fit(
@@ -87,16 +96,17 @@ def run_fit(
     ):
         summary = write_plan(
             stage,
-            [PlannedTrajectory(fit.result.trajectory.in_3d(), limits=fit.limits)],
+            [PlannedTrajectory(lifted(fit.trajectory, 0.0), limits=fit.limits)],
             rate=rate,
             guaranteed=True,
             summary=fit_summary(fit, options, rate),
             plot=lambda path: plot_fit(fit, path, title),
         )
+    uploads = "" if fit.budget is None else f", {len(fit.budget.uploads)} upload(s)"
     say_done(
         f"{out}: duration {summary['duration_s']:.2f} s, solve "
         f"{1e3 * summary['solve_time_s']:.1f} ms, max excess {summary['max_excess']:.1e}, "
-        f"rms deviation {1e3 * summary['rms_deviation_m']:.2f} mm"
+        f"rms deviation {1e3 * summary['rms_deviation_m']:.2f} mm{uploads}"
     )
     return summary
 
@@ -136,9 +146,15 @@ def fit(
     best_effort: Annotated[
         bool, typer.Option(help="Write the fit even if it misses the points by more.")
     ] = False,
+    target: Target = None,
     force: Force = False,
 ) -> None:
-    """Fit a smooth trajectory to POINTS_CSV that starts and ends at rest."""
+    """Fit a smooth trajectory to POINTS_CSV that starts and ends at rest.
+
+    With --target the fit is made of degree-7 pieces (--degree and --knot-interval are
+    the target's), split into uploads that hover between them when one upload misses
+    the tolerance (untimed points only).
+    """
     with user_errors():
         check_out(out)
         options = FitOptions(
@@ -152,6 +168,7 @@ def fit(
             timing="segments" if timing == "segments" else "path",
             tolerance_m=tolerance,
             best_effort=best_effort,
+            target=upload_target(target),
         )
         points, times = read_points_csv(points_csv)
         if timing not in (None, "given", "path", "segments"):

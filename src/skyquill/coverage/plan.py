@@ -37,9 +37,11 @@ from skyquill.coverage.paths import (
 )
 from skyquill.coverage.regions import check_width, coverage_fraction
 from skyquill.coverage.speed import SpeedPlan, plan_speed
+from skyquill.coverage.target import DeliveredPath, check_target_path, deliver
 from skyquill.errors import InfeasibleError, InputError
 from skyquill.limits import BoxLimit, CylinderLimit, DerivativeLimit, VehicleLimits
 from skyquill.optimize.legs import LegLimits, stop_and_go
+from skyquill.targets import UploadTarget
 from skyquill.trajectory import Samples, Trajectory, concatenate
 from skyquill.validation import as_float, as_int
 from skyquill.verify import Verification, verify
@@ -103,6 +105,10 @@ class CoverageOptions:
         inscribed regular polygon of this many sides (even, >= 4;
         ``norm_sides`` of :func:`~skyquill.coverage.speed.plan_speed`; 16 is
         within 2 % of the circle) and measured as norms.
+    target : UploadTarget or None
+        A vehicle's upload budget (:data:`skyquill.targets.TARGETS`): the
+        planned path is then re-fitted into its uploads, degree-7 pieces flown
+        rest to rest between uploads (:mod:`skyquill.coverage.target`).
     """
 
     width: float = 2.0
@@ -117,6 +123,7 @@ class CoverageOptions:
     altitude: float = 2.0
     grid: int | None = None
     norm_sides: int = 16
+    target: UploadTarget | None = None
 
     def __post_init__(self) -> None:
         for name in ("width", "delta", "rate"):
@@ -139,6 +146,9 @@ class CoverageOptions:
         sides = as_int("norm_sides", self.norm_sides, low=4, high=1024)
         if sides % 2:
             raise InputError(f"norm_sides: got {sides}, expected an even integer from 4 to 1024")
+        if self.target is not None and not isinstance(self.target, UploadTarget):
+            name = type(self.target).__name__
+            raise InputError(f"target: got {name}, expected an UploadTarget or None")
 
     @property
     def per_axis(self) -> bool:
@@ -200,19 +210,26 @@ class CoveragePlan:
     waypoints : ndarray, shape (K, 2)
         The control polygon (spline patterns) or the stop points (zigzag-stop), m.
     path : ndarray, shape (M, 2)
-        The flown path, densely sampled (every ~2 cm), m.
+        The flown path, densely sampled (every ~2 cm), m (with a target: the
+        delivered flight's).
     trajectory : Trajectory
         The flight at ``options.altitude``, 3-D: a retimed path (spline
-        patterns), straight legs (stop-and-go) or parts at rest between them.
+        patterns), straight legs (stop-and-go) or parts at rest between them;
+        with a target, ``delivered.trajectory``.
     coverage : float
-        Covered fraction of the region's area.
+        Covered fraction of the region's area (by ``path``).
     limits : dict
         The dense check of ``trajectory`` against :func:`coverage_limits`
         (see :func:`limits_report`) and ``joins``.
     planning_time : float
         Wall time of :func:`plan_coverage`, s.
     speed_plan : SpeedPlan or None
-        The LP's plan (spline patterns only).
+        The LP's plan (spline patterns only; with a target, of the planned
+        path before it was re-fitted).
+    delivered : DeliveredPath or None
+        With ``options.target``: the re-fit into the target's uploads.
+    planned_coverage : float or None
+        With a target: the coverage of the planned path before the re-fit.
     """
 
     region: Polygon
@@ -224,6 +241,8 @@ class CoveragePlan:
     limits: dict[str, Any]
     planning_time: float
     speed_plan: SpeedPlan | None
+    delivered: DeliveredPath | None = None
+    planned_coverage: float | None = None
 
     @property
     def duration(self) -> float:
@@ -242,6 +261,7 @@ class CoveragePlan:
     def summary(self) -> dict[str, Any]:
         """What ``summary.json`` holds (JSON-ready)."""
         lp = self.speed_plan
+        target = self.delivered
         return {
             "pattern": self.options.pattern,
             "duration_s": self.duration,
@@ -262,7 +282,11 @@ class CoveragePlan:
                 "iterations": lp.iterations,
                 "solve_time_s": lp.solve_time,
             },
-        }
+        } | (
+            {}
+            if target is None
+            else {"target": target.summary(), "planned_coverage_fraction": self.planned_coverage}
+        )
 
 
 def grid_points(length: float) -> int:
@@ -341,6 +365,10 @@ def plan_tuned(region: Polygon, options: CoverageOptions, target: float) -> Cove
         raise InputError(f"min_coverage: got {goal:g}, expected a fraction in (0, 1]")
     # Every trial is checked against the budget at the densest spacing tried.
     _check_region(region, replace(options, epsilon=min(TUNING_EPSILONS)))
+    if options.target is not None:
+        # Trials are compared as planned; only the winner is re-fitted for the target.
+        untargeted = plan_tuned(region, replace(options, target=None), goal)
+        return _for_target(untargeted, replace(untargeted.options, target=options.target))
     deltas = (options.delta,) if options.pattern == "zigzag-stop" else TUNING_DELTAS
     laps = (False,) if options.pattern == "spiral" else (False, True)
     candidates: list[CoverageOptions] = []
@@ -380,6 +408,8 @@ def _check_region(region: Polygon, options: CoverageOptions) -> None:
             f"{MAX_REGION_SIZE_M:g} m across (split it into several missions)"
         )
     check_width(region, options.width, options.epsilon)
+    if options.target is not None:
+        check_target_path(region, options.width, options.epsilon, options.target)
 
 
 def _plan_or_none(region: Polygon, options: CoverageOptions) -> CoveragePlan | None:
@@ -416,9 +446,16 @@ def plan_coverage(region: Polygon, options: CoverageOptions | None = None) -> Co
         The path cannot be timed within the limits. A concave region's
         spiral whose joins are too tight to time is flown part by part,
         resting at each join (``limits["joins"] == "stop"``) before that.
+        With ``options.target``: the re-fit needs more uploads than
+        :data:`~skyquill.optimize.budget.MAX_UPLOADS` (a path estimated longer
+        than :data:`~skyquill.coverage.target.MAX_TARGET_PATH_M` is an
+        :class:`InputError` before any work).
     """
-    start = time.perf_counter()
     opts = options or CoverageOptions()
+    if opts.target is not None:
+        _check_region(region, opts)
+        return _for_target(plan_coverage(region, replace(opts, target=None)), opts)
+    start = time.perf_counter()
     _check_region(region, opts)
     waypoints, path = covering_path(region, opts)
     try:
@@ -445,6 +482,26 @@ def plan_coverage(region: Polygon, options: CoverageOptions | None = None) -> Co
         limits=limits | {"joins": joins},
         planning_time=time.perf_counter() - start,
         speed_plan=speed_plan,
+    )
+
+
+def _for_target(plan: CoveragePlan, options: CoverageOptions) -> CoveragePlan:
+    """``plan`` re-fitted into ``options.target``'s uploads, its coverage measured again."""
+    assert options.target is not None  # only called with a target
+    start = time.perf_counter()
+    delivered = deliver(plan.path, options.limits, options.width, options.altitude, options.target)
+    # The refit holds the limits through the hull: a guaranteed check, unlike the LP's.
+    check = verify(delivered.trajectory, coverage_limits(options), guaranteed=True)
+    return replace(
+        plan,
+        options=options,
+        path=delivered.path,
+        trajectory=delivered.trajectory,
+        coverage=coverage_fraction(plan.region, delivered.path, options.width),
+        limits=limits_report(check) | {"joins": plan.limits["joins"]},
+        planning_time=plan.planning_time + time.perf_counter() - start,
+        delivered=delivered,
+        planned_coverage=plan.coverage,
     )
 
 

@@ -239,7 +239,7 @@ def check_width(region: Polygon, width: float, epsilon: float = 1.0) -> float:
         raise InputError(
             f"width: got {w:g} m on a region of {region.area:.4g} m², i.e. a path of about "
             f"{length / 1e3:.4g} km, expected at most {MAX_PATH_LENGTH_M / 1e3:g} km "
-            f"({_what_fits(region, epsilon)})"
+            f"({what_fits(region, epsilon)})"
         )
     if region.buffer(-0.5 * w).is_empty:
         minx, miny, maxx, maxy = region.bounds
@@ -250,9 +250,9 @@ def check_width(region: Polygon, width: float, epsilon: float = 1.0) -> float:
     return w
 
 
-def _what_fits(region: Polygon, epsilon: float) -> str:
-    """Which swath would fit the path budget, or that the region must be split."""
-    room = MAX_PATH_LENGTH_M - region.exterior.length
+def what_fits(region: Polygon, epsilon: float, budget_m: float = MAX_PATH_LENGTH_M) -> str:
+    """Which swath would fit a path of ``budget_m`` metres, or that the region must be split."""
+    room = budget_m - region.exterior.length
     if room <= 0.0:
         return "the perimeter alone is too long: split the region into several missions"
     least = region.area / (epsilon * room)

@@ -11,6 +11,11 @@ problem solved again; the factor used is reported, never hidden. A fit
 farther from the points than the tolerance is not a result: allocated timings
 are redone slower, then it is an :class:`~skyquill.errors.InfeasibleError`
 (unless ``best_effort``).
+
+With a ``target`` (a vehicle's upload budget) the fit is made of degree-7
+pieces, at most one upload's worth over the whole flight; if that misses the
+tolerance, allocated timings are cut into uploads flown rest to rest with a
+hover between them (:mod:`skyquill.optimize.budget`).
 """
 
 from __future__ import annotations
@@ -23,6 +28,7 @@ import numpy as np
 
 from skyquill.errors import InfeasibleError, InputError
 from skyquill.limits import DerivativeLimit, VehicleLimits
+from skyquill.optimize.budget import BudgetPlan, ChunkFit, one_upload, split_into_uploads
 from skyquill.optimize.problem import Boundary, PointDeviation, SmoothingProblem
 from skyquill.optimize.solve import FitResult, solve
 from skyquill.optimize.timing import (
@@ -32,7 +38,10 @@ from skyquill.optimize.timing import (
 )
 from skyquill.solvers import DEFAULT_BACKEND
 from skyquill.spline import HullKind
+from skyquill.targets import UploadTarget
+from skyquill.trajectory import Trajectory
 from skyquill.validation import FloatArray, as_array, as_float, as_int, strictly_increasing
+from skyquill.verify import Verification
 
 #: Most knot spans one fit may have: the QP has ``(spans + degree) * d``
 #: unknowns and a hull constraint block per span and limit; beyond this the
@@ -103,6 +112,11 @@ class FitOptions:
     best_effort
         Return a fit that misses the tolerance instead of raising
         :class:`~skyquill.errors.InfeasibleError` (as ``WritingOptions.best_effort``).
+    target
+        A vehicle's upload budget (:data:`skyquill.targets.TARGETS`), or ``None``.
+        With one, ``degree`` and ``knot_interval`` are the target's: pieces
+        of its highest degree, at most :attr:`~skyquill.targets.UploadTarget.max_pieces`
+        spread over the flight (or over each upload when the plan is split).
     """
 
     limits: VehicleLimits = field(default_factory=lambda: VehicleLimits(1.0, 2.0, 10.0))
@@ -118,6 +132,7 @@ class FitOptions:
     max_stretches: int = 10
     tolerance_m: float | None = None
     best_effort: bool = False
+    target: UploadTarget | None = None
 
     def __post_init__(self) -> None:
         if not isinstance(self.limits, VehicleLimits):
@@ -143,6 +158,9 @@ class FitOptions:
             as_float("tolerance_m", self.tolerance_m, positive=True)
         if not isinstance(self.best_effort, bool):
             raise InputError(f"best_effort: got {self.best_effort!r}, expected True or False")
+        if self.target is not None and not isinstance(self.target, UploadTarget):
+            name = type(self.target).__name__
+            raise InputError(f"target: got {name}, expected an UploadTarget or None")
 
 
 def default_tolerance(points: FloatArray, given_times: bool) -> float:
@@ -179,6 +197,12 @@ class PointFit:
         The fraction of ``amax`` the allocation used (``None`` with given
         times): ``options.allocation_accel_fraction``, halved up to
         :data:`MAX_SLOWDOWNS` times while the fit missed the tolerance.
+    budget
+        With ``options.target``: the plan cut into the target's uploads
+        (``None`` without). Split into several, ``result`` is the first
+        upload's engine result, ``times`` are on the whole plan's clock
+        (hovers included), ``time_scale`` is the largest and
+        ``accel_fraction`` the smallest over the uploads.
     """
 
     result: FitResult
@@ -189,6 +213,17 @@ class PointFit:
     rms_deviation_m: float
     max_deviation_m: float
     accel_fraction: float | None = None
+    budget: BudgetPlan | None = None
+
+    @property
+    def trajectory(self) -> Trajectory:
+        """What is flown: the engine's spline, or with a target the plan cut into uploads."""
+        return self.result.trajectory if self.budget is None else self.budget.trajectory
+
+    @property
+    def verification(self) -> Verification:
+        """The dense check of :attr:`trajectory` against :attr:`limits`."""
+        return self.result.verification if self.budget is None else self.budget.verification
 
 
 def fit_points(
@@ -216,6 +251,9 @@ def fit_points(
         The limits cannot be met within ``max_stretches``, or the fit is farther
         than the tolerance from the points (unless ``best_effort``); allocated
         timings are first redone slower (see ``PointFit.accel_fraction``).
+        With ``options.target``: timed points that one upload cannot hold
+        within the tolerance (the message says what would fit), or untimed
+        ones needing more than :data:`~skyquill.optimize.budget.MAX_UPLOADS`.
     """
     opts = options or FitOptions()
     pts = as_array("points", points, ndim=2, max_abs=MAX_COORDINATE_M)
@@ -227,35 +265,135 @@ def fit_points(
             "(resample the recording more coarsely)"
         )
     limits = opts.limits.derivative_limits(pts.shape[1], sides=opts.norm_sides)
+    if opts.target is not None:
+        # A piece of the highest degree the vehicle evaluates carries the most path.
+        opts = replace(opts, degree=opts.target.max_degree)
     if times is not None:
         t = as_array("times", times, shape=(pts.shape[0],), max_abs=1e7)
         strictly_increasing("times", t)
+        if opts.target is not None:
+            return _timed_for_target(pts, t - t[0], limits, opts, opts.target)
         fit = _fit_timed(pts, t - t[0], limits, opts)
         _check_fidelity(fit.max_deviation_m, pts, True, opts)
         return fit
+    if opts.target is not None:
+        return _allocated_for_target(pts, limits, opts, opts.target)
+    fit = _fit_allocated(pts, limits, opts, _tolerance(pts, False, opts))
+    _check_fidelity(fit.max_deviation_m, pts, False, opts)
+    return fit
+
+
+def _fit_allocated(
+    pts: FloatArray,
+    limits: tuple[DerivativeLimit, ...],
+    opts: FitOptions,
+    tolerance: float,
+    spans: int | None = None,
+) -> PointFit:
+    """Fit at allocated times, redone slower while farther than ``tolerance`` from ``pts``."""
     # The allocation knows nothing of jerk: when the fit cuts the turns, allocate
     # again with half the acceleration (slower turns), reported in the result.
     vmax, amax = opts.limits.timing_bounds()
     allocate = allocate_path_times if opts.timing == "path" else allocate_segment_times
     fraction = opts.allocation_accel_fraction
     for slowdown in range(MAX_SLOWDOWNS + 1):
-        fit = _fit_timed(pts, allocate(pts, vmax, fraction * amax), limits, opts)
+        fit = _fit_timed(pts, allocate(pts, vmax, fraction * amax), limits, opts, spans)
         fit = replace(fit, accel_fraction=fraction)
-        if fit.max_deviation_m <= _tolerance(pts, False, opts) or slowdown == MAX_SLOWDOWNS:
+        if fit.max_deviation_m <= tolerance or slowdown == MAX_SLOWDOWNS:
             break
         fraction *= 0.5
-    _check_fidelity(fit.max_deviation_m, pts, False, opts)
     return fit
 
 
-def _fit_timed(
-    pts: FloatArray, t: FloatArray, limits: tuple[DerivativeLimit, ...], opts: FitOptions
+def _allocated_for_target(
+    pts: FloatArray, limits: tuple[DerivativeLimit, ...], opts: FitOptions, target: UploadTarget
 ) -> PointFit:
-    """Fit at times ``t`` (N,), stretched by ``stretch_factor`` while infeasible."""
+    """One upload if it is within the tolerance, else rest-to-rest uploads with hovers."""
+    plan = _split_plan(pts, limits, opts, target)
+    fractions = [c.accel_fraction for c in plan.chunks if c.accel_fraction is not None]
+    return _budget_fit(
+        plan, pts, limits, max(c.time_scale for c in plan.chunks), min(fractions, default=None)
+    )
+
+
+def _split_plan(
+    pts: FloatArray, limits: tuple[DerivativeLimit, ...], opts: FitOptions, target: UploadTarget
+) -> BudgetPlan:
+    tolerance = _tolerance(pts, False, opts)
+
+    def fit_chunk(chunk: FloatArray) -> ChunkFit:
+        fit = _fit_allocated(chunk, limits, opts, tolerance, target.max_pieces)
+        return ChunkFit(
+            fit.result, fit.times, fit.max_deviation_m, fit.time_scale, fit.accel_fraction
+        )
+
+    return split_into_uploads(pts, fit_chunk, tolerance, target, limits)
+
+
+def _timed_for_target(
+    pts: FloatArray,
+    t: FloatArray,
+    limits: tuple[DerivativeLimit, ...],
+    opts: FitOptions,
+    target: UploadTarget,
+) -> PointFit:
+    """One upload at the caller's times; refused (with what would fit) beyond the tolerance."""
+    fit = _fit_timed(pts, t, limits, opts, target.max_pieces)
+    tolerance = _tolerance(pts, True, opts)
+    if fit.max_deviation_m > tolerance and not opts.best_effort:
+        # Splitting would insert rests and hovers into the caller's clock: say what would fit.
+        try:
+            uploads = len(_split_plan(pts, limits, opts, target).uploads)
+            instead = f"the points without their times ({uploads} upload{'s' * (uploads > 1)})"
+        except InfeasibleError:
+            instead = "fewer points (the points without their times need too many uploads)"
+        raise InfeasibleError(
+            f"tolerance_m: one {target.name} upload ({target.max_pieces} pieces) at the given "
+            f"times is {fit.max_deviation_m * 1e3:.4g} mm from the points at most, expected at "
+            f"most {tolerance * 1e3:.4g} mm; more uploads would change the given timing. "
+            f"A tolerance_m of {fit.max_deviation_m:.4g} m, or {instead} would fit",
+            ("fidelity", "target"),
+        )
+    chunk = ChunkFit(fit.result, fit.times, fit.max_deviation_m, fit.time_scale)
+    return replace(fit, budget=one_upload(chunk, target, limits))
+
+
+def _budget_fit(
+    plan: BudgetPlan,
+    pts: FloatArray,
+    limits: tuple[DerivativeLimit, ...],
+    time_scale: float,
+    accel_fraction: float | None,
+) -> PointFit:
+    err = np.linalg.norm(plan.trajectory.evaluate(plan.times) - pts, axis=1)
+    return PointFit(
+        plan.chunks[0].result,
+        pts,
+        plan.times,
+        time_scale,
+        limits,
+        float(np.sqrt(np.mean(err**2))),
+        float(err.max()),
+        accel_fraction,
+        plan,
+    )
+
+
+def _fit_timed(
+    pts: FloatArray,
+    t: FloatArray,
+    limits: tuple[DerivativeLimit, ...],
+    opts: FitOptions,
+    spans: int | None = None,
+) -> PointFit:
+    """Fit at times ``t`` (N,), stretched by ``stretch_factor`` while infeasible.
+
+    ``spans``: the number of knot spans (else one per ``knot_interval``).
+    """
     scale = 1.0
     for attempt in range(opts.max_stretches + 1):
         try:
-            result = solve(_problem(pts, t * scale, limits, opts), opts.solver)
+            result = solve(_problem(pts, t * scale, limits, opts, spans), opts.solver)
             break
         except InfeasibleError:
             if attempt == opts.max_stretches:
@@ -290,10 +428,14 @@ def _check_fidelity(max_dev: float, pts: FloatArray, given: bool, opts: FitOptio
 
 
 def _problem(
-    pts: FloatArray, t: FloatArray, limits: tuple[DerivativeLimit, ...], opts: FitOptions
+    pts: FloatArray,
+    t: FloatArray,
+    limits: tuple[DerivativeLimit, ...],
+    opts: FitOptions,
+    spans: int | None = None,
 ) -> SmoothingProblem:
     duration = float(t[-1])
-    n_spans = max(1, math.ceil(duration / opts.knot_interval))
+    n_spans = spans or max(1, math.ceil(duration / opts.knot_interval))
     if n_spans > MAX_SPANS:
         raise InputError(
             f"knot_interval: got {opts.knot_interval:g} s for a {duration:.6g} s plan, i.e. "

@@ -29,7 +29,7 @@ def plot_fit(fit: PointFit, path: str | Path, title: str = "") -> None:
     title
         Figure title.
     """
-    traj = fit.result.trajectory
+    traj = fit.trajectory
     t = np.linspace(0.0, traj.duration, 2000)
     fig, ax = plt.subplots(2, 2, figsize=(11, 8), layout="constrained")
     p = traj.evaluate(t)
@@ -47,7 +47,7 @@ def plot_fit(fit: PointFit, path: str | Path, title: str = "") -> None:
         name = {1: "velocity", 2: "acceleration", 3: "jerk"}[order]
         panel.set(xlabel="t [s]", ylabel=f"{name} [{unit}]", title=name)
         panel.legend(loc="upper right", fontsize=8)
-    check = fit.result.verification
+    check = fit.verification
     fig.suptitle(
         f"{title}  duration {traj.duration:.2f} s, max excess {check.max_excess:.1e}, "
         f"rms deviation {1e3 * fit.rms_deviation_m:.1f} mm"
