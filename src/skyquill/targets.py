@@ -20,6 +20,7 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 from dataclasses import dataclass
+from typing import Any, Literal
 
 import numpy as np
 
@@ -71,6 +72,9 @@ class UploadTarget:
 CRAZYFLIE = UploadTarget("crazyflie", 4096, 132, 7, 1.0)
 #: ``--target`` choices.
 TARGETS: dict[str, UploadTarget] = {CRAZYFLIE.name: CRAZYFLIE}
+#: How a plan was made to fit: one upload over the whole flight, or several
+#: flown rest to rest with a hover between them.
+Strategy = Literal["one-upload", "split"]
 
 
 @dataclass(frozen=True)
@@ -95,6 +99,29 @@ class Upload:
     parts: tuple[Trajectory, ...]
     pieces: int
     hover_before_s: float
+
+
+def uploads_summary(
+    target: UploadTarget, strategy: Strategy, uploads: tuple[Upload, ...]
+) -> dict[str, Any]:
+    """The ``"target"`` section of a planning command's ``summary.json`` (s, pieces, B)."""
+    return {
+        "name": target.name,
+        "strategy": strategy,
+        "max_pieces_per_upload": target.max_pieces,
+        "hover_s": target.hover_s,
+        "pieces": sum(u.pieces for u in uploads),
+        "uploads": [
+            {
+                "pieces": u.pieces,
+                "bytes": u.pieces * target.bytes_per_piece,
+                "start_s": u.start_s,
+                "end_s": u.end_s,
+                "hover_before_s": u.hover_before_s,
+            }
+            for u in uploads
+        ],
+    }
 
 
 def hover(position: FloatArray, duration: float) -> SplineTrajectory:

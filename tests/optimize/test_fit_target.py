@@ -20,7 +20,7 @@ EXAMPLES = Path(__file__).parents[2] / "examples"
 def test_the_spiral_fits_one_upload_at_the_default_tolerance() -> None:
     points, _ = read_points_csv(EXAMPLES / "spiral.csv")
     fit = fit_points(points, None, FitOptions(target=CRAZYFLIE))
-    assert fit.budget is not None and fit.budget.strategy == "one upload"
+    assert fit.budget is not None and fit.budget.strategy == "one-upload"
     traj = fit.trajectory
     assert isinstance(traj, SplineTrajectory) and traj.degree == 7
     (upload,) = plan_uploads(traj, CRAZYFLIE)

@@ -35,7 +35,6 @@ from skyquill.calligraphy.mission import (
     Mission,
     RoutePlan,
     RouteSamples,
-    TargetStrategy,
     WritingOptions,
     measure_deviation,
     plan_route,
@@ -43,7 +42,14 @@ from skyquill.calligraphy.mission import (
 )
 from skyquill.errors import InfeasibleError
 from skyquill.optimize.timing import allocate_path_times
-from skyquill.targets import Upload, UploadTarget, hover, plan_uploads
+from skyquill.targets import (
+    Strategy,
+    Upload,
+    UploadTarget,
+    hover,
+    plan_uploads,
+    uploads_summary,
+)
 from skyquill.trajectory import RestToRestSequence, Trajectory
 from skyquill.validation import FloatArray
 
@@ -68,26 +74,12 @@ class TargetPlan:
     """
 
     target: UploadTarget
-    strategy: TargetStrategy
+    strategy: Strategy
     uploads: tuple[Upload, ...]
 
     def as_dict(self) -> dict[str, Any]:
         """``summary.json`` form (s, pieces, B)."""
-        return {
-            "name": self.target.name,
-            "strategy": self.strategy,
-            "pieces": sum(u.pieces for u in self.uploads),
-            "uploads": [
-                {
-                    "pieces": u.pieces,
-                    "bytes": u.pieces * self.target.bytes_per_piece,
-                    "start_s": u.start_s,
-                    "end_s": u.end_s,
-                    "hover_before_s": u.hover_before_s,
-                }
-                for u in self.uploads
-            ],
-        }
+        return uploads_summary(self.target, self.strategy, self.uploads)
 
 
 @dataclass(frozen=True)
@@ -273,7 +265,7 @@ def _mission(
     uploads = plan_uploads(trajectory, opts.target)  # the contract: raises if it does not fit
     strokes = samples.strokes_world
     # A split into one group would be the whole route again: it is tried as one upload.
-    strategy: TargetStrategy = "one-upload" if len(plans) == 1 else "split"
+    strategy: Strategy = "one-upload" if len(plans) == 1 else "split"
     brush = opts.brush_length_m if any(p.compensated for p in plans) else 0.0
     deviation = measure_deviation(trajectory, windows, strokes, brush)
     return Mission(

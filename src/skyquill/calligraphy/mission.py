@@ -47,6 +47,7 @@ from skyquill.optimize.solve import FitResult
 from skyquill.optimize.timing import allocate_path_times
 from skyquill.strokes import Strokes, turning_points
 from skyquill.strokes.model import MAX_STROKES
+from skyquill.targets import Strategy as TargetStrategy
 from skyquill.targets import UploadTarget
 from skyquill.trajectory import RestToRestSequence, SplineTrajectory, Trajectory
 from skyquill.validation import FloatArray, as_array, as_float, as_int
@@ -81,7 +82,6 @@ MAX_SPANS = 20_000
 TILT_PASSES = 3
 GRAVITY = 9.81  # m/s^2
 #: The ways to fit a vehicle's upload budget (:mod:`skyquill.calligraphy.budget`).
-TargetStrategy = Literal["one-upload", "split"]
 TARGET_STRATEGIES: tuple[TargetStrategy, ...] = ("one-upload", "split")
 
 

@@ -20,14 +20,14 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any, Literal
+from typing import Any
 
 import numpy as np
 
 from skyquill.errors import InfeasibleError
 from skyquill.limits import DerivativeLimit
 from skyquill.optimize.solve import FitResult
-from skyquill.targets import Upload, UploadTarget, hover, plan_uploads
+from skyquill.targets import Strategy, Upload, UploadTarget, hover, plan_uploads, uploads_summary
 from skyquill.trajectory import RestToRestSequence, SplineTrajectory, Trajectory
 from skyquill.validation import FloatArray
 from skyquill.verify import Verification, verify
@@ -40,8 +40,6 @@ MAX_UPLOADS = 50
 #: The split point of a chunk is looked for between these fractions of its arc length
 #: (the middle third: both halves keep a fair share of the path).
 SPLIT_WINDOW = (1.0 / 3.0, 2.0 / 3.0)
-
-Strategy = Literal["one upload", "split"]
 
 
 @dataclass(frozen=True)
@@ -82,7 +80,7 @@ class BudgetPlan:
     target
         The vehicle the plan is made for.
     strategy
-        ``"one upload"`` (one spline over the whole flight) or ``"split"``
+        ``"one-upload"`` (one spline over the whole flight) or ``"split"``
         (chunks flown rest to rest, hovering between them).
     trajectory
         The plan: a :class:`~skyquill.trajectory.SplineTrajectory` of at most
@@ -114,29 +112,14 @@ class BudgetPlan:
 
     def summary(self) -> dict[str, Any]:
         """The ``"target"`` section of a ``summary.json`` (SI units)."""
-        return {
-            "name": self.target.name,
-            "strategy": self.strategy,
-            "max_pieces_per_upload": self.target.max_pieces,
-            "hover_s": self.target.hover_s,
-            "uploads": [
-                {
-                    "pieces": u.pieces,
-                    "bytes": u.pieces * self.target.bytes_per_piece,
-                    "start_s": u.start_s,
-                    "end_s": u.end_s,
-                    "hover_before_s": u.hover_before_s,
-                }
-                for u in self.uploads
-            ],
-        }
+        return uploads_summary(self.target, self.strategy, self.uploads)
 
 
 def one_upload(
     chunk: ChunkFit, target: UploadTarget, limits: tuple[DerivativeLimit, ...]
 ) -> BudgetPlan:
     """The plan of a fit made in one upload (``chunk`` holds every point)."""
-    return _plan(target, "one upload", (chunk,), (0, chunk.times.size - 1), limits)
+    return _plan(target, "one-upload", (chunk,), (0, chunk.times.size - 1), limits)
 
 
 def split_into_uploads(
@@ -178,7 +161,7 @@ def split_into_uploads(
     firsts = sorted(done)
     bounds = (*firsts, points.shape[0] - 1)
     chunks = tuple(done[f][1] for f in firsts)
-    strategy: Strategy = "split" if len(chunks) > 1 else "one upload"
+    strategy: Strategy = "split" if len(chunks) > 1 else "one-upload"
     return _plan(target, strategy, chunks, bounds, limits)
 
 
