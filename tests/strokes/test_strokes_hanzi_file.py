@@ -78,7 +78,7 @@ def test_a_directory_or_nothing_is_refused(tmp_path: Path) -> None:
 def test_not_json_is_refused(tmp_path: Path) -> None:
     p = tmp_path / "永.json"
     p.write_text("<svg/>", encoding="utf-8")
-    with pytest.raises(InputError, match="永.json"):
+    with pytest.raises(InputError, match=r"永\.json"):
         hanzi_file(p)
 
 

@@ -125,7 +125,7 @@ def test_shapes_outside_layers_form_one_unnamed_layer(tmp_path: Path) -> None:
 
 
 def test_only_plotter_skipped_layers_is_refused(tmp_path: Path) -> None:
-    body = VPYPE.split('<g fill="none" id="layer1"')[0] + "</svg>"
+    body = VPYPE.split('<g fill="none" id="layer1"', maxsplit=1)[0] + "</svg>"
     with pytest.raises(InputError, match=r"d.svg: no path or shape found .*% layers"):
         load_svg(_write(tmp_path, body))
 

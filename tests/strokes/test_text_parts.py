@@ -44,7 +44,7 @@ def test_narrow_word_stays_narrow() -> None:
     cap = 0.5 * 21.0 / (_ink(typed_strokes("mmmm"))[1][0] - 0.0)  # cap height, m
     assert hi[1] - lo[1] == pytest.approx(cap, rel=1e-9)
     assert (bottom, top) == (-7.0, 21.0)
-    w_lo, w_hi = _ink(wide)
+    _, w_hi = _ink(wide)
     assert w_hi[0] == pytest.approx(0.5)  # the widest part fills its board
 
 
