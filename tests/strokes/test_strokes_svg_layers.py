@@ -124,6 +124,19 @@ def test_shapes_outside_layers_form_one_unnamed_layer(tmp_path: Path) -> None:
     np.testing.assert_allclose(_extent(layers[0].paths[0]), [2 * 0.0254, 0.0], atol=1e-15)
 
 
+def test_merge_keeps_document_order_around_groups(tmp_path: Path) -> None:
+    body = (
+        '<svg xmlns="http://www.w3.org/2000/svg">'
+        '<path d="M 0 0 L 1 0"/><g id="g"><path d="M 0 1 L 2 1"/></g><path d="M 0 2 L 3 2"/>'
+        "</svg>"
+    )
+    p = _write(tmp_path, body)
+    assert [float(np.ptp(s[:, 0])) for s in load_svg(p).paths] == [1.0, 2.0, 3.0]
+    layers = load_svg_layers(p)
+    assert [s.source for s in layers] == ["d.svg layer ''", "d.svg layer 'g'"]
+    assert [float(np.ptp(s[:, 0])) for s in layers[0].paths] == [1.0, 3.0]
+
+
 def test_only_plotter_skipped_layers_is_refused(tmp_path: Path) -> None:
     body = VPYPE.split('<g fill="none" id="layer1"', maxsplit=1)[0] + "</svg>"
     with pytest.raises(InputError, match=r"d.svg: no path or shape found .*% layers"):

@@ -110,8 +110,8 @@ def load_svg(
     zero-length segments) is skipped and logged: it would be a stroke of one
     repeated point, which :class:`Strokes` refuses.
     """
-    layers = _read_layers(Path(path), tolerance, true_size)
-    strokes = tuple(stroke for _, layer in layers for stroke in layer)
+    parts = _read_parts(Path(path), tolerance, true_size)
+    strokes = tuple(stroke for _, _, part in parts for stroke in part)
     return Strokes(paths=strokes, source=Path(path).name)
 
 
@@ -144,19 +144,27 @@ def load_svg_layers(
         As :func:`load_svg`.
     """
     p = Path(path)
-    layers = _read_layers(p, tolerance, true_size)
-    stacked = np.concatenate([s for _, layer in layers for s in layer], axis=0)
+    parts = _read_parts(p, tolerance, true_size)
+    stacked = np.concatenate([s for _, _, part in parts for s in part], axis=0)
     box = np.stack([stacked.min(axis=0), stacked.max(axis=0)])
+    layers: dict[int, tuple[str, list[FloatArray]]] = {}
+    for key, name, part in parts:  # the shapes outside every layer (key -1) join up
+        layers.setdefault(key, (name, []))[1].extend(part)
     return [
         Strokes(paths=tuple(layer), source=f"{p.name} layer {name!r}", box=box)
-        for name, layer in layers
+        for name, layer in layers.values()
     ]
 
 
-def _read_layers(
+def _read_parts(
     p: Path, tolerance: float | None, true_size: bool
-) -> list[tuple[str, list[FloatArray]]]:
-    """The drawn layers' strokes (y up; metres with ``true_size``), empty layers left out."""
+) -> list[tuple[int, str, list[FloatArray]]]:
+    """Strokes (y up; metres with ``true_size``) by top-level element, in document order.
+
+    Each entry is ``(layer key, layer name, strokes)`` of one top-level element
+    with something to draw: a layer's key is its index, a shape outside every
+    layer has key -1 and name ``""``.
+    """
     if not p.is_file():
         raise InputError(f"{p}: no such file, expected an SVG file")
     size = p.stat().st_size
@@ -164,15 +172,15 @@ def _read_layers(
         raise InputError(f"{p}: got {size:,} bytes, expected an SVG file of at most {MAX_BYTES:,}")
     try:
         svg = se.SVG.parse(str(p), ppi=PPI)
-        grouped = _drawn_layers(svg)
+        grouped = _drawn_parts(svg)
     except Exception as exc:  # svgelements lets XML, value, recursion and I/O errors through
         raise InputError(f"{p}: cannot be parsed as SVG ({exc}), expected an SVG file") from None
     metres = _metres_per_px(p, svg) if true_size else 1.0
-    elements = [e for _, layer in grouped for e in layer]
+    elements = [e for _, _, part in grouped for e in part]
     for i, element in enumerate(elements):
         _check_data(p, i, element)
-    layers = [(name, _reified(layer)) for name, layer in grouped]
-    shapes = [s for _, layer in layers for s in layer]
+    parts = [(key, name, _reified(part)) for key, name, part in grouped]
+    shapes = [s for _, _, part in parts for s in part]
     if len(shapes) > MAX_STROKES:
         raise InputError(
             f"{p}: got {len(shapes):,} drawn shapes, expected at most {MAX_STROKES:,} strokes"
@@ -186,11 +194,11 @@ def _read_layers(
     if not (math.isfinite(tol) and tol > 0.0):
         raise InputError(f"tolerance: got {tol:g}, expected a finite number > 0")
     budget = _Budget(p)
-    out: list[tuple[str, list[FloatArray]]] = []
-    for name, layer in layers:
-        strokes = _flattened(p, layer, tol, budget, first=sum(len(s) for _, s in out))
+    out: list[tuple[int, str, list[FloatArray]]] = []
+    for key, name, part in parts:
+        strokes = _flattened(p, part, tol, budget, first=sum(len(s) for _, _, s in out))
         if strokes:
-            out.append((name, [s * metres for s in strokes]))
+            out.append((key, name, [s * metres for s in strokes]))
     if not out:
         raise InputError(
             f"{p}: every subpath is a single point, expected at least one path of non-zero length"
@@ -232,16 +240,16 @@ def _flattened(
     return strokes
 
 
-def _drawn_layers(svg: Any) -> list[tuple[str, list[Any]]]:
-    """The shapes of each top-level layer a plotter draws, in document order.
+def _drawn_parts(svg: Any) -> list[tuple[int, str, list[Any]]]:
+    """The shapes a plotter draws by top-level element, in document order.
 
-    Walks the tree with an explicit stack: a deeply nested file must not hit
-    Python's recursion limit here.
+    Layers are the top-level groups; a shape outside them is an entry of its
+    own (key -1), so that merging keeps the document's order.
     """
-    layers: dict[int, tuple[str, list[Any]]] = {}
+    parts: list[tuple[int, str, list[Any]]] = []
     for index, child in enumerate(svg):
         if isinstance(child, se.Shape):
-            layers.setdefault(-1, ("", []))[1].append(child)  # outside every layer
+            parts.append((-1, "", [child]))
             continue
         if not isinstance(child, se.Group | se.Use):
             continue
@@ -251,11 +259,16 @@ def _drawn_layers(svg: Any) -> list[tuple[str, list[Any]]]:
             logger.info("left out layer %r: a plotter does not draw %s layers", label, "%")
             continue
         name = label or attributes.get("id") or f"group {index + 1}"
-        layers[index] = (str(name), _shapes_under(child))
-    return [layer for layer in layers.values() if layer[1]]
+        parts.append((index, str(name), _shapes_under(child)))
+    return [part for part in parts if part[2]]
 
 
 def _shapes_under(group: Any) -> list[Any]:
+    """Every shape inside ``group``, in document order.
+
+    Walks the tree with an explicit stack: a deeply nested file must not hit
+    Python's recursion limit here.
+    """
     shapes: list[Any] = []
     stack = list(reversed(group))
     while stack:
