@@ -218,3 +218,13 @@ def test_hostile_sizes_and_labels_give_input_error_or_strokes(
             continue
         drawn = 1 if label.startswith("%") else 2
         assert sum(s.n_strokes for s in layers) == drawn
+
+
+@pytest.mark.parametrize("hidden", ['display="none"', 'style="display: none ;stroke:red"'])
+def test_hidden_groups_in_either_spelling_are_left_out(tmp_path: Path, hidden: str) -> None:
+    body = (
+        f'<svg xmlns="http://www.w3.org/2000/svg"><g {hidden}><path d="M 0 0 L 1 1"/></g>'
+        '<path d="M 0 0 L 2 1"/></svg>'
+    )
+    (s,) = load_svg_layers(_write(tmp_path, body))
+    np.testing.assert_array_equal(s.paths[0], [[0.0, 0.0], [2.0, -1.0]])
