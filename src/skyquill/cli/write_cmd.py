@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Annotated, Any
@@ -39,25 +40,76 @@ from skyquill.limits import VehicleLimits
 def load_input(
     text: str | None, strokes: Path | None, svg: Path | None, hanzi: Path | None, font: str
 ) -> Any:
-    """The single input as :class:`~skyquill.strokes.Strokes` (imported lazily)."""
-    from skyquill.strokes import load_stroke_json, load_svg, typed_strokes
+    """The single input as :class:`~skyquill.strokes.Strokes` (imported lazily).
+
+    ``--hanzi FILE`` without TEXT writes that one character's file (``永.json``).
+    """
+    (part,) = load_parts(text, strokes, svg, hanzi, font)
+    return part
+
+
+def load_parts(
+    text: str | None,
+    strokes: Path | None,
+    svg: Path | None,
+    hanzi: Path | None,
+    font: str,
+    *,
+    true_size: bool = False,
+    layers: str = "merge",
+) -> list[Any]:
+    """The input as one :class:`~skyquill.strokes.Strokes` per drone (one, or an SVG's layers)."""
+    from skyquill.strokes import (
+        hanzi_file,
+        load_stroke_json,
+        load_svg,
+        load_svg_layers,
+        typed_strokes,
+    )
 
     given = [
         name
         for name, v in (("TEXT", text), ("--strokes", strokes), ("--svg", svg))
         if v is not None
     ]
+    if hanzi is not None and not given:
+        given = ["--hanzi"]  # one character's hanzi-writer-data file, named after it
     if len(given) != 1:
         raise InputError(
             f"input: got {', '.join(given) or 'nothing'}, expected exactly one of TEXT, "
-            "--strokes FILE or --svg FILE"
+            "--strokes FILE or --svg FILE (or --hanzi CHAR.json alone)"
         )
-    if strokes is not None:
-        return load_stroke_json(strokes)
+    if hanzi is not None and given[0] not in ("TEXT", "--hanzi"):
+        raise InputError(f"--hanzi: got it with {given[0]}, expected TEXT or no other input")
+    if layers not in ("merge", "keep"):
+        raise InputError(f"--layers: got {layers!r}, expected merge or keep")
+    if svg is None and (true_size or layers != "merge"):
+        flag = "--true-size" if true_size else "--layers"
+        raise InputError(f"{flag}: got it with {given[0]}, expected --svg FILE")
     if svg is not None:
-        return load_svg(svg)
-    assert text is not None
-    return typed_strokes(text, font, hanzi)
+        if layers == "keep":
+            return load_svg_layers(svg, true_size=true_size)
+        return [load_svg(svg, true_size=true_size)]
+    if strokes is not None:
+        return [load_stroke_json(strokes)]
+    if text is None:
+        assert hanzi is not None
+        return [hanzi_file(hanzi)]
+    return [typed_strokes(text, font, hanzi)]
+
+
+def true_size_m(parts: Sequence[Any]) -> float:
+    """The larger side of the drawing in metres (``--true-size``), checked against the range."""
+    from skyquill.calligraphy.mission import SIZE_RANGE_M
+
+    extent = max(float(np.max(hi - lo)) for lo, hi in (p.bounds() for p in parts))
+    low, high = SIZE_RANGE_M
+    if not low <= extent <= high:
+        raise InputError(
+            f"--true-size: got a drawing of {extent:g} m, expected {low:g} to {high:g} m "
+            "(check the SVG's width and height)"
+        )
+    return extent
 
 
 @app.command()
@@ -66,8 +118,15 @@ def write(
     text: Annotated[str | None, typer.Argument(help="Text to write (Latin or Chinese).")] = None,
     strokes: Annotated[Path | None, typer.Option(help='Stroke JSON {"strokes": [...]}')] = None,
     svg: Annotated[Path | None, typer.Option(help="SVG file: every path is a stroke.")] = None,
+    true_size: Annotated[
+        bool, typer.Option(help="SVG: its width/height on paper, not --size.")
+    ] = False,
+    layers: Annotated[
+        str, typer.Option(help="SVG layers: merge (one drawing) or keep (a drone each).")
+    ] = "merge",
     hanzi: Annotated[
-        Path | None, typer.Option(help="hanzi-writer-data JSON file or directory.")
+        Path | None,
+        typer.Option(help="hanzi-writer-data JSON file or directory; CHAR.json alone writes CHAR."),
     ] = None,
     font: Annotated[str, typer.Option(help="Hershey font for Latin text.")] = "futural",
     size: Annotated[float, typer.Option(help="Larger side of each drone's writing, m.")] = 0.5,
@@ -100,7 +159,7 @@ def write(
     """Plan pen-up / pen-down writing flights; write CSVs, input_strokes.json, plot, summary."""
     from skyquill.calligraphy.mission import WritingOptions
     from skyquill.calligraphy.show import plan_show
-    from skyquill.strokes import split_text, typed_strokes
+    from skyquill.strokes import typed_parts
 
     with user_errors():
         check_out(out)
@@ -118,9 +177,12 @@ def write(
         if drones != 1:
             if text is None or strokes is not None or svg is not None:
                 raise InputError("--drones: several drones need TEXT to share out, got a file")
-            parts = [typed_strokes(p, font, hanzi) for p in split_text(text, drones)]
+            # One scale for the whole line: each drone's part keeps its size in it.
+            parts = typed_parts(text, drones, font, hanzi)
         else:
-            parts = [load_input(text, strokes, svg, hanzi, font)]
+            parts = load_parts(text, strokes, svg, hanzi, font, true_size=true_size, layers=layers)
+        if true_size:
+            options = dataclasses.replace(options, size_m=true_size_m(parts))
         with console.status(f"planning {len(parts)} writing flight(s)"):
             show = plan_show(
                 parts,

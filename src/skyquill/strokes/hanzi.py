@@ -32,6 +32,10 @@ HANZI_DIR_ENV = "SKYQUILL_HANZI_DIR"
 #: Side of the em box the medians are given in, and the default advance of
 #: :func:`hanzi_text`.
 EM = 1024.0
+#: Bottom and top of the em box, y up: the box of one character is
+#: ``[[0, EM_BOTTOM], [EM, EM_TOP]]``.
+EM_BOTTOM = -124.0
+EM_TOP = EM_BOTTOM + EM
 
 _BUNDLE = "hanzi_medians.json"
 
@@ -147,6 +151,61 @@ def hanzi_strokes(char: str, source: str | Path | None = None) -> Strokes:
             "expected a list of strokes"
         )
     return Strokes(paths=tuple(medians), source=f"hanzi {char}")
+
+
+def hanzi_file(path: str | Path) -> Strokes:
+    """Strokes of the character of one ``hanzi-writer-data`` file, named by its file.
+
+    The package ships one JSON per character, named after it (``永.json``),
+    holding ``{"strokes": [SVG outlines], "medians": [[[x, y], ...], ...]}``
+    (and sometimes ``"radStrokes"``): the file alone says what to write.
+
+    Parameters
+    ----------
+    path
+        The file; its name without ``.json`` is the character.
+
+    Returns
+    -------
+    Strokes
+        As :func:`hanzi_strokes`: one stroke per median, em-box units, y up.
+
+    Raises
+    ------
+    InputError
+        If ``path`` is not a file (a directory needs the text to write), its
+        name is not one character, it is not JSON, it is not an object with a
+        ``"medians"`` list, or ``"strokes"`` and ``"medians"`` differ in length.
+    """
+    p = Path(path)
+    if not p.is_file():
+        what = "a directory" if p.is_dir() else "no such file"
+        raise InputError(
+            f"hanzi file {p}: got {what}, expected one character's hanzi-writer-data file "
+            "such as 永.json (give the text to write to pick from a directory)"
+        )
+    char = p.name.removesuffix(".json")
+    if len(char) != 1:
+        raise InputError(
+            f"hanzi file {p}: got the name {char!r}, expected a file named after its one "
+            "character, such as 永.json"
+        )
+    data = read_json(p, f"hanzi-writer data for {char!r}")
+    if not isinstance(data, dict) or not isinstance(data.get("medians"), list):
+        got = f"a JSON {type(data).__name__}" + (
+            f" with keys {sorted(data)[:5]}" if isinstance(data, dict) else ""
+        )
+        raise InputError(
+            f'hanzi file {p}: got {got}, expected an object with a "medians" list '
+            "(one character's hanzi-writer-data file)"
+        )
+    outlines = data.get("strokes")
+    if isinstance(outlines, list) and len(outlines) != len(data["medians"]):
+        raise InputError(
+            f'hanzi file {p}: got {len(outlines)} "strokes" and {len(data["medians"])} '
+            '"medians", expected one median per stroke'
+        )
+    return Strokes(paths=tuple(data["medians"]), source=f"hanzi {char}")
 
 
 def hanzi_text(text: str, source: str | Path | None = None, *, advance: float = EM) -> Strokes:

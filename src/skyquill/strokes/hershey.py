@@ -34,6 +34,30 @@ def _load(font: str) -> HersheyFonts:
     return hf
 
 
+def line_extent(font: str = "futural") -> tuple[float, float]:
+    """The bottom and top of a line of text, font units, y up from the baseline.
+
+    Parameters
+    ----------
+    font
+        A name from :func:`hershey_fonts`.
+
+    Returns
+    -------
+    bottom, top
+        The descender line (negative) and the cap line, in the units and frame
+        of :func:`text_strokes` (``-7`` and ``21`` for the standard fonts).
+
+    Raises
+    ------
+    InputError
+        If ``font`` is unknown.
+    """
+    opts = _load(font).render_options
+    base = float(opts["base_line"])
+    return base - float(opts["bottom_line"]), base - float(opts["cap_line"])
+
+
 def _polylines(segments: list[tuple[tuple[float, float], tuple[float, float]]]) -> list[list[Any]]:
     """Join consecutive segments sharing an endpoint into polylines."""
     lines: list[list[Any]] = []

@@ -49,6 +49,13 @@ class Strokes:
     source
         Where the strokes came from, for messages and plots (for example
         ``"text 'Hi' (futural)"``, ``"hanzi 永"``, ``"drawing.svg"``).
+    box
+        Optional ``(2, 2)`` layout box ``[[x_lo, y_lo], [x_hi, y_hi]]``, source
+        units: the area the drawing is laid out in (the character cells of a
+        line shared between drones, the whole drawing of one SVG layer).
+        :meth:`bounds` and :meth:`scaled` then fit this box, grown to every
+        point, instead of the ink alone, so that parts laid out together keep
+        one scale and their places.
 
     Raises
     ------
@@ -56,12 +63,14 @@ class Strokes:
         If there is no stroke, a stroke has fewer than 2 points, a NaN or
         infinite coordinate, coordinates of magnitude above ``1e12``, or all its
         points equal; or if ``times`` does not match ``paths`` in lengths or is
-        not strictly increasing.
+        not strictly increasing; or if ``box`` is not a finite ``(2, 2)`` array
+        with ``x_lo <= x_hi`` and ``y_lo <= y_hi``.
     """
 
     paths: tuple[FloatArray, ...]
     times: tuple[FloatArray, ...] | None = None
     source: str = ""
+    box: FloatArray | None = None
 
     def __post_init__(self) -> None:
         label = f"strokes from {self.source}" if self.source else "strokes"
@@ -71,6 +80,8 @@ class Strokes:
             object.__setattr__(self, "times", _check_times(label, self.times, paths))
         if not isinstance(self.source, str):
             raise InputError(f"source: got {type(self.source).__name__}, expected a str")
+        if self.box is not None:
+            object.__setattr__(self, "box", _check_box(label, self.box))
 
     @property
     def n_points(self) -> int:
@@ -83,7 +94,7 @@ class Strokes:
         return len(self.paths)
 
     def bounds(self) -> tuple[FloatArray, FloatArray]:
-        """Axis-aligned bounding box of all points.
+        """The drawing's extent: the bounding box of all points, grown to ``box``.
 
         Returns
         -------
@@ -91,6 +102,8 @@ class Strokes:
             ``(2,)`` arrays: the smallest and largest ``(x, y)``, source units.
         """
         stacked = np.concatenate(self.paths, axis=0)
+        if self.box is not None:
+            stacked = np.concatenate([stacked, self.box], axis=0)
         return stacked.min(axis=0), stacked.max(axis=0)
 
     def scaled(self, size: float) -> Strokes:
@@ -104,9 +117,10 @@ class Strokes:
         Returns
         -------
         Strokes
-            The same strokes with the bounding box's bottom-left corner at
-            ``(0, 0)`` and its larger side equal to ``size``; the aspect ratio
-            and the times are kept.
+            The same strokes with the extent's (:meth:`bounds`) bottom-left
+            corner at ``(0, 0)`` and its larger side equal to ``size``; the
+            aspect ratio, the times and the box (moved and scaled alike) are
+            kept.
 
         Raises
         ------
@@ -125,7 +139,18 @@ class Strokes:
                 "expected a drawing of non-negligible extent"
             )
         paths = tuple((p - lo) * factor for p in self.paths)
-        return Strokes(paths=paths, times=self.times, source=self.source)
+        box = None if self.box is None else (self.box - lo) * factor
+        return Strokes(paths=paths, times=self.times, source=self.source, box=box)
+
+
+def _check_box(label: str, raw: Any) -> FloatArray:
+    box = as_array(f"{label}: box", raw, shape=(2, 2), max_abs=MAX_COORDINATE)
+    if np.any(box[0] > box[1]):
+        raise InputError(
+            f"{label}: box: got lower corner ({box[0, 0]:g}, {box[0, 1]:g}) above or right of "
+            f"upper corner ({box[1, 0]:g}, {box[1, 1]:g}), expected [[x_lo, y_lo], [x_hi, y_hi]]"
+        )
+    return _frozen(box)
 
 
 def _check_paths(label: str, paths: Any) -> tuple[FloatArray, ...]:

@@ -29,6 +29,13 @@ _INITIAL_STEPS = 8
 _MAX_REFINEMENTS = 30
 #: Largest SVG file read, bytes: checked before the XML parser sees it.
 MAX_BYTES = 32 * 2**20
+#: CSS pixels per inch: what a unitless SVG length means on paper.
+PPI = 96.0
+INCH_M = 0.0254
+#: Top-level layers whose label starts with this are not drawn by a plotter
+#: (AxiDraw's documentation layers; vpype's ``% pen up trajectories``).
+PLOTTER_SKIP_PREFIX = "%"
+_INKSCAPE_LABEL = "{http://www.inkscape.org/namespaces/inkscape}label"
 
 # What path data and point lists may hold: numbers, separators and (in path
 # data) command letters. svgelements stops at the first token it cannot read
@@ -37,18 +44,32 @@ MAX_BYTES = 32 * 2**20
 _NUMBER = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
 _PATH_TOKEN = re.compile(rf"\s+|,|{_NUMBER}|[MmZzLlHhVvCcSsQqTtAa]")
 _POINTS_TOKEN = re.compile(rf"\s+|,|{_NUMBER}")
+_UNIT_M = {
+    "mm": 1e-3,
+    "cm": 1e-2,
+    "in": INCH_M,
+    "pt": INCH_M / 72.0,
+    "pc": INCH_M / 6.0,
+    "px": INCH_M / PPI,
+}
+_ABSOLUTE_LENGTH = re.compile(rf"\s*({_NUMBER})\s*(mm|cm|in|pt|pc|px)?\s*", re.IGNORECASE)
 
 
-def load_svg(path: str | Path, *, tolerance: float | None = None) -> Strokes:
-    """Load every drawn path of an SVG file as strokes.
+def load_svg(
+    path: str | Path, *, tolerance: float | None = None, true_size: bool = False
+) -> Strokes:
+    """Load every drawn path of an SVG file as strokes, all layers merged.
 
     Every shape (``path``, ``rect``, ``circle``, ``ellipse``, ``line``,
     ``polyline``, ``polygon``) is read with ``svgelements``, which applies the
     nested ``transform`` attributes and the ``viewBox`` and leaves out hidden
-    elements and ``<defs>``; text is not drawn. Each subpath becomes one stroke,
-    in document order. Curves (quadratic and cubic Béziers, elliptical arcs) are
-    flattened to polylines whose chord error is at most ``tolerance``; a closing
-    ``Z`` draws the segment back to the subpath's start.
+    elements (``display:none``, so hidden Inkscape layers) and ``<defs>``; text
+    is not drawn. Top-level layers whose label starts with ``%`` are left out:
+    a plotter does not draw them (AxiDraw's documentation layers; vpype writes
+    its pen-up moves as ``% pen up trajectories``). Each subpath becomes one
+    stroke, in document order. Curves (quadratic and cubic Béziers, elliptical
+    arcs) are flattened to polylines whose chord error is at most
+    ``tolerance``; a closing ``Z`` draws the segment back to the subpath's start.
 
     Parameters
     ----------
@@ -58,12 +79,17 @@ def load_svg(path: str | Path, *, tolerance: float | None = None) -> Strokes:
         Largest distance between a curve and its polyline, in SVG user units
         after the viewBox (CSS px). Default: 0.1 % of the diagonal of the
         drawing's bounding box.
+    true_size
+        Return metres, from the root's ``width`` and ``height`` (mm, cm, in, pt,
+        pc, or px at 96 per inch) and its ``viewBox``: a drawing 10 cm wide on
+        paper spans 0.1.
 
     Returns
     -------
     Strokes
-        Points in SVG user units with y flipped to point up (``(x, -y)``), so the
-        drawing reads the right way up; ``source`` is the file's name.
+        Points in SVG user units (metres with ``true_size``) with y flipped to
+        point up (``(x, -y)``), so the drawing reads the right way up;
+        ``source`` is the file's name.
 
     Raises
     ------
@@ -74,7 +100,9 @@ def load_svg(path: str | Path, *, tolerance: float | None = None) -> Strokes:
         there); if a point is not finite; if it has no drawn shape, or if every
         subpath is a lone point; if it has more than
         :data:`~skyquill.strokes.model.MAX_STROKES` subpaths, or flattening
-        needs more than :data:`~skyquill.strokes.model.MAX_POINTS` points.
+        needs more than :data:`~skyquill.strokes.model.MAX_POINTS` points; with
+        ``true_size``, if ``width`` or ``height`` is missing or relative (``%``,
+        ``em``).
 
     Notes
     -----
@@ -82,43 +110,119 @@ def load_svg(path: str | Path, *, tolerance: float | None = None) -> Strokes:
     zero-length segments) is skipped and logged: it would be a stroke of one
     repeated point, which :class:`Strokes` refuses.
     """
+    parts = _read_parts(Path(path), tolerance, true_size)
+    strokes = tuple(stroke for _, _, part in parts for stroke in part)
+    return Strokes(paths=strokes, source=Path(path).name)
+
+
+def load_svg_layers(
+    path: str | Path, *, tolerance: float | None = None, true_size: bool = False
+) -> list[Strokes]:
+    """Load an SVG file as one :class:`Strokes` per drawn layer, in document order.
+
+    A layer is a top-level group (Inkscape's ``<g inkscape:groupmode="layer">``,
+    vpype's ``<g id="layer1">``); shapes outside every group form one more
+    layer. Hidden layers and ``%`` layers are left out, as by :func:`load_svg`,
+    and so is a layer with nothing to draw.
+
+    Parameters
+    ----------
+    path, tolerance, true_size
+        As for :func:`load_svg`.
+
+    Returns
+    -------
+    list of Strokes
+        ``source`` reads ``"drawing.svg layer 'Outline'"`` (the layer's
+        ``inkscape:label``, else its ``id``); every layer's ``box`` is the
+        bounding box of the whole drawing, so that each scales as the drawing
+        does and keeps its place in it.
+
+    Raises
+    ------
+    InputError
+        As :func:`load_svg`.
+    """
     p = Path(path)
+    parts = _read_parts(p, tolerance, true_size)
+    stacked = np.concatenate([s for _, _, part in parts for s in part], axis=0)
+    box = np.stack([stacked.min(axis=0), stacked.max(axis=0)])
+    layers: dict[int, tuple[str, list[FloatArray]]] = {}
+    for key, name, part in parts:  # the shapes outside every layer (key -1) join up
+        layers.setdefault(key, (name, []))[1].extend(part)
+    return [
+        Strokes(paths=tuple(layer), source=f"{p.name} layer {name!r}", box=box)
+        for name, layer in layers.values()
+    ]
+
+
+def _read_parts(
+    p: Path, tolerance: float | None, true_size: bool
+) -> list[tuple[int, str, list[FloatArray]]]:
+    """Strokes (y up; metres with ``true_size``) by top-level element, in document order.
+
+    Each entry is ``(layer key, layer name, strokes)`` of one top-level element
+    with something to draw: a layer's key is its index, a shape outside every
+    layer has key -1 and name ``""``.
+    """
     if not p.is_file():
         raise InputError(f"{p}: no such file, expected an SVG file")
     size = p.stat().st_size
     if size > MAX_BYTES:
         raise InputError(f"{p}: got {size:,} bytes, expected an SVG file of at most {MAX_BYTES:,}")
     try:
-        svg = se.SVG.parse(str(p))
-        elements = [e for e in svg.elements() if isinstance(e, se.Shape)]
+        svg = se.SVG.parse(str(p), ppi=PPI)
+        grouped = _drawn_parts(svg)
     except Exception as exc:  # svgelements lets XML, value, recursion and I/O errors through
         raise InputError(f"{p}: cannot be parsed as SVG ({exc}), expected an SVG file") from None
+    metres = _metres_per_px(p, svg) if true_size else 1.0
+    elements = [e for _, _, part in grouped for e in part]
     for i, element in enumerate(elements):
         _check_data(p, i, element)
-    shapes: list[Any] = [e if isinstance(e, se.Path) else se.Path(e) for e in elements]
-    shapes = [s for s in shapes if len(s) > 0]
+    parts = [(key, name, _reified(part)) for key, name, part in grouped]
+    shapes = [s for _, _, part in parts for s in part]
     if len(shapes) > MAX_STROKES:
         raise InputError(
             f"{p}: got {len(shapes):,} drawn shapes, expected at most {MAX_STROKES:,} strokes"
         )
     if not shapes:
         raise InputError(
-            f"{p}: no path or shape found (text and <defs> are not drawn), "
+            f"{p}: no path or shape found (text, <defs>, hidden and % layers are not drawn), "
             "expected an SVG with at least one path"
         )
     tol = _tolerance(p, shapes) if tolerance is None else float(tolerance)
     if not (math.isfinite(tol) and tol > 0.0):
         raise InputError(f"tolerance: got {tol:g}, expected a finite number > 0")
+    budget = _Budget(p)
+    out: list[tuple[int, str, list[FloatArray]]] = []
+    for key, name, part in parts:
+        strokes = _flattened(p, part, tol, budget, first=sum(len(s) for _, _, s in out))
+        if strokes:
+            out.append((key, name, [s * metres for s in strokes]))
+    if not out:
+        raise InputError(
+            f"{p}: every subpath is a single point, expected at least one path of non-zero length"
+        )
+    return out
 
+
+def _reified(layer: list[Any]) -> list[Any]:
+    shapes = [e if isinstance(e, se.Path) else se.Path(e) for e in layer]
+    return [s for s in shapes if len(s) > 0]
+
+
+def _flattened(
+    p: Path, shapes: list[Any], tol: float, budget: _Budget, first: int
+) -> list[FloatArray]:
+    """One layer's subpaths as ``(K, 2)`` arrays, y up; ``first`` strokes came before."""
     strokes: list[FloatArray] = []
     skipped = 0
-    budget = _Budget(p)
     for shape in shapes:
         for sub in _subpaths(shape, tol, budget):
             if len(sub) < 2:
                 skipped += 1
                 continue
-            if len(strokes) == MAX_STROKES:
+            if first + len(strokes) == MAX_STROKES:
                 raise InputError(
                     f"{p}: got more than {MAX_STROKES:,} subpaths, expected at most "
                     f"{MAX_STROKES:,} strokes"
@@ -126,18 +230,73 @@ def load_svg(path: str | Path, *, tolerance: float | None = None) -> Strokes:
             arr = np.asarray(sub, dtype=np.float64)
             if not np.all(np.isfinite(arr)):
                 raise InputError(
-                    f"{p}: stroke {len(strokes)}: got a NaN or infinite coordinate (a number "
-                    "beyond the float range, or a transform of one), expected finite numbers"
+                    f"{p}: stroke {first + len(strokes)}: got a NaN or infinite coordinate (a "
+                    "number beyond the float range, or a transform of one), expected finite numbers"
                 )
             arr[:, 1] = -arr[:, 1]
             strokes.append(arr)
     if skipped:
         logger.info("%s: skipped %d subpath(s) that never leave their start point", p, skipped)
-    if not strokes:
-        raise InputError(
-            f"{p}: every subpath is a single point, expected at least one path of non-zero length"
-        )
-    return Strokes(paths=tuple(strokes), source=p.name)
+    return strokes
+
+
+def _drawn_parts(svg: Any) -> list[tuple[int, str, list[Any]]]:
+    """The shapes a plotter draws by top-level element, in document order.
+
+    Layers are the top-level groups; a shape outside them is an entry of its
+    own (key -1), so that merging keeps the document's order.
+    """
+    parts: list[tuple[int, str, list[Any]]] = []
+    for index, child in enumerate(svg):
+        if isinstance(child, se.Shape):
+            parts.append((-1, "", [child]))
+            continue
+        if not isinstance(child, se.Group | se.Use):
+            continue
+        attributes = child.values.get("attributes", {})
+        label = attributes.get(_INKSCAPE_LABEL)
+        if isinstance(label, str) and label.startswith(PLOTTER_SKIP_PREFIX):
+            logger.info("left out layer %r: a plotter does not draw %s layers", label, "%")
+            continue
+        name = label or attributes.get("id") or f"group {index + 1}"
+        parts.append((index, str(name), _shapes_under(child)))
+    return [part for part in parts if part[2]]
+
+
+def _shapes_under(group: Any) -> list[Any]:
+    """Every shape inside ``group``, in document order.
+
+    Walks the tree with an explicit stack: a deeply nested file must not hit
+    Python's recursion limit here.
+    """
+    shapes: list[Any] = []
+    stack = list(reversed(group))
+    while stack:
+        element = stack.pop()
+        if isinstance(element, se.Shape):
+            shapes.append(element)
+        elif isinstance(element, se.Group | se.Use):
+            stack.extend(reversed(element))
+    return shapes
+
+
+def _metres_per_px(p: Path, svg: Any) -> float:
+    """Metres per user unit after the viewBox, from the root's absolute width and height."""
+    attributes = svg.values.get("attributes", {})
+    sizes: dict[str, float] = {}
+    for name in ("width", "height"):
+        text = attributes.get(name)
+        match = _ABSOLUTE_LENGTH.fullmatch(text) if isinstance(text, str) else None
+        if match is None or float(match.group(1)) <= 0.0:
+            got = f"no {name}" if text is None else repr(text)
+            raise InputError(
+                f"{p}: {name}: got {got}, expected an absolute length > 0 (mm, cm, in, pt, pc "
+                "or px) to draw at true size"
+            )
+        sizes[name] = float(match.group(1)) * _UNIT_M[(match.group(2) or "px").lower()]
+    # svgelements has mapped the viewBox onto width x height px with its own
+    # (7-digit) mm constant; dividing by its width in px undoes that rounding.
+    return sizes["width"] / float(svg.width)
 
 
 def _check_data(p: Path, index: int, element: Any) -> None:
