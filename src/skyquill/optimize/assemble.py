@@ -103,18 +103,97 @@ class Assembled:
         return f + self.f_coupled if self.f_coupled is not None else f
 
 
-def assemble(problem: SmoothingProblem) -> Assembled:
-    """Build the matrices of ``problem`` (validated)."""
-    basis = problem.basis
-    alpha = problem.alpha
-    M, d = problem.n_ctrl, problem.dim
+@dataclass(frozen=True)
+class _Fixed:
+    """The blocks of an assembly that the point times leave alone (:class:`AssemblyCache`)."""
 
+    smooth: sp.csr_array  # (M, M): the smoothness Gram matrices
+    boundary: tuple[list[FloatArray], list[FloatArray], dict[float, FloatArray]]
+    G_ineq: sp.csr_array
+    h_ineq: FloatArray
+    families: tuple[InequalityFamily, ...]
+    cones: NormCones | None
+
+
+class AssemblyCache:
+    """Re-use the blocks that stay the same across a sequence of assemblies.
+
+    Re-segmentation assembles a dozen problems per plan that differ only in
+    the point times: the smoothness Gram matrices, the boundary rows, the
+    limit and corridor rows and the cones depend on the knots, ``alpha`` and
+    the terms themselves, not on the times, and with the total time fixed
+    they come out bit-identical every time. The cache keeps the last set,
+    keyed on exactly what they are built from (degree, control points,
+    ``alpha``, hull, dimension, smoothness weights, and the values of the
+    boundary, limit and corridor terms), so a problem that differs in any of
+    those is assembled afresh. One cache belongs to one sequence of solves
+    (:class:`skyquill.optimize.workspace.Workspace`); there is no global state.
+    """
+
+    def __init__(self) -> None:
+        self._key: tuple[object, ...] | None = None
+        self._fixed: _Fixed | None = None
+        #: How often the blocks were re-used (for tests and benchmarks).
+        self.hits = 0
+
+    def fixed(self, problem: SmoothingProblem) -> _Fixed:
+        """The time-independent blocks of ``problem``, built or re-used."""
+        key = _fixed_key(problem)
+        if self._fixed is not None and key == self._key:
+            self.hits += 1
+            return self._fixed
+        self._key, self._fixed = key, _build_fixed(problem)
+        return self._fixed
+
+
+def _fingerprint(value: object) -> object:
+    """A hashable, exact (bitwise for arrays) stand-in for a problem term."""
+    if isinstance(value, np.ndarray):
+        return (value.shape, value.dtype.str, value.tobytes())
+    if isinstance(value, tuple | list):
+        return tuple(_fingerprint(v) for v in value)
+    if hasattr(value, "__dataclass_fields__"):
+        names = value.__dataclass_fields__
+        return (type(value).__name__, *(_fingerprint(getattr(value, n)) for n in names))
+    return value
+
+
+def _fixed_key(problem: SmoothingProblem) -> tuple[object, ...]:
+    return (
+        problem.dim,
+        problem.degree,
+        problem.n_ctrl,
+        problem.alpha,
+        problem.hull,
+        tuple(sorted(problem.smoothness.items())),
+        _fingerprint(problem.boundary),
+        _fingerprint(problem.limits),
+        _fingerprint(problem.corridors),
+    )
+
+
+def _build_fixed(problem: SmoothingProblem) -> _Fixed:
+    basis, alpha, M = problem.basis, problem.alpha, problem.n_ctrl
     smooth = [
         sigma * alpha ** (2 * order - 1) * basis.gram(order)
         for order, sigma in problem.smoothness.items()
         if sigma
     ]
-    G_axis = sp.csr_array(sum(smooth[1:], smooth[0]) if smooth else sp.csr_array((M, M)))
+    G_smooth = sp.csr_array(sum(smooth[1:], smooth[0]) if smooth else sp.csr_array((M, M)))
+    G_ineq, h_ineq, families = _inequalities(problem)
+    return _Fixed(G_smooth, _boundary_rows(problem), G_ineq, h_ineq, families, _cones(problem))
+
+
+def assemble(problem: SmoothingProblem, cache: AssemblyCache | None = None) -> Assembled:
+    """Build the matrices of ``problem`` (validated).
+
+    ``cache`` re-uses the blocks the point times do not change from the
+    previous assembly when they would come out the same (:class:`AssemblyCache`).
+    """
+    basis = problem.basis
+    M, d = problem.n_ctrl, problem.dim
+    fixed = cache.fixed(problem) if cache is not None else _build_fixed(problem)
+    G_axis = fixed.smooth
     F = np.zeros((M, d))
     coupled: list[tuple[sp.csr_array, FloatArray]] = []
     for term in problem.deviations:
@@ -132,9 +211,7 @@ def assemble(problem: SmoothingProblem) -> Assembled:
     diagonal = G_axis.diagonal().max(initial=0.0)
     if G_coupled is not None:
         diagonal = max(diagonal, G_coupled.diagonal().max(initial=0.0))
-    E, e = _equalities(problem)
-    G_ineq, h_ineq, families = _inequalities(problem)
-    cones = _cones(problem)
+    E, e = _equalities(problem, fixed.boundary)
     return Assembled(
         1.0 / diagonal if diagonal > 0 else 1.0,
         sp.csr_array(G_axis),
@@ -143,10 +220,10 @@ def assemble(problem: SmoothingProblem) -> Assembled:
         f_coupled,
         E,
         e,
-        G_ineq,
-        h_ineq,
-        families,
-        cones,
+        fixed.G_ineq,
+        fixed.h_ineq,
+        fixed.families,
+        fixed.cones,
     )
 
 
@@ -217,16 +294,14 @@ def _flat_term(
     return sp.csr_array(G), f
 
 
-def _equalities(problem: SmoothingProblem) -> tuple[sp.csr_array, FloatArray]:
-    """Boundary conditions (eq. 42) and interpolated points (eq. 13), per axis.
+def _boundary_rows(
+    problem: SmoothingProblem,
+) -> tuple[list[FloatArray], list[FloatArray], dict[float, FloatArray]]:
+    """Boundary rows (eq. 42) in ``s``, their right-hand sides, and the fixed end positions.
 
     Derivative rows are in ``s``: ``Gamma_n C = value / alpha^n`` (O(1) rows).
-    An interpolated point at ``t = 0`` or ``t = duration`` where the boundary
-    already fixes the position repeats that row exactly (both are ``e_0`` or
-    ``e_{M-1}``) and would make the KKT matrix singular: it is dropped if it
-    agrees, and a contradiction raises :class:`InfeasibleError`.
     """
-    basis, alpha, M = problem.basis, problem.alpha, problem.n_ctrl
+    basis, alpha = problem.basis, problem.alpha
     dense_rows: list[FloatArray] = []
     rhs: list[FloatArray] = []
     fixed: dict[float, FloatArray] = {}
@@ -239,6 +314,24 @@ def _equalities(problem: SmoothingProblem) -> tuple[sp.csr_array, FloatArray]:
                 rhs.append(to_s * value[None, :])
                 if bc.order == 0:
                     fixed[float(s_end)] = value
+    return dense_rows, rhs, fixed
+
+
+def _equalities(
+    problem: SmoothingProblem,
+    boundary: tuple[list[FloatArray], list[FloatArray], dict[float, FloatArray]],
+) -> tuple[sp.csr_array, FloatArray]:
+    """Boundary conditions (eq. 42, ``boundary`` from :func:`_boundary_rows`) and
+    interpolated points (eq. 13), per axis.
+
+    An interpolated point at ``t = 0`` or ``t = duration`` where the boundary
+    already fixes the position repeats that row exactly (both are ``e_0`` or
+    ``e_{M-1}``) and would make the KKT matrix singular: it is dropped if it
+    agrees, and a contradiction raises :class:`InfeasibleError`.
+    """
+    basis, M = problem.basis, problem.n_ctrl
+    dense_rows, boundary_rhs, fixed = boundary
+    rhs = list(boundary_rhs)
     blocks = [sp.csr_array(np.array(dense_rows))] if dense_rows else []
     for term in problem.interpolation:
         s = _params(problem, term.times)

@@ -46,10 +46,12 @@ from skyquill.errors import InfeasibleError, InputError, SolverError
 from skyquill.optimize.assemble import Assembled, NormCones, assemble, problem_cost
 from skyquill.optimize.kkt import SingularKKTError, solve_equality_qp
 from skyquill.optimize.problem import SmoothingProblem
+from skyquill.optimize.workspace import Workspace
 from skyquill.solvers import (
     BACKENDS,
     CONIC_BACKENDS,
     DEFAULT_BACKEND,
+    PiqpSession,
     QuadraticProgram,
     SecondOrderCones,
     solve_qp,
@@ -148,7 +150,12 @@ class FitResult:
         return self.trajectory.verify(self.problem.limits, self.problem.corridors)
 
 
-def solve(problem: SmoothingProblem, solver: str = DEFAULT_BACKEND) -> FitResult:
+def solve(
+    problem: SmoothingProblem,
+    solver: str = DEFAULT_BACKEND,
+    *,
+    workspace: Workspace | None = None,
+) -> FitResult:
     """Solve ``problem``; the result carries its dense check (``verification``).
 
     Parameters
@@ -157,6 +164,11 @@ def solve(problem: SmoothingProblem, solver: str = DEFAULT_BACKEND) -> FitResult
         The validated problem.
     solver
         QP backend for problems with inequalities (see :data:`BACKENDS`).
+    workspace
+        Shared with the other solves of a sequence of related problems
+        (re-segmentation): re-used assembly blocks and PIQP setups
+        (:class:`~skyquill.optimize.workspace.Workspace`). The result is the
+        fresh solve's, to the backend's tolerance.
 
     Raises
     ------
@@ -170,10 +182,10 @@ def solve(problem: SmoothingProblem, solver: str = DEFAULT_BACKEND) -> FitResult
         raise InputError(f"solver: got {solver!r}, expected one of {sorted(BACKENDS)}")
     start = time.perf_counter()
     if problem.has_inequalities:
-        C, (y, z, cone_z), used, margin, asm = _solve_qp(problem, solver)
+        C, (y, z, cone_z), used, margin, asm = _solve_qp(problem, solver, workspace)
         method: Literal["closed_form", "qp"] = "qp"
     else:
-        asm = assemble(problem)
+        asm = workspace.assemble(problem) if workspace is not None else assemble(problem)
         (C, y), z, used, margin = _closed_form(asm), np.zeros(0), "sparse-lu", 0.0
         cone_z = None
         method = "closed_form"
@@ -332,11 +344,14 @@ def _hull_excess(asm: Assembled, x: FloatArray) -> float:
 _Solved = tuple[FloatArray, tuple[FloatArray, FloatArray, FloatArray | None], str, float, Assembled]
 
 
-def _solve_qp(problem: SmoothingProblem, solver: str) -> _Solved:
+def _solve_qp(problem: SmoothingProblem, solver: str, workspace: Workspace | None) -> _Solved:
     """Control points, the duals ``(y, z, cone_z)`` of the same (tightened) QP, backend, margin."""
-    exact = assemble(problem)
+    exact = workspace.assemble(problem) if workspace is not None else assemble(problem)
+    session = workspace.session("qp") if workspace is not None else None
     if exact.cones is not None:
-        relaxed = _relaxed(problem, exact, solver)
+        relaxed = _relaxed(
+            problem, exact, workspace.session("relaxed") if workspace is not None else None
+        )
         if relaxed is not None:
             return relaxed
         backends = list(CONIC_BACKENDS)
@@ -346,7 +361,7 @@ def _solve_qp(problem: SmoothingProblem, solver: str) -> _Solved:
     for margin in _MARGINS:
         qp = _to_qp(exact, margin)
         for backend in backends:
-            sol = solve_qp(qp, backend)
+            sol = solve_qp(qp, backend, session=session)
             if sol.status == "infeasible":
                 _raise_infeasible(problem, exact)
             if sol.status == "optimal" and sol.x is not None:
@@ -370,7 +385,7 @@ def _solve_qp(problem: SmoothingProblem, solver: str) -> _Solved:
 
 
 def _relaxed(
-    problem: SmoothingProblem, exact: Assembled, solver: str
+    problem: SmoothingProblem, exact: Assembled, session: PiqpSession | None
 ) -> (
     tuple[FloatArray, tuple[FloatArray, FloatArray, FloatArray | None], str, float, Assembled]
     | None
@@ -378,38 +393,45 @@ def _relaxed(
     """The conic program's optimum from a QP, when the norm limits turn out not to bind.
 
     Every ball ``||v_p|| <= r_p`` is replaced by its circumscribing box
-    ``|v_p,i| <= r_p``: a relaxation, solved by the (faster) QP backend. If its
-    solution meets every ball to the guarantee tolerance it is the conic
-    program's optimum (a relaxation's optimum that is feasible is optimal), and
-    if no box row is active the dropped rows carry no multiplier, so the duals
-    are the conic program's too (cone duals 0). Writing at the default limits
-    is such a case: nothing binds, and a Clarabel solve takes ~2x a PIQP one.
-    Returns None when a ball or a box binds (then the cones are needed).
+    ``-r_p <= v_p,i <= r_p``: a relaxation, solved by the (faster) QP backend,
+    one two-sided row per component. If its solution meets every ball to the
+    guarantee tolerance it is the conic program's optimum (a relaxation's
+    optimum that is feasible is optimal), and if no box row is active the
+    dropped rows carry no multiplier, so the duals are the conic program's too
+    (cone duals 0). Writing at the default limits is such a case: nothing
+    binds, and a Clarabel solve takes ~2x a PIQP one. Returns None when a ball
+    or a box binds (then the cones are needed).
     """
     assert exact.cones is not None
-    cones = exact.cones
-    d = cones.map.shape[0] // cones.radius.size
-    bound = np.repeat(cones.radius, d)
-    box = sp.csr_array(sp.vstack([cones.map, -cones.map]))
-    relaxed = replace(
-        exact,
-        G_ineq=sp.csr_array(sp.vstack([exact.G_ineq, box])),
-        h_ineq=np.concatenate([exact.h_ineq, bound, bound]),
-        cones=None,
-    )
     margin = _MARGINS[0]
-    sol = solve_qp(_to_qp(relaxed, margin), DEFAULT_BACKEND)
+    qp = _relaxed_qp(exact, margin)
+    sol = solve_qp(qp, DEFAULT_BACKEND, session=session)
     if sol.status != "optimal" or sol.x is None or sol.y is None or sol.z is None:
         return None
     if _hull_excess(exact, sol.x) > GUARANTEE_RTOL:
         return None  # a ball is violated: the norm limit binds
-    slack = np.concatenate([bound, bound]) - box @ sol.x
-    if np.any(slack <= 1e-6 * np.maximum(np.concatenate([bound, bound]), 1e-3)):
+    bound = np.repeat(exact.cones.radius, problem.dim)
+    slack = bound - np.abs(exact.cones.map @ sol.x)
+    if np.any(slack <= 1e-6 * np.maximum(bound, 1e-3)):
         return None  # a box row binds: its multiplier would be lost
     C = sol.x.reshape(problem.n_ctrl, problem.dim)
     m = exact.G_ineq.shape[0]
-    cone_z = np.zeros(cones.radius.size * (d + 1))
+    cone_z = np.zeros(exact.cones.radius.size * (problem.dim + 1))
     return C, (sol.y, sol.z[:m], cone_z), sol.solver, margin, exact
+
+
+def _relaxed_qp(exact: Assembled, margin: float) -> QuadraticProgram:
+    """The QP of ``exact`` with its cones replaced by two-sided box rows (:func:`_relaxed`)."""
+    assert exact.cones is not None
+    linear = _to_qp(replace(exact, cones=None), margin)
+    bound = np.repeat(exact.cones.radius, exact.F.shape[1])
+    tight = bound - margin * np.maximum(bound, 1e-3)
+    return replace(
+        linear,
+        G=sp.csc_array(sp.vstack([linear.G, exact.cones.map])),
+        h=np.concatenate([linear.h, tight]),
+        h_lower=np.concatenate([np.full(linear.h.size, -np.inf), -tight]),
+    )
 
 
 def _raise_infeasible(problem: SmoothingProblem, asm: Assembled, certain: bool = True) -> None:

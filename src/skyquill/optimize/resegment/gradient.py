@@ -49,6 +49,7 @@ from skyquill.optimize.resegment.multipliers import Multipliers, multipliers
 from skyquill.optimize.resegment.problems import ProblemFactory, check_problem, zero_based
 from skyquill.optimize.resegment.results import TimeGradient
 from skyquill.optimize.solve import FitResult, solve
+from skyquill.optimize.workspace import Workspace
 from skyquill.solvers import DEFAULT_BACKEND
 from skyquill.validation import FloatArray
 
@@ -61,6 +62,8 @@ def time_gradient(
     make_problem: ProblemFactory,
     solver: str = DEFAULT_BACKEND,
     result: FitResult | None = None,
+    *,
+    workspace: Workspace | None = None,
 ) -> TimeGradient:
     """Optimal cost ``f`` at ``times`` and its analytic gradient (module docstring).
 
@@ -74,6 +77,10 @@ def time_gradient(
         QP backend for problems with inequalities.
     result
         A solve of ``make_problem(times)`` to reuse (skips the solve).
+    workspace
+        Shared with the solves of a sequence (:mod:`skyquill.optimize.workspace`):
+        the solve (when ``result`` is None) and the multipliers re-use its
+        assembly blocks and PIQP setup.
 
     Returns
     -------
@@ -83,8 +90,8 @@ def time_gradient(
     if result is None:
         problem = make_problem(t)
         check_problem(problem, t, None)
-        result = solve(problem, solver)
-    mult = multipliers(result) if _needs_multipliers(result) else None
+        result = solve(problem, solver, workspace=workspace)
+    mult = multipliers(result, workspace) if _needs_multipliers(result) else None
     grad_t = _lagrangian_gradient(result.problem, result.trajectory.control_points, mult, t)
     grad_T = np.cumsum(grad_t[::-1])[::-1][1:].copy()
     if mult is None:

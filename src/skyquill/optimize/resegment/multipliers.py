@@ -29,6 +29,7 @@ from skyquill.optimize.assemble import Assembled, assemble, problem_cost
 from skyquill.optimize.problem import SmoothingProblem
 from skyquill.optimize.resegment.polish import polish
 from skyquill.optimize.solve import FitResult, _to_qp
+from skyquill.optimize.workspace import Workspace
 from skyquill.validation import FloatArray
 
 log = logging.getLogger(__name__)
@@ -77,12 +78,17 @@ class Multipliers:
     cost: float
 
 
-def multipliers(result: FitResult) -> Multipliers:
-    """The multipliers of ``result``'s solve (polished on the QP route), with the residual."""
+def multipliers(result: FitResult, workspace: Workspace | None = None) -> Multipliers:
+    """The multipliers of ``result``'s solve (polished on the QP route), with the residual.
+
+    ``workspace``: the one ``result`` was solved with, whose assembly of the
+    same problem is then re-used.
+    """
     problem = result.problem
-    # Assembled again rather than kept in FitResult: the matrices are 4-5x the
-    # size of the rest of a result, which missions pickle across processes.
-    asm = assemble(problem)
+    # Assembled again (or taken from the solve's workspace) rather than kept in
+    # FitResult: the matrices are 4-5x the size of the rest of a result, which
+    # missions pickle across processes.
+    asm = workspace.assemble(problem) if workspace is not None else assemble(problem)
     # The QP the solve handed its backend (h tightened by the margin it needed).
     qp = _to_qp(asm, result.margin)
     C, cost = result.trajectory.control_points, result.cost
