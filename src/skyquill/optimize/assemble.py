@@ -109,6 +109,8 @@ class _Fixed:
 
     smooth: sp.csr_array  # (M, M): the smoothness Gram matrices
     boundary: tuple[list[FloatArray], list[FloatArray], dict[float, FloatArray]]
+    E: sp.csr_array  # (m_b, M): the boundary rows alone
+    e: FloatArray  # (m_b, d)
     G_ineq: sp.csr_array
     h_ineq: FloatArray
     families: tuple[InequalityFamily, ...]
@@ -133,8 +135,28 @@ class AssemblyCache:
     def __init__(self) -> None:
         self._key: tuple[object, ...] | None = None
         self._fixed: _Fixed | None = None
+        self._design: dict[tuple[object, ...], tuple[FloatArray, sp.csr_array]] = {}
         #: How often the blocks were re-used (for tests and benchmarks).
         self.hits = 0
+
+    def design_matrix(
+        self, problem: SmoothingProblem, times: FloatArray, order: int = 0
+    ) -> sp.csr_array:
+        """The basis rows (derivative ``order`` in ``s``) at a term's ``times``, shape (N, M).
+
+        The assembly, the cost and the time gradient of one problem each need
+        them; they are kept for the very ``times`` array (held, so identity is
+        exact) at the same knots and ``alpha``, for the last few terms.
+        """
+        key = (id(times), problem.alpha, problem.degree, problem.n_ctrl, order)
+        held = self._design.get(key)
+        if held is not None and held[0] is times:
+            return held[1]
+        if len(self._design) >= _DESIGN_ENTRIES:
+            self._design.clear()
+        matrix = problem.basis.design_matrix(_params(problem, times), order)
+        self._design[key] = (times, matrix)
+        return matrix
 
     def fixed(self, problem: SmoothingProblem) -> _Fixed:
         """The time-independent blocks of ``problem``, built or re-used."""
@@ -144,6 +166,19 @@ class AssemblyCache:
             return self._fixed
         self._key, self._fixed = key, _build_fixed(problem)
         return self._fixed
+
+
+#: Design matrices an :class:`AssemblyCache` keeps (a few terms of one or two problems).
+_DESIGN_ENTRIES = 16
+
+
+def design_matrix(
+    problem: SmoothingProblem, times: FloatArray, order: int = 0, cache: AssemblyCache | None = None
+) -> sp.csr_array:
+    """Basis rows of derivative ``order`` (in ``s``) at ``times`` (s), through ``cache`` if any."""
+    if cache is not None:
+        return cache.design_matrix(problem, times, order)
+    return problem.basis.design_matrix(_params(problem, times), order)
 
 
 def _fingerprint(value: object) -> object:
@@ -181,7 +216,9 @@ def _build_fixed(problem: SmoothingProblem) -> _Fixed:
     ]
     G_smooth = sp.csr_array(sum(smooth[1:], smooth[0]) if smooth else sp.csr_array((M, M)))
     G_ineq, h_ineq, families = _inequalities(problem)
-    return _Fixed(G_smooth, _boundary_rows(problem), G_ineq, h_ineq, families, _cones(problem))
+    boundary = _boundary_rows(problem)
+    E, e = _stack_equalities(problem, [np.array(boundary[0])] if boundary[0] else [], boundary[1])
+    return _Fixed(G_smooth, boundary, E, e, G_ineq, h_ineq, families, _cones(problem))
 
 
 def assemble(problem: SmoothingProblem, cache: AssemblyCache | None = None) -> Assembled:
@@ -190,7 +227,6 @@ def assemble(problem: SmoothingProblem, cache: AssemblyCache | None = None) -> A
     ``cache`` re-uses the blocks the point times do not change from the
     previous assembly when they would come out the same (:class:`AssemblyCache`).
     """
-    basis = problem.basis
     M, d = problem.n_ctrl, problem.dim
     fixed = cache.fixed(problem) if cache is not None else _build_fixed(problem)
     G_axis = fixed.smooth
@@ -198,7 +234,7 @@ def assemble(problem: SmoothingProblem, cache: AssemblyCache | None = None) -> A
     coupled: list[tuple[sp.csr_array, FloatArray]] = []
     for term in problem.deviations:
         if isinstance(term, PointDeviation):
-            H = basis.design_matrix(_params(problem, term.times))
+            H = design_matrix(problem, term.times, 0, cache)
             G_axis = G_axis + term.weight * (H.T @ H)
             F -= 2.0 * term.weight * (H.T @ term.points)
         else:
@@ -211,7 +247,9 @@ def assemble(problem: SmoothingProblem, cache: AssemblyCache | None = None) -> A
     diagonal = G_axis.diagonal().max(initial=0.0)
     if G_coupled is not None:
         diagonal = max(diagonal, G_coupled.diagonal().max(initial=0.0))
-    E, e = _equalities(problem, fixed.boundary)
+    # Without interpolated points the rows are the boundary's: the same objects
+    # every time, which lets the solve re-use what it derives from them.
+    E, e = _equalities(problem, fixed.boundary) if problem.interpolation else (fixed.E, fixed.e)
     return Assembled(
         1.0 / diagonal if diagonal > 0 else 1.0,
         sp.csr_array(G_axis),
@@ -227,12 +265,15 @@ def assemble(problem: SmoothingProblem, cache: AssemblyCache | None = None) -> A
     )
 
 
-def problem_cost(problem: SmoothingProblem, C: FloatArray) -> dict[str, float]:
+def problem_cost(
+    problem: SmoothingProblem, C: FloatArray, cache: AssemblyCache | None = None
+) -> dict[str, float]:
     """Cost of control points ``C`` (M, d), term by term: ``smoothness``, ``deviation``, ``total``.
 
     Smoothness is ``sum_n sigma_n alpha^(2n-1) sum_j D_j' W_n D_j`` on the
     derivative control points ``D = Gamma_n C`` (eq. 8-10), deviations are the
     residuals themselves (eq. 11, 25, 27): no cancellation of large terms.
+    ``cache`` re-uses the design matrices of the assembly.
     """
     basis, alpha = problem.basis, problem.alpha
     smooth = 0.0
@@ -243,7 +284,7 @@ def problem_cost(problem: SmoothingProblem, C: FloatArray) -> dict[str, float]:
     deviation = 0.0
     for term in problem.deviations:
         if isinstance(term, PointDeviation):
-            residual = basis.design_matrix(_params(problem, term.times)) @ C - term.points
+            residual = design_matrix(problem, term.times, 0, cache) @ C - term.points
             deviation += term.weight * float(np.sum(residual**2))
         else:
             Q, w = term.quadratic()
@@ -329,10 +370,10 @@ def _equalities(
     ``e_{M-1}``) and would make the KKT matrix singular: it is dropped if it
     agrees, and a contradiction raises :class:`InfeasibleError`.
     """
-    basis, M = problem.basis, problem.n_ctrl
+    basis = problem.basis
     dense_rows, boundary_rhs, fixed = boundary
     rhs = list(boundary_rhs)
-    blocks = [sp.csr_array(np.array(dense_rows))] if dense_rows else []
+    blocks: list[FloatArray | sp.csr_array] = [np.array(dense_rows)] if dense_rows else []
     for term in problem.interpolation:
         s = _params(problem, term.times)
         keep = np.ones(s.size, dtype=bool)
@@ -350,9 +391,16 @@ def _equalities(
             keep &= ~repeat
         blocks.append(basis.design_matrix(s[keep]))
         rhs.append(term.points[keep])
+    return _stack_equalities(problem, blocks, rhs)
+
+
+def _stack_equalities(
+    problem: SmoothingProblem, blocks: list[FloatArray | sp.csr_array], rhs: list[FloatArray]
+) -> tuple[sp.csr_array, FloatArray]:
+    """``E`` (m_eq, M) and ``e`` (m_eq, d) from row blocks and their right-hand sides."""
     if not blocks:
-        return sp.csr_array((0, M)), np.zeros((0, problem.dim))
-    return sp.csr_array(sp.vstack(blocks)), np.vstack(rhs)
+        return sp.csr_array((0, problem.n_ctrl)), np.zeros((0, problem.dim))
+    return sp.csr_array(sp.vstack([sp.csr_array(b) for b in blocks])), np.vstack(rhs)
 
 
 def _inequalities(

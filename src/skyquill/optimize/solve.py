@@ -32,9 +32,10 @@ from __future__ import annotations
 
 import logging
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 from functools import cached_property
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 import scipy.linalg
@@ -51,7 +52,6 @@ from skyquill.solvers import (
     BACKENDS,
     CONIC_BACKENDS,
     DEFAULT_BACKEND,
-    PiqpSession,
     QuadraticProgram,
     SecondOrderCones,
     solve_qp,
@@ -191,7 +191,7 @@ def solve(
         method = "closed_form"
     elapsed = time.perf_counter() - start
     traj = SplineTrajectory(C, problem.degree, problem.duration)
-    terms = problem_cost(problem, C)
+    terms = problem_cost(problem, C, workspace.assembly if workspace is not None else None)
     return FitResult(
         traj,
         method,
@@ -289,21 +289,33 @@ def _closed_form_kkt(asm: Assembled) -> tuple[FloatArray, FloatArray]:
     return sol.x.reshape(M, d), sol.y
 
 
-def _to_qp(asm: Assembled, margin: float = 0.0) -> QuadraticProgram:
+def _to_qp(
+    asm: Assembled, margin: float = 0.0, workspace: Workspace | None = None
+) -> QuadraticProgram:
     """The QP of ``asm``, every inequality tightened by ``margin * max(|h|, 1e-3)``.
 
     The margin keeps a solver's feasibility tolerance from leaving the result
     outside a limit it was asked to hold; cone radii shrink the same way.
+    ``workspace`` re-uses the equality rows, inequality rows and cones derived
+    from the same assembly blocks (what the times leave alone).
     """
     d = asm.F.shape[1]
+
+    def memo(name: str, keys: tuple[object, ...], build: Callable[[], Any]) -> Any:
+        return workspace.memo(name, keys, build) if workspace is not None else build()
+
+    cones = None
+    if asm.cones is not None:
+        held = asm.cones
+        cones = memo(f"cones {margin!r}", (held,), lambda: _second_order_cones(held, margin))
     return QuadraticProgram(
         P=sp.csc_array(2.0 * asm.hessian()),
         q=asm.linear(),
-        A_eq=sp.csc_array(sp.kron(asm.E, sp.eye_array(d))),
+        A_eq=memo("A_eq", (asm.E,), lambda: sp.csc_array(sp.kron(asm.E, sp.eye_array(d)))),
         b_eq=asm.e.ravel(),
-        G=sp.csc_array(asm.G_ineq),
+        G=memo("G", (asm.G_ineq,), lambda: sp.csc_array(asm.G_ineq)),
         h=asm.h_ineq - margin * np.maximum(np.abs(asm.h_ineq), 1e-3),
-        cones=_second_order_cones(asm.cones, margin) if asm.cones is not None else None,
+        cones=cones,
     )
 
 
@@ -349,9 +361,7 @@ def _solve_qp(problem: SmoothingProblem, solver: str, workspace: Workspace | Non
     exact = workspace.assemble(problem) if workspace is not None else assemble(problem)
     session = workspace.session("qp") if workspace is not None else None
     if exact.cones is not None:
-        relaxed = _relaxed(
-            problem, exact, workspace.session("relaxed") if workspace is not None else None
-        )
+        relaxed = _relaxed(problem, exact, workspace)
         if relaxed is not None:
             return relaxed
         backends = list(CONIC_BACKENDS)
@@ -359,7 +369,7 @@ def _solve_qp(problem: SmoothingProblem, solver: str, workspace: Workspace | Non
         backends = [solver, *(b for b in ("clarabel", "piqp") if b != solver)]
     failures: list[str] = []
     for margin in _MARGINS:
-        qp = _to_qp(exact, margin)
+        qp = _to_qp(exact, margin, workspace)
         for backend in backends:
             sol = solve_qp(qp, backend, session=session)
             if sol.status == "infeasible":
@@ -385,7 +395,7 @@ def _solve_qp(problem: SmoothingProblem, solver: str, workspace: Workspace | Non
 
 
 def _relaxed(
-    problem: SmoothingProblem, exact: Assembled, session: PiqpSession | None
+    problem: SmoothingProblem, exact: Assembled, workspace: Workspace | None
 ) -> (
     tuple[FloatArray, tuple[FloatArray, FloatArray, FloatArray | None], str, float, Assembled]
     | None
@@ -404,7 +414,8 @@ def _relaxed(
     """
     assert exact.cones is not None
     margin = _MARGINS[0]
-    qp = _relaxed_qp(exact, margin)
+    qp = _relaxed_qp(exact, margin, workspace)
+    session = workspace.session("relaxed") if workspace is not None else None
     sol = solve_qp(qp, DEFAULT_BACKEND, session=session)
     if sol.status != "optimal" or sol.x is None or sol.y is None or sol.z is None:
         return None
@@ -420,15 +431,21 @@ def _relaxed(
     return C, (sol.y, sol.z[:m], cone_z), sol.solver, margin, exact
 
 
-def _relaxed_qp(exact: Assembled, margin: float) -> QuadraticProgram:
+def _relaxed_qp(exact: Assembled, margin: float, workspace: Workspace | None) -> QuadraticProgram:
     """The QP of ``exact`` with its cones replaced by two-sided box rows (:func:`_relaxed`)."""
-    assert exact.cones is not None
-    linear = _to_qp(replace(exact, cones=None), margin)
-    bound = np.repeat(exact.cones.radius, exact.F.shape[1])
+    cones = exact.cones
+    assert cones is not None
+    linear = _to_qp(replace(exact, cones=None), margin, workspace)
+    bound = np.repeat(cones.radius, exact.F.shape[1])
     tight = bound - margin * np.maximum(bound, 1e-3)
+
+    def rows() -> sp.csc_array:
+        return sp.csc_array(sp.vstack([linear.G, cones.map]))
+
+    G = workspace.memo("relaxed G", (linear.G, cones), rows) if workspace is not None else rows()
     return replace(
         linear,
-        G=sp.csc_array(sp.vstack([linear.G, exact.cones.map])),
+        G=G,
         h=np.concatenate([linear.h, tight]),
         h_lower=np.concatenate([np.full(linear.h.size, -np.inf), -tight]),
     )

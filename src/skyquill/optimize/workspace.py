@@ -20,9 +20,14 @@ a fresh solve returns, to the QP backend's tolerance
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from typing import TypeVar
+
 from skyquill.optimize.assemble import Assembled, AssemblyCache, assemble
 from skyquill.optimize.problem import SmoothingProblem
 from skyquill.solvers import PiqpSession
+
+T = TypeVar("T")
 
 
 class Workspace:
@@ -32,6 +37,7 @@ class Workspace:
         self.assembly = AssemblyCache()
         self._sessions: dict[str, PiqpSession] = {}
         self._last: tuple[SmoothingProblem, Assembled] | None = None
+        self._memo: dict[str, tuple[tuple[object, ...], object]] = {}
 
     def session(self, route: str) -> PiqpSession:
         """The PIQP session of a QP route (``"qp"``, ``"relaxed"``): one sparsity pattern each."""
@@ -44,6 +50,21 @@ class Workspace:
         asm = assemble(problem, self.assembly)
         self._last = (problem, asm)
         return asm
+
+    def memo(self, name: str, keys: tuple[object, ...], build: Callable[[], T]) -> T:
+        """``build()``, re-used while ``keys`` are the very objects of the last call.
+
+        For matrices derived from assembly blocks that :class:`AssemblyCache`
+        hands out again unchanged (the same objects): identity is the exact
+        key, and the memo holds the keys, so they cannot be recycled.
+        """
+        held = self._memo.get(name)
+        same = held is not None and len(held[0]) == len(keys)
+        if held is not None and same and all(a is b for a, b in zip(held[0], keys, strict=True)):
+            return held[1]  # type: ignore[return-value]
+        value = build()
+        self._memo[name] = (keys, value)
+        return value
 
     @property
     def sessions(self) -> dict[str, PiqpSession]:

@@ -41,19 +41,33 @@ class _Data:
     G: sp.csc_matrix | None
     h_l: FloatArray | None
     h_u: FloatArray | None
+    #: The program's own ``A_eq`` and ``G``, to recognise them when they come again.
+    sources: tuple[object, object]
 
     @classmethod
-    def of(cls, qp: QuadraticProgram) -> _Data:
+    def of(cls, qp: QuadraticProgram, last: _Data | None) -> _Data:
+        """PIQP's arguments for ``qp``; ``A_eq`` and ``G`` taken over from ``last`` when the
+        program brings the very same matrices (a workspace hands them out again)."""
         rows = qp.h.size > 0
         lower = qp.h_lower if rows and qp.h_lower is not None else None
+        A, G = None, None
+        if last is not None and last.sources[0] is qp.A_eq:
+            A = last.A
+        elif qp.b_eq.size:
+            A = sp.csc_matrix(qp.A_eq)
+        if last is not None and last.sources[1] is qp.G:
+            G = last.G
+        elif rows:
+            G = sp.csc_matrix(qp.G)
         return cls(
             sp.csc_matrix(qp.P),
             qp.q,
-            sp.csc_matrix(qp.A_eq) if qp.b_eq.size else None,
+            A,
             qp.b_eq if qp.b_eq.size else None,
-            sp.csc_matrix(qp.G) if rows else None,
+            G,
             lower,
             qp.h if rows else None,
+            (qp.A_eq, qp.G),
         )
 
     def same_pattern(self, other: _Data) -> bool:
@@ -89,6 +103,8 @@ class _Data:
 
 
 def _same_pattern(a: sp.csc_matrix | None, b: sp.csc_matrix | None) -> bool:
+    if a is b:
+        return True
     if a is None or b is None:
         return a is None and b is None
     return (
@@ -116,7 +132,7 @@ class PiqpSession:
     def solve(self, qp: QuadraticProgram, tol: float) -> QPSolution:
         """Solve ``qp``; ``tol`` sets PIQP's absolute and relative tolerances."""
         start = time.perf_counter()
-        data = _Data.of(qp)
+        data = _Data.of(qp, self._data)
         if self._data is not None and tol == self._tol and self._data.same_pattern(data):
             changes = self._data.changes(data)
             if changes:

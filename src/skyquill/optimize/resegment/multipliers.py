@@ -90,7 +90,7 @@ def multipliers(result: FitResult, workspace: Workspace | None = None) -> Multip
     # missions pickle across processes.
     asm = workspace.assemble(problem) if workspace is not None else assemble(problem)
     # The QP the solve handed its backend (h tightened by the margin it needed).
-    qp = _to_qp(asm, result.margin)
+    qp = _to_qp(asm, result.margin, workspace)
     C, cost = result.trajectory.control_points, result.cost
     x, y, z = C.ravel(), result.y, result.z
     cone_z = result.cone_z if result.cone_z is not None else np.zeros(0)
@@ -103,7 +103,8 @@ def multipliers(result: FitResult, workspace: Workspace | None = None) -> Multip
             if polished.cone_z is not None:
                 cone_z = polished.cone_z
             C = x.reshape(C.shape)
-            cost = problem_cost(problem, C)["total"]
+            cache = workspace.assembly if workspace is not None else None
+            cost = problem_cost(problem, C, cache)["total"]
     orders, cone_orders = _row_orders(problem, asm)
     A_c = qp.cones.A if qp.cones is not None else None
     quad = qp.P @ x
