@@ -309,7 +309,7 @@ def _to_qp(
         held = asm.cones
         cones = memo(f"cones {margin!r}", (held,), lambda: _second_order_cones(held, margin))
     return QuadraticProgram(
-        P=sp.csc_array(2.0 * asm.hessian()),
+        P=memo("P", (asm.G_axis, asm.G_coupled), lambda: _hessian(asm, workspace)),
         q=asm.linear(),
         A_eq=memo("A_eq", (asm.E,), lambda: sp.csc_array(sp.kron(asm.E, sp.eye_array(d)))),
         b_eq=asm.e.ravel(),
@@ -317,6 +317,13 @@ def _to_qp(
         h=asm.h_ineq - margin * np.maximum(np.abs(asm.h_ineq), 1e-3),
         cones=cones,
     )
+
+
+def _hessian(asm: Assembled, workspace: Workspace | None) -> sp.csc_array:
+    """The QP's ``P = 2 H`` (CSC); separable ``H = G_axis (x) I_d`` through the workspace."""
+    if workspace is None or asm.G_coupled is not None:
+        return sp.csc_array(2.0 * asm.hessian())
+    return workspace.kron_eye(sp.csr_array(2.0 * asm.G_axis), asm.F.shape[1])
 
 
 def _second_order_cones(

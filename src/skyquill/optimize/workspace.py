@@ -23,6 +23,9 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import TypeVar
 
+import numpy as np
+import scipy.sparse as sp
+
 from skyquill.optimize.assemble import Assembled, AssemblyCache, assemble
 from skyquill.optimize.problem import SmoothingProblem
 from skyquill.solvers import PiqpSession
@@ -38,6 +41,7 @@ class Workspace:
         self._sessions: dict[str, PiqpSession] = {}
         self._last: tuple[SmoothingProblem, Assembled] | None = None
         self._memo: dict[str, tuple[tuple[object, ...], object]] = {}
+        self._kron: tuple[sp.csr_array, int, sp.csc_array] | None = None
 
     def session(self, route: str) -> PiqpSession:
         """The PIQP session of a QP route (``"qp"``, ``"relaxed"``): one sparsity pattern each."""
@@ -65,6 +69,31 @@ class Workspace:
         value = build()
         self._memo[name] = (keys, value)
         return value
+
+    def kron_eye(self, A: sp.csr_array, d: int) -> sp.csc_array:
+        """``kron(A, I_d)`` (CSC) of a canonical CSR ``A``, shape (M d, M d).
+
+        The Hessians of one re-segmentation share their sparsity pattern (the
+        band of the basis); the Kronecker product's pattern, and where each of
+        its entries comes from in ``A.data``, are computed once by scipy's
+        ``kron`` on the entry numbers and re-used while the pattern holds.
+        """
+        A = sp.csr_array(A)
+        A.sum_duplicates()  # canonical: the pattern then says where each entry is
+        held = self._kron
+        if not (
+            held is not None
+            and held[1] == d
+            and held[0].shape == A.shape
+            and np.array_equal(held[0].indptr, A.indptr)
+            and np.array_equal(held[0].indices, A.indices)
+        ):
+            numbers = sp.csr_array((np.arange(1.0, A.nnz + 1.0), A.indices, A.indptr), A.shape)
+            held = (A, d, sp.kron(numbers, sp.eye_array(d), format="csc"))
+            self._kron = held
+        where = held[2]
+        source = where.data.astype(np.intp) - 1
+        return sp.csc_array((A.data[source], where.indices, where.indptr), shape=where.shape)
 
     @property
     def sessions(self) -> dict[str, PiqpSession]:

@@ -20,6 +20,7 @@ other limit a family of rows of ``G_ineq``, in the order of
 from __future__ import annotations
 
 import logging
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -28,7 +29,7 @@ from skyquill.limits import NormLimit
 from skyquill.optimize.assemble import Assembled, assemble, problem_cost
 from skyquill.optimize.problem import SmoothingProblem
 from skyquill.optimize.resegment.polish import polish
-from skyquill.optimize.solve import FitResult, _to_qp
+from skyquill.optimize.solve import FitResult, _closed_form_kkt, _to_qp
 from skyquill.optimize.workspace import Workspace
 from skyquill.validation import FloatArray
 
@@ -95,7 +96,7 @@ def multipliers(result: FitResult, workspace: Workspace | None = None) -> Multip
     x, y, z = C.ravel(), result.y, result.z
     cone_z = result.cone_z if result.cone_z is not None else np.zeros(0)
     if result.method == "qp":
-        polished = polish(qp, x, z, result.cone_z)
+        polished = polish(qp, x, z, result.cone_z, equality_solve=_equality_solve(asm))
         if polished is None:
             log.debug("no polished point; using the solver's point and duals")
         else:
@@ -128,6 +129,18 @@ def multipliers(result: FitResult, workspace: Workspace | None = None) -> Multip
         residual,
         cost,
     )
+
+
+def _equality_solve(asm: Assembled) -> Callable[[], tuple[FloatArray, FloatArray]] | None:
+    """The per-axis closed form of ``asm`` for :func:`polish` when nothing is held."""
+    if not asm.separable:
+        return None
+
+    def solve_per_axis() -> tuple[FloatArray, FloatArray]:
+        C, y = _closed_form_kkt(asm)
+        return C.ravel(), y
+
+    return solve_per_axis
 
 
 def _row_orders(problem: SmoothingProblem, asm: Assembled) -> tuple[FloatArray, FloatArray]:
