@@ -27,12 +27,17 @@ def _same(fresh: FitResult, reused: FitResult, rtol: float = 1e-8) -> None:
     a, b = fresh.trajectory.control_points, reused.trajectory.control_points
     assert np.abs(a - b).max() <= rtol * np.abs(a).max()
     assert reused.cost == pytest.approx(fresh.cost, rel=rtol)
-    assert reused.method == fresh.method
-    assert reused.margin == fresh.margin
+    assert reused.n_inequalities == fresh.n_inequalities
+    assert reused.z.shape == fresh.z.shape
+    if reused.method == "closed_form":  # nothing binds: all inequality multipliers 0
+        assert not np.any(reused.z) and reused.solver == "sparse-lu"
+        assert reused.verification.max_excess == 0.0
+    else:
+        assert (reused.method, reused.margin) == (fresh.method, fresh.margin)
 
 
-# The limits: loose exact norms (the box relaxation answers, PIQP), per-axis
-# boxes that bind (the linear QP, PIQP), no limits (the closed form).
+# The limits: loose exact norms (the closed form meets them; fresh: the box
+# relaxation, PIQP), per-axis boxes that bind (the linear QP, PIQP), no limits.
 LIMITS = {
     "relaxed cones": lambda: vehicle_limits(3, 50.0, 200.0, 2000.0),
     "binding boxes": lambda: (BoxLimit.symmetric(2, 0.4, 3), BoxLimit.symmetric(3, 2.0, 3)),
@@ -56,9 +61,11 @@ def test_reused_solves_equal_fresh_solves_along_a_time_sequence(kind: str) -> No
         _same(fresh, solve(problem, workspace=workspace))
         _same(fresh, solve(problem, workspace=workspace))  # the same problem twice
     assert workspace.assembly.hits == 3  # the repeats re-use the whole assembly
-    if kind != "none":
+    if kind == "binding boxes":
         (session,) = workspace.sessions.values()
         assert (session.setups, session.updates) == (1, 7)
+    else:  # loose limits: the equality-only minimiser meets them, no QP at all
+        assert not workspace.sessions
 
 
 def test_the_first_problem_solved_again_after_others_is_unchanged() -> None:
@@ -99,3 +106,18 @@ def test_the_workspace_hands_the_solved_assembly_to_the_gradient() -> None:
     workspace = Workspace()
     solve(problem, workspace=workspace)
     assert workspace.assemble(problem) is workspace.assemble(problem)
+
+
+def test_loose_cones_that_bind_on_the_second_problem_go_to_the_qp() -> None:
+    """The closed form first, then a problem where it breaks a limit: the QP decides."""
+    pts, times = _points(12, 3)
+    loose = solve(point_fit_factory(pts, 20)(times))
+    peak = float(np.linalg.norm(loose.trajectory.sample(400.0).a, axis=1).max())
+    workspace = Workspace()
+    limits = (NormLimit(2, 2.0 * peak, dim=3),)
+    first = solve(point_fit_factory(pts, 20, limits=limits)(times), workspace=workspace)
+    faster = point_fit_factory(pts, 20, limits=limits)(0.5 * times)
+    second = solve(faster, workspace=workspace)
+    assert first.method == "closed_form"
+    assert second.method == "qp"
+    _same(solve(faster), second)

@@ -77,6 +77,8 @@ class FitResult:
         The B-spline trajectory.
     method
         ``"closed_form"`` or ``"qp"`` (also for the conic program of exact norm limits).
+        With a workspace, also ``"closed_form"`` for a problem with
+        inequalities that its equality-only minimiser meets (:func:`solve`).
     solver
         ``"sparse-lu"`` or the QP backend's name.
     cost
@@ -167,8 +169,14 @@ def solve(
     workspace
         Shared with the other solves of a sequence of related problems
         (re-segmentation): re-used assembly blocks and PIQP setups
-        (:class:`~skyquill.optimize.workspace.Workspace`). The result is the
-        fresh solve's, to the backend's tolerance.
+        (:class:`~skyquill.optimize.workspace.Workspace`). With a workspace a
+        problem with inequalities is first solved subject to its equalities
+        alone (the closed form, one per-axis factorisation): when that point
+        meets every limit, corridor and cone exactly it is the optimum (of a
+        relaxation, and feasible), with all inequality multipliers 0, and is
+        returned as ``method="closed_form"`` (a writing mission's
+        re-segmentation at its default limits, where nothing binds). Either
+        way the result is the fresh solve's, to the backend's tolerance.
 
     Raises
     ------
@@ -181,9 +189,13 @@ def solve(
     if solver not in BACKENDS:
         raise InputError(f"solver: got {solver!r}, expected one of {sorted(BACKENDS)}")
     start = time.perf_counter()
-    if problem.has_inequalities:
+    inside = _inside_optimum(problem, workspace) if workspace is not None else None
+    if inside is not None:
+        C, (y, z, cone_z), used, margin, asm = inside
+        method: Literal["closed_form", "qp"] = "closed_form"
+    elif problem.has_inequalities:
         C, (y, z, cone_z), used, margin, asm = _solve_qp(problem, solver, workspace)
-        method: Literal["closed_form", "qp"] = "qp"
+        method = "qp"
     else:
         asm = workspace.assemble(problem) if workspace is not None else assemble(problem)
         (C, y), z, used, margin = _closed_form(asm), np.zeros(0), "sparse-lu", 0.0
@@ -209,6 +221,33 @@ def solve(
         n_cones=asm.cones.radius.size if asm.cones is not None else 0,
         cone_z=cone_z,
     )
+
+
+def _inside_optimum(problem: SmoothingProblem, workspace: Workspace) -> _Solved | None:
+    """The minimiser subject to the equalities, if it meets every inequality exactly.
+
+    A relaxation's optimum that is feasible is optimal, and no inequality
+    holds it, so every inequality and cone multiplier is 0. Exactly: ``G x <=
+    h`` and ``||v_p|| <= r_p`` without tolerance, so the guarantee's excess is
+    0. ``None`` without inequalities, when one is not met, or when the
+    equalities alone do not determine the point (the QP route decides).
+    """
+    if not problem.has_inequalities:
+        return None
+    asm = workspace.assemble(problem)
+    try:
+        C, y = _closed_form_kkt(asm)
+    except SingularKKTError:
+        return None
+    x = C.ravel()
+    if np.any(asm.G_ineq @ x > asm.h_ineq):
+        return None
+    cone_z = None
+    if asm.cones is not None:
+        if np.any(asm.cones.norms(x) > asm.cones.radius):
+            return None
+        cone_z = np.zeros(asm.cones.radius.size * (problem.dim + 1))
+    return C, (y, np.zeros(asm.G_ineq.shape[0]), cone_z), "sparse-lu", 0.0, asm
 
 
 def _closed_form(asm: Assembled) -> tuple[FloatArray, FloatArray]:
