@@ -11,6 +11,7 @@ from resegment_cases import limited_spiral, spiral
 from skyquill.errors import InputError
 from skyquill.optimize import solve
 from skyquill.optimize.resegment import point_fit_factory, resegment, time_gradient
+from skyquill.optimize.workspace import Workspace
 
 
 # ------------------------------------------------------------------ descent
@@ -119,3 +120,16 @@ def test_a_solve_at_other_times_is_not_taken_as_the_first_iterate() -> None:
         resegment(pts, times, make, initial_result=other)
     with pytest.raises(InputError, match="make_problem: got duration"):
         resegment(pts, times, make, initial_result=solve(make(2.0 * times)))
+
+
+def test_a_callers_workspace_carries_its_setup_into_the_run() -> None:
+    pts, times, make = limited_spiral(24, 18, 8)
+    workspace = Workspace()
+    first = solve(make(times), workspace=workspace)
+    own = resegment(pts, times, make, mode="fixed", max_iter=4, initial_result=first)
+    shared = resegment(
+        pts, times, make, mode="fixed", max_iter=4, initial_result=first, workspace=workspace
+    )
+    assert workspace.assembly.hits >= shared.n_solves  # every solve re-used the blocks
+    a, b = own.result.trajectory.control_points, shared.result.trajectory.control_points
+    assert np.abs(a - b).max() <= 1e-8 * np.abs(a).max()

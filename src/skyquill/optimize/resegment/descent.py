@@ -172,6 +172,7 @@ def resegment(
     step_rule: Literal["bb", "double"] = "bb",
     solver: str = DEFAULT_BACKEND,
     initial_result: FitResult | None = None,
+    workspace: Workspace | None = None,
 ) -> ResegmentResult:
     """Re-segment the point times by gradient descent (paper 000 §5.4).
 
@@ -217,6 +218,11 @@ def resegment(
         as the first iterate instead of solving the same problem again. Its
         problem must be made for ``times`` (checked: duration, control points,
         point-deviation times).
+    workspace
+        Shared by every solve and gradient of the run
+        (:class:`~skyquill.optimize.workspace.Workspace`); a fresh one if
+        ``None``. A caller that solved the first problem with a workspace
+        passes it on, so that the run starts from its assembly and PIQP setup.
 
     Returns
     -------
@@ -244,7 +250,17 @@ def resegment(
     if make_problem is None:
         make_problem = point_fit_factory(pts, pts.shape[0] + 5)
     search, res = _start(
-        _Search(make_problem, mode, rho, solver, float(t[-1]), 0), t, initial_result
+        _Search(
+            make_problem,
+            mode,
+            rho,
+            solver,
+            float(t[-1]),
+            0,
+            workspace=workspace if workspace is not None else Workspace(),
+        ),
+        t,
+        initial_result,
     )
     T = np.diff(t)
     F = search.objective(t, res)
