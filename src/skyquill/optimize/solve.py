@@ -240,7 +240,7 @@ def _inside_optimum(problem: SmoothingProblem, workspace: Workspace) -> _Solved 
     except SingularKKTError:
         return None
     x = C.ravel()
-    if np.any(asm.G_ineq @ x > asm.h_ineq):
+    if not np.all(np.isfinite(x)) or np.any(asm.G_ineq @ x > asm.h_ineq):
         return None
     cone_z = None
     if asm.cones is not None:
