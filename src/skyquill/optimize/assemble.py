@@ -103,23 +103,138 @@ class Assembled:
         return f + self.f_coupled if self.f_coupled is not None else f
 
 
-def assemble(problem: SmoothingProblem) -> Assembled:
-    """Build the matrices of ``problem`` (validated)."""
-    basis = problem.basis
-    alpha = problem.alpha
-    M, d = problem.n_ctrl, problem.dim
+@dataclass(frozen=True)
+class _Fixed:
+    """The blocks of an assembly that the point times leave alone (:class:`AssemblyCache`)."""
 
+    smooth: sp.csr_array  # (M, M): the smoothness Gram matrices
+    boundary: tuple[list[FloatArray], list[FloatArray], dict[float, FloatArray]]
+    E: sp.csr_array  # (m_b, M): the boundary rows alone
+    e: FloatArray  # (m_b, d)
+    G_ineq: sp.csr_array
+    h_ineq: FloatArray
+    families: tuple[InequalityFamily, ...]
+    cones: NormCones | None
+
+
+class AssemblyCache:
+    """Re-use the blocks that stay the same across a sequence of assemblies.
+
+    Re-segmentation assembles a dozen problems per plan that differ only in
+    the point times: the smoothness Gram matrices, the boundary rows, the
+    limit and corridor rows and the cones depend on the knots, ``alpha`` and
+    the terms themselves, not on the times, and with the total time fixed
+    they come out bit-identical every time. The cache keeps the last set,
+    keyed on exactly what they are built from (degree, control points,
+    ``alpha``, hull, dimension, smoothness weights, and the values of the
+    boundary, limit and corridor terms), so a problem that differs in any of
+    those is assembled afresh. One cache belongs to one sequence of solves
+    (:class:`skyquill.optimize.workspace.Workspace`); there is no global state.
+    """
+
+    def __init__(self) -> None:
+        self._key: tuple[object, ...] | None = None
+        self._fixed: _Fixed | None = None
+        self._design: dict[tuple[object, ...], tuple[FloatArray, sp.csr_array]] = {}
+        #: How often the blocks were re-used (for tests and benchmarks).
+        self.hits = 0
+
+    def design_matrix(
+        self, problem: SmoothingProblem, times: FloatArray, order: int = 0
+    ) -> sp.csr_array:
+        """The basis rows (derivative ``order`` in ``s``) at a term's ``times``, shape (N, M).
+
+        The assembly, the cost and the time gradient of one problem each need
+        them; they are kept for the very ``times`` array (held, so identity is
+        exact) at the same knots and ``alpha``, for the last few terms.
+        """
+        key = (id(times), problem.alpha, problem.degree, problem.n_ctrl, order)
+        held = self._design.get(key)
+        if held is not None and held[0] is times:
+            return held[1]
+        if len(self._design) >= _DESIGN_ENTRIES:
+            self._design.clear()
+        matrix = problem.basis.design_matrix(_params(problem, times), order)
+        self._design[key] = (times, matrix)
+        return matrix
+
+    def fixed(self, problem: SmoothingProblem) -> _Fixed:
+        """The time-independent blocks of ``problem``, built or re-used."""
+        key = _fixed_key(problem)
+        if self._fixed is not None and key == self._key:
+            self.hits += 1
+            return self._fixed
+        self._key, self._fixed = key, _build_fixed(problem)
+        return self._fixed
+
+
+#: Design matrices an :class:`AssemblyCache` keeps (a few terms of one or two problems).
+_DESIGN_ENTRIES = 16
+
+
+def design_matrix(
+    problem: SmoothingProblem, times: FloatArray, order: int = 0, cache: AssemblyCache | None = None
+) -> sp.csr_array:
+    """Basis rows of derivative ``order`` (in ``s``) at ``times`` (s), through ``cache`` if any."""
+    if cache is not None:
+        return cache.design_matrix(problem, times, order)
+    return problem.basis.design_matrix(_params(problem, times), order)
+
+
+def _fingerprint(value: object) -> object:
+    """A hashable, exact (bitwise for arrays) stand-in for a problem term."""
+    if isinstance(value, np.ndarray):
+        return (value.shape, value.dtype.str, value.tobytes())
+    if isinstance(value, tuple | list):
+        return tuple(_fingerprint(v) for v in value)
+    if hasattr(value, "__dataclass_fields__"):
+        names = value.__dataclass_fields__
+        return (type(value).__name__, *(_fingerprint(getattr(value, n)) for n in names))
+    return value
+
+
+def _fixed_key(problem: SmoothingProblem) -> tuple[object, ...]:
+    return (
+        problem.dim,
+        problem.degree,
+        problem.n_ctrl,
+        problem.alpha,
+        problem.hull,
+        tuple(sorted(problem.smoothness.items())),
+        _fingerprint(problem.boundary),
+        _fingerprint(problem.limits),
+        _fingerprint(problem.corridors),
+    )
+
+
+def _build_fixed(problem: SmoothingProblem) -> _Fixed:
+    basis, alpha, M = problem.basis, problem.alpha, problem.n_ctrl
     smooth = [
         sigma * alpha ** (2 * order - 1) * basis.gram(order)
         for order, sigma in problem.smoothness.items()
         if sigma
     ]
-    G_axis = sp.csr_array(sum(smooth[1:], smooth[0]) if smooth else sp.csr_array((M, M)))
+    G_smooth = sp.csr_array(sum(smooth[1:], smooth[0]) if smooth else sp.csr_array((M, M)))
+    G_ineq, h_ineq, families = _inequalities(problem)
+    boundary = _boundary_rows(problem)
+    E, e = _stack_equalities(problem, [np.array(boundary[0])] if boundary[0] else [], boundary[1])
+    return _Fixed(G_smooth, boundary, E, e, G_ineq, h_ineq, families, _cones(problem))
+
+
+def assemble(problem: SmoothingProblem, cache: AssemblyCache | None = None) -> Assembled:
+    """Build the matrices of ``problem`` (validated).
+
+    ``cache`` re-uses the blocks the point times do not change from the
+    previous assembly when they would come out the same (:class:`AssemblyCache`).
+    """
+    M, d = problem.n_ctrl, problem.dim
+    fixed = cache.fixed(problem) if cache is not None else _build_fixed(problem)
+    G_axis = fixed.smooth
     F = np.zeros((M, d))
     coupled: list[tuple[sp.csr_array, FloatArray]] = []
     for term in problem.deviations:
         if isinstance(term, PointDeviation):
-            H = basis.design_matrix(_params(problem, term.times))
+            H = design_matrix(problem, term.times, 0, cache)
             G_axis = G_axis + term.weight * (H.T @ H)
             F -= 2.0 * term.weight * (H.T @ term.points)
         else:
@@ -132,9 +247,9 @@ def assemble(problem: SmoothingProblem) -> Assembled:
     diagonal = G_axis.diagonal().max(initial=0.0)
     if G_coupled is not None:
         diagonal = max(diagonal, G_coupled.diagonal().max(initial=0.0))
-    E, e = _equalities(problem)
-    G_ineq, h_ineq, families = _inequalities(problem)
-    cones = _cones(problem)
+    # Without interpolated points the rows are the boundary's: the same objects
+    # every time, which lets the solve re-use what it derives from them.
+    E, e = _equalities(problem, fixed.boundary) if problem.interpolation else (fixed.E, fixed.e)
     return Assembled(
         1.0 / diagonal if diagonal > 0 else 1.0,
         sp.csr_array(G_axis),
@@ -143,19 +258,22 @@ def assemble(problem: SmoothingProblem) -> Assembled:
         f_coupled,
         E,
         e,
-        G_ineq,
-        h_ineq,
-        families,
-        cones,
+        fixed.G_ineq,
+        fixed.h_ineq,
+        fixed.families,
+        fixed.cones,
     )
 
 
-def problem_cost(problem: SmoothingProblem, C: FloatArray) -> dict[str, float]:
+def problem_cost(
+    problem: SmoothingProblem, C: FloatArray, cache: AssemblyCache | None = None
+) -> dict[str, float]:
     """Cost of control points ``C`` (M, d), term by term: ``smoothness``, ``deviation``, ``total``.
 
     Smoothness is ``sum_n sigma_n alpha^(2n-1) sum_j D_j' W_n D_j`` on the
     derivative control points ``D = Gamma_n C`` (eq. 8-10), deviations are the
     residuals themselves (eq. 11, 25, 27): no cancellation of large terms.
+    ``cache`` re-uses the design matrices of the assembly.
     """
     basis, alpha = problem.basis, problem.alpha
     smooth = 0.0
@@ -166,7 +284,7 @@ def problem_cost(problem: SmoothingProblem, C: FloatArray) -> dict[str, float]:
     deviation = 0.0
     for term in problem.deviations:
         if isinstance(term, PointDeviation):
-            residual = basis.design_matrix(_params(problem, term.times)) @ C - term.points
+            residual = design_matrix(problem, term.times, 0, cache) @ C - term.points
             deviation += term.weight * float(np.sum(residual**2))
         else:
             Q, w = term.quadratic()
@@ -217,16 +335,14 @@ def _flat_term(
     return sp.csr_array(G), f
 
 
-def _equalities(problem: SmoothingProblem) -> tuple[sp.csr_array, FloatArray]:
-    """Boundary conditions (eq. 42) and interpolated points (eq. 13), per axis.
+def _boundary_rows(
+    problem: SmoothingProblem,
+) -> tuple[list[FloatArray], list[FloatArray], dict[float, FloatArray]]:
+    """Boundary rows (eq. 42) in ``s``, their right-hand sides, and the fixed end positions.
 
     Derivative rows are in ``s``: ``Gamma_n C = value / alpha^n`` (O(1) rows).
-    An interpolated point at ``t = 0`` or ``t = duration`` where the boundary
-    already fixes the position repeats that row exactly (both are ``e_0`` or
-    ``e_{M-1}``) and would make the KKT matrix singular: it is dropped if it
-    agrees, and a contradiction raises :class:`InfeasibleError`.
     """
-    basis, alpha, M = problem.basis, problem.alpha, problem.n_ctrl
+    basis, alpha = problem.basis, problem.alpha
     dense_rows: list[FloatArray] = []
     rhs: list[FloatArray] = []
     fixed: dict[float, FloatArray] = {}
@@ -239,7 +355,25 @@ def _equalities(problem: SmoothingProblem) -> tuple[sp.csr_array, FloatArray]:
                 rhs.append(to_s * value[None, :])
                 if bc.order == 0:
                     fixed[float(s_end)] = value
-    blocks = [sp.csr_array(np.array(dense_rows))] if dense_rows else []
+    return dense_rows, rhs, fixed
+
+
+def _equalities(
+    problem: SmoothingProblem,
+    boundary: tuple[list[FloatArray], list[FloatArray], dict[float, FloatArray]],
+) -> tuple[sp.csr_array, FloatArray]:
+    """Boundary conditions (eq. 42, ``boundary`` from :func:`_boundary_rows`) and
+    interpolated points (eq. 13), per axis.
+
+    An interpolated point at ``t = 0`` or ``t = duration`` where the boundary
+    already fixes the position repeats that row exactly (both are ``e_0`` or
+    ``e_{M-1}``) and would make the KKT matrix singular: it is dropped if it
+    agrees, and a contradiction raises :class:`InfeasibleError`.
+    """
+    basis = problem.basis
+    dense_rows, boundary_rhs, fixed = boundary
+    rhs = list(boundary_rhs)
+    blocks: list[FloatArray | sp.csr_array] = [np.array(dense_rows)] if dense_rows else []
     for term in problem.interpolation:
         s = _params(problem, term.times)
         keep = np.ones(s.size, dtype=bool)
@@ -257,9 +391,16 @@ def _equalities(problem: SmoothingProblem) -> tuple[sp.csr_array, FloatArray]:
             keep &= ~repeat
         blocks.append(basis.design_matrix(s[keep]))
         rhs.append(term.points[keep])
+    return _stack_equalities(problem, blocks, rhs)
+
+
+def _stack_equalities(
+    problem: SmoothingProblem, blocks: list[FloatArray | sp.csr_array], rhs: list[FloatArray]
+) -> tuple[sp.csr_array, FloatArray]:
+    """``E`` (m_eq, M) and ``e`` (m_eq, d) from row blocks and their right-hand sides."""
     if not blocks:
-        return sp.csr_array((0, M)), np.zeros((0, problem.dim))
-    return sp.csr_array(sp.vstack(blocks)), np.vstack(rhs)
+        return sp.csr_array((0, problem.n_ctrl)), np.zeros((0, problem.dim))
+    return sp.csr_array(sp.vstack([sp.csr_array(b) for b in blocks])), np.vstack(rhs)
 
 
 def _inequalities(

@@ -32,9 +32,10 @@ from __future__ import annotations
 
 import logging
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 from functools import cached_property
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 import scipy.linalg
@@ -46,6 +47,7 @@ from skyquill.errors import InfeasibleError, InputError, SolverError
 from skyquill.optimize.assemble import Assembled, NormCones, assemble, problem_cost
 from skyquill.optimize.kkt import SingularKKTError, solve_equality_qp
 from skyquill.optimize.problem import SmoothingProblem
+from skyquill.optimize.workspace import Workspace
 from skyquill.solvers import (
     BACKENDS,
     CONIC_BACKENDS,
@@ -75,6 +77,8 @@ class FitResult:
         The B-spline trajectory.
     method
         ``"closed_form"`` or ``"qp"`` (also for the conic program of exact norm limits).
+        With a workspace, also ``"closed_form"`` for a problem with
+        inequalities that its equality-only minimiser meets (:func:`solve`).
     solver
         ``"sparse-lu"`` or the QP backend's name.
     cost
@@ -148,7 +152,12 @@ class FitResult:
         return self.trajectory.verify(self.problem.limits, self.problem.corridors)
 
 
-def solve(problem: SmoothingProblem, solver: str = DEFAULT_BACKEND) -> FitResult:
+def solve(
+    problem: SmoothingProblem,
+    solver: str = DEFAULT_BACKEND,
+    *,
+    workspace: Workspace | None = None,
+) -> FitResult:
     """Solve ``problem``; the result carries its dense check (``verification``).
 
     Parameters
@@ -157,6 +166,17 @@ def solve(problem: SmoothingProblem, solver: str = DEFAULT_BACKEND) -> FitResult
         The validated problem.
     solver
         QP backend for problems with inequalities (see :data:`BACKENDS`).
+    workspace
+        Shared with the other solves of a sequence of related problems
+        (re-segmentation): re-used assembly blocks and PIQP setups
+        (:class:`~skyquill.optimize.workspace.Workspace`). With a workspace a
+        problem with inequalities is first solved subject to its equalities
+        alone (the closed form, one per-axis factorisation): when that point
+        meets every limit, corridor and cone exactly it is the optimum (of a
+        relaxation, and feasible), with all inequality multipliers 0, and is
+        returned as ``method="closed_form"`` (a writing mission's
+        re-segmentation at its default limits, where nothing binds). Either
+        way the result is the fresh solve's, to the backend's tolerance.
 
     Raises
     ------
@@ -169,17 +189,21 @@ def solve(problem: SmoothingProblem, solver: str = DEFAULT_BACKEND) -> FitResult
     if solver not in BACKENDS:
         raise InputError(f"solver: got {solver!r}, expected one of {sorted(BACKENDS)}")
     start = time.perf_counter()
-    if problem.has_inequalities:
-        C, (y, z, cone_z), used, margin, asm = _solve_qp(problem, solver)
-        method: Literal["closed_form", "qp"] = "qp"
+    inside = _inside_optimum(problem, workspace) if workspace is not None else None
+    if inside is not None:
+        C, (y, z, cone_z), used, margin, asm = inside
+        method: Literal["closed_form", "qp"] = "closed_form"
+    elif problem.has_inequalities:
+        C, (y, z, cone_z), used, margin, asm = _solve_qp(problem, solver, workspace)
+        method = "qp"
     else:
-        asm = assemble(problem)
+        asm = workspace.assemble(problem) if workspace is not None else assemble(problem)
         (C, y), z, used, margin = _closed_form(asm), np.zeros(0), "sparse-lu", 0.0
         cone_z = None
         method = "closed_form"
     elapsed = time.perf_counter() - start
     traj = SplineTrajectory(C, problem.degree, problem.duration)
-    terms = problem_cost(problem, C)
+    terms = problem_cost(problem, C, workspace.assembly if workspace is not None else None)
     return FitResult(
         traj,
         method,
@@ -197,6 +221,33 @@ def solve(problem: SmoothingProblem, solver: str = DEFAULT_BACKEND) -> FitResult
         n_cones=asm.cones.radius.size if asm.cones is not None else 0,
         cone_z=cone_z,
     )
+
+
+def _inside_optimum(problem: SmoothingProblem, workspace: Workspace) -> _Solved | None:
+    """The minimiser subject to the equalities, if it meets every inequality exactly.
+
+    A relaxation's optimum that is feasible is optimal, and no inequality
+    holds it, so every inequality and cone multiplier is 0. Exactly: ``G x <=
+    h`` and ``||v_p|| <= r_p`` without tolerance, so the guarantee's excess is
+    0. ``None`` without inequalities, when one is not met, or when the
+    equalities alone do not determine the point (the QP route decides).
+    """
+    if not problem.has_inequalities:
+        return None
+    asm = workspace.assemble(problem)
+    try:
+        C, y = _closed_form_kkt(asm)
+    except SingularKKTError:
+        return None
+    x = C.ravel()
+    if not np.all(np.isfinite(x)) or np.any(asm.G_ineq @ x > asm.h_ineq):
+        return None
+    cone_z = None
+    if asm.cones is not None:
+        if np.any(asm.cones.norms(x) > asm.cones.radius):
+            return None
+        cone_z = np.zeros(asm.cones.radius.size * (problem.dim + 1))
+    return C, (y, np.zeros(asm.G_ineq.shape[0]), cone_z), "sparse-lu", 0.0, asm
 
 
 def _closed_form(asm: Assembled) -> tuple[FloatArray, FloatArray]:
@@ -277,22 +328,41 @@ def _closed_form_kkt(asm: Assembled) -> tuple[FloatArray, FloatArray]:
     return sol.x.reshape(M, d), sol.y
 
 
-def _to_qp(asm: Assembled, margin: float = 0.0) -> QuadraticProgram:
+def _to_qp(
+    asm: Assembled, margin: float = 0.0, workspace: Workspace | None = None
+) -> QuadraticProgram:
     """The QP of ``asm``, every inequality tightened by ``margin * max(|h|, 1e-3)``.
 
     The margin keeps a solver's feasibility tolerance from leaving the result
     outside a limit it was asked to hold; cone radii shrink the same way.
+    ``workspace`` re-uses the equality rows, inequality rows and cones derived
+    from the same assembly blocks (what the times leave alone).
     """
     d = asm.F.shape[1]
+
+    def memo(name: str, keys: tuple[object, ...], build: Callable[[], Any]) -> Any:
+        return workspace.memo(name, keys, build) if workspace is not None else build()
+
+    cones = None
+    if asm.cones is not None:
+        held = asm.cones
+        cones = memo(f"cones {margin!r}", (held,), lambda: _second_order_cones(held, margin))
     return QuadraticProgram(
-        P=sp.csc_array(2.0 * asm.hessian()),
+        P=memo("P", (asm.G_axis, asm.G_coupled), lambda: _hessian(asm, workspace)),
         q=asm.linear(),
-        A_eq=sp.csc_array(sp.kron(asm.E, sp.eye_array(d))),
+        A_eq=memo("A_eq", (asm.E,), lambda: sp.csc_array(sp.kron(asm.E, sp.eye_array(d)))),
         b_eq=asm.e.ravel(),
-        G=sp.csc_array(asm.G_ineq),
+        G=memo("G", (asm.G_ineq,), lambda: sp.csc_array(asm.G_ineq)),
         h=asm.h_ineq - margin * np.maximum(np.abs(asm.h_ineq), 1e-3),
-        cones=_second_order_cones(asm.cones, margin) if asm.cones is not None else None,
+        cones=cones,
     )
+
+
+def _hessian(asm: Assembled, workspace: Workspace | None) -> sp.csc_array:
+    """The QP's ``P = 2 H`` (CSC); separable ``H = G_axis (x) I_d`` through the workspace."""
+    if workspace is None or asm.G_coupled is not None:
+        return sp.csc_array(2.0 * asm.hessian())
+    return workspace.kron_eye(sp.csr_array(2.0 * asm.G_axis), asm.F.shape[1])
 
 
 def _second_order_cones(
@@ -332,11 +402,12 @@ def _hull_excess(asm: Assembled, x: FloatArray) -> float:
 _Solved = tuple[FloatArray, tuple[FloatArray, FloatArray, FloatArray | None], str, float, Assembled]
 
 
-def _solve_qp(problem: SmoothingProblem, solver: str) -> _Solved:
+def _solve_qp(problem: SmoothingProblem, solver: str, workspace: Workspace | None) -> _Solved:
     """Control points, the duals ``(y, z, cone_z)`` of the same (tightened) QP, backend, margin."""
-    exact = assemble(problem)
+    exact = workspace.assemble(problem) if workspace is not None else assemble(problem)
+    session = workspace.session("qp") if workspace is not None else None
     if exact.cones is not None:
-        relaxed = _relaxed(problem, exact, solver)
+        relaxed = _relaxed(problem, exact, workspace)
         if relaxed is not None:
             return relaxed
         backends = list(CONIC_BACKENDS)
@@ -344,9 +415,9 @@ def _solve_qp(problem: SmoothingProblem, solver: str) -> _Solved:
         backends = [solver, *(b for b in ("clarabel", "piqp") if b != solver)]
     failures: list[str] = []
     for margin in _MARGINS:
-        qp = _to_qp(exact, margin)
+        qp = _to_qp(exact, margin, workspace)
         for backend in backends:
-            sol = solve_qp(qp, backend)
+            sol = solve_qp(qp, backend, session=session)
             if sol.status == "infeasible":
                 _raise_infeasible(problem, exact)
             if sol.status == "optimal" and sol.x is not None:
@@ -370,7 +441,7 @@ def _solve_qp(problem: SmoothingProblem, solver: str) -> _Solved:
 
 
 def _relaxed(
-    problem: SmoothingProblem, exact: Assembled, solver: str
+    problem: SmoothingProblem, exact: Assembled, workspace: Workspace | None
 ) -> (
     tuple[FloatArray, tuple[FloatArray, FloatArray, FloatArray | None], str, float, Assembled]
     | None
@@ -378,38 +449,52 @@ def _relaxed(
     """The conic program's optimum from a QP, when the norm limits turn out not to bind.
 
     Every ball ``||v_p|| <= r_p`` is replaced by its circumscribing box
-    ``|v_p,i| <= r_p``: a relaxation, solved by the (faster) QP backend. If its
-    solution meets every ball to the guarantee tolerance it is the conic
-    program's optimum (a relaxation's optimum that is feasible is optimal), and
-    if no box row is active the dropped rows carry no multiplier, so the duals
-    are the conic program's too (cone duals 0). Writing at the default limits
-    is such a case: nothing binds, and a Clarabel solve takes ~2x a PIQP one.
-    Returns None when a ball or a box binds (then the cones are needed).
+    ``-r_p <= v_p,i <= r_p``: a relaxation, solved by the (faster) QP backend,
+    one two-sided row per component. If its solution meets every ball to the
+    guarantee tolerance it is the conic program's optimum (a relaxation's
+    optimum that is feasible is optimal), and if no box row is active the
+    dropped rows carry no multiplier, so the duals are the conic program's too
+    (cone duals 0). Writing at the default limits is such a case: nothing
+    binds, and a Clarabel solve takes ~2x a PIQP one. Returns None when a ball
+    or a box binds (then the cones are needed).
     """
     assert exact.cones is not None
-    cones = exact.cones
-    d = cones.map.shape[0] // cones.radius.size
-    bound = np.repeat(cones.radius, d)
-    box = sp.csr_array(sp.vstack([cones.map, -cones.map]))
-    relaxed = replace(
-        exact,
-        G_ineq=sp.csr_array(sp.vstack([exact.G_ineq, box])),
-        h_ineq=np.concatenate([exact.h_ineq, bound, bound]),
-        cones=None,
-    )
     margin = _MARGINS[0]
-    sol = solve_qp(_to_qp(relaxed, margin), DEFAULT_BACKEND)
+    qp = _relaxed_qp(exact, margin, workspace)
+    session = workspace.session("relaxed") if workspace is not None else None
+    sol = solve_qp(qp, DEFAULT_BACKEND, session=session)
     if sol.status != "optimal" or sol.x is None or sol.y is None or sol.z is None:
         return None
     if _hull_excess(exact, sol.x) > GUARANTEE_RTOL:
         return None  # a ball is violated: the norm limit binds
-    slack = np.concatenate([bound, bound]) - box @ sol.x
-    if np.any(slack <= 1e-6 * np.maximum(np.concatenate([bound, bound]), 1e-3)):
+    bound = np.repeat(exact.cones.radius, problem.dim)
+    slack = bound - np.abs(exact.cones.map @ sol.x)
+    if np.any(slack <= 1e-6 * np.maximum(bound, 1e-3)):
         return None  # a box row binds: its multiplier would be lost
     C = sol.x.reshape(problem.n_ctrl, problem.dim)
     m = exact.G_ineq.shape[0]
-    cone_z = np.zeros(cones.radius.size * (d + 1))
+    cone_z = np.zeros(exact.cones.radius.size * (problem.dim + 1))
     return C, (sol.y, sol.z[:m], cone_z), sol.solver, margin, exact
+
+
+def _relaxed_qp(exact: Assembled, margin: float, workspace: Workspace | None) -> QuadraticProgram:
+    """The QP of ``exact`` with its cones replaced by two-sided box rows (:func:`_relaxed`)."""
+    cones = exact.cones
+    assert cones is not None
+    linear = _to_qp(replace(exact, cones=None), margin, workspace)
+    bound = np.repeat(cones.radius, exact.F.shape[1])
+    tight = bound - margin * np.maximum(bound, 1e-3)
+
+    def rows() -> sp.csc_array:
+        return sp.csc_array(sp.vstack([linear.G, cones.map]))
+
+    G = workspace.memo("relaxed G", (linear.G, cones), rows) if workspace is not None else rows()
+    return replace(
+        linear,
+        G=G,
+        h=np.concatenate([linear.h, tight]),
+        h_lower=np.concatenate([np.full(linear.h.size, -np.inf), -tight]),
+    )
 
 
 def _raise_infeasible(problem: SmoothingProblem, asm: Assembled, certain: bool = True) -> None:

@@ -13,7 +13,7 @@ from skyquill.errors import InputError
 from skyquill.solvers.base import QPBackend, QPSolution, QuadraticProgram, SecondOrderCones
 from skyquill.solvers.clarabel_backend import solve_clarabel
 from skyquill.solvers.osqp_backend import solve_osqp
-from skyquill.solvers.piqp_backend import solve_piqp
+from skyquill.solvers.piqp_backend import PiqpSession, solve_piqp
 
 BACKENDS: dict[str, QPBackend] = {
     "clarabel": solve_clarabel,
@@ -26,9 +26,17 @@ CONIC_BACKENDS = ("clarabel",)
 
 
 def solve_qp(
-    qp: QuadraticProgram, backend: str = DEFAULT_BACKEND, tol: float = 1e-10
+    qp: QuadraticProgram,
+    backend: str = DEFAULT_BACKEND,
+    tol: float = 1e-10,
+    *,
+    session: PiqpSession | None = None,
 ) -> QPSolution:
-    """Solve ``qp`` with the named backend."""
+    """Solve ``qp`` with the named backend.
+
+    ``session`` (PIQP only, ignored by the others) keeps PIQP's setup between
+    programs of the same sparsity pattern (:class:`PiqpSession`).
+    """
     if backend not in BACKENDS:
         raise InputError(f"solver: got {backend!r}, expected one of {sorted(BACKENDS)}")
     if qp.cones is not None and backend not in CONIC_BACKENDS:
@@ -36,6 +44,8 @@ def solve_qp(
             f"solver: got {backend!r} for a program with second-order cones, expected one "
             f"of {list(CONIC_BACKENDS)}"
         )
+    if session is not None and backend == "piqp":
+        return session.solve(qp, tol)
     return BACKENDS[backend](qp, tol)
 
 
@@ -43,6 +53,7 @@ __all__ = [
     "BACKENDS",
     "CONIC_BACKENDS",
     "DEFAULT_BACKEND",
+    "PiqpSession",
     "QPSolution",
     "QuadraticProgram",
     "SecondOrderCones",

@@ -8,12 +8,15 @@ import clarabel
 import numpy as np
 import scipy.sparse as sp
 
-from skyquill.solvers.base import QPSolution, QuadraticProgram
+from skyquill.solvers.base import QPSolution, QuadraticProgram, fold_duals, one_sided
 
 
 def solve_clarabel(qp: QuadraticProgram, tol: float) -> QPSolution:
     """Solve with Clarabel; ``tol`` sets its gap and feasibility tolerances."""
     start = time.perf_counter()
+    m_rows = qp.h.size
+    # Clarabel's cones are one-sided: a two-sided row becomes two rows.
+    qp, below = one_sided(qp)
     settings = clarabel.DefaultSettings()
     settings.verbose = False
     settings.tol_gap_abs = settings.tol_gap_rel = tol
@@ -49,7 +52,7 @@ def solve_clarabel(qp: QuadraticProgram, tol: float) -> QPSolution:
             elapsed,
             name,
             z[:m_eq],
-            z[m_eq : m_eq + m_in],
+            fold_duals(z[m_eq : m_eq + m_in], below, m_rows),
             z[m_eq + m_in :] if qp.cones is not None else None,
         )
     if "PrimalInfeasible" in name:

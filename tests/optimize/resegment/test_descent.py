@@ -9,7 +9,9 @@ import pytest
 from resegment_cases import limited_spiral, spiral
 
 from skyquill.errors import InputError
+from skyquill.optimize import solve
 from skyquill.optimize.resegment import point_fit_factory, resegment, time_gradient
+from skyquill.optimize.workspace import Workspace
 
 
 # ------------------------------------------------------------------ descent
@@ -96,3 +98,38 @@ def test_rejects_bad_arguments() -> None:
         resegment(pts[:1], times[:1])
     with pytest.raises(InputError, match="times: got times\\[0\\] = 1, expected 0"):
         time_gradient(times + 1.0, make)
+
+
+def test_the_callers_solve_is_the_first_iterate_instead_of_a_second_solve() -> None:
+    pts, times, make = limited_spiral(24, 18, 8)
+    again = resegment(pts, times, make, mode="fixed", max_iter=4)
+    first = solve(make(times))
+    given = resegment(pts, times, make, mode="fixed", max_iter=4, initial_result=first)
+    assert given.n_solves == again.n_solves - 1
+    assert given.history[0] == first.cost
+    assert np.allclose(given.times, again.times, rtol=1e-8, atol=0.0)
+    a, b = again.result.trajectory.control_points, given.result.trajectory.control_points
+    assert np.abs(a - b).max() <= 1e-8 * np.abs(a).max()
+
+
+def test_a_solve_at_other_times_is_not_taken_as_the_first_iterate() -> None:
+    pts, times = spiral(12)
+    make = point_fit_factory(pts, 16)
+    other = solve(make(times * np.linspace(1.0, 1.2, times.size) * times[-1] / (1.2 * times[-1])))
+    with pytest.raises(InputError, match="initial_result: got a solve whose point times"):
+        resegment(pts, times, make, initial_result=other)
+    with pytest.raises(InputError, match="make_problem: got duration"):
+        resegment(pts, times, make, initial_result=solve(make(2.0 * times)))
+
+
+def test_a_callers_workspace_carries_its_setup_into_the_run() -> None:
+    pts, times, make = limited_spiral(24, 18, 8)
+    workspace = Workspace()
+    first = solve(make(times), workspace=workspace)
+    own = resegment(pts, times, make, mode="fixed", max_iter=4, initial_result=first)
+    shared = resegment(
+        pts, times, make, mode="fixed", max_iter=4, initial_result=first, workspace=workspace
+    )
+    assert workspace.assembly.hits >= shared.n_solves  # every solve re-used the blocks
+    a, b = own.result.trajectory.control_points, shared.result.trajectory.control_points
+    assert np.abs(a - b).max() <= 1e-8 * np.abs(a).max()

@@ -40,7 +40,7 @@ def test_without_a_polished_point_the_solver_duals_are_used(
     backend's tolerance (the reason for the polish; module docstring of ``polish``)."""
     _, times, make = limited_spiral(24, 18, None)
     polished = time_gradient(times, make)
-    monkeypatch.setattr(multipliers_module, "polish", lambda *args: None)
+    monkeypatch.setattr(multipliers_module, "polish", lambda *args, **kwargs: None)
     raw = time_gradient(times, make)
     assert raw.polished_cost == raw.cost
     assert raw.stationarity_residual < 1e-8

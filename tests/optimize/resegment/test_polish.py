@@ -12,7 +12,7 @@ from resegment_cases import limited_random, limited_spiral
 from skyquill.optimize import solve
 from skyquill.optimize.assemble import assemble, problem_cost
 from skyquill.optimize.resegment.polish import polish
-from skyquill.optimize.solve import FitResult, _to_qp
+from skyquill.optimize.solve import FitResult, _closed_form_kkt, _to_qp
 
 CASES = ["spiral-box", "spiral-cylinder", "random-1", "random-2", "random-90"]
 
@@ -70,3 +70,37 @@ def test_only_tight_rows_are_held() -> None:
     out = polish(qp, x0, np.full(qp.G.shape[0], 1e-12))
     assert out is not None
     assert np.count_nonzero(out.z) < x0.size
+
+
+@pytest.mark.parametrize("loose", [True, False])
+def test_the_per_axis_closed_form_polishes_as_the_full_kkt_solve(loose: bool) -> None:
+    """Nothing held (loose limits): the closed form replaces the KKT solve, same point and
+    duals; with active rows it is not used (the active set decides)."""
+    _, times, make = limited_spiral(24, 18, None)
+    problem = make(times)
+    if loose:
+        problem = replace(
+            problem,
+            limits=tuple(
+                replace(lim, lower=10.0 * lim.lower, upper=10.0 * lim.upper)
+                for lim in problem.limits
+            ),
+        )
+    result = solve(problem)
+    asm = assemble(problem)
+    qp = _to_qp(asm, result.margin)
+    x0 = result.trajectory.control_points.ravel()
+    calls = []
+
+    def per_axis() -> tuple[np.ndarray, np.ndarray]:
+        calls.append(1)
+        C, y = _closed_form_kkt(asm)
+        return C.ravel(), y
+
+    full = polish(qp, x0, result.z)
+    fast = polish(qp, x0, result.z, equality_solve=per_axis)
+    assert full is not None and fast is not None
+    assert len(calls) == (1 if loose else 0)
+    assert np.abs(fast.x - full.x).max() <= 1e-10 * np.abs(full.x).max()
+    assert np.abs(fast.y - full.y).max() <= 1e-7 * np.abs(full.y).max()
+    assert np.array_equal(fast.z > 0.0, full.z > 0.0)

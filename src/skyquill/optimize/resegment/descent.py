@@ -39,7 +39,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Literal
 
 import numpy as np
@@ -48,6 +48,7 @@ from skyquill.errors import InfeasibleError, InputError
 from skyquill.optimize.resegment.gradient import time_gradient
 from skyquill.optimize.resegment.problems import (
     ProblemFactory,
+    check_initial,
     check_problem,
     point_fit_factory,
     times_from_segments,
@@ -55,6 +56,7 @@ from skyquill.optimize.resegment.problems import (
 )
 from skyquill.optimize.resegment.results import Mode, ResegmentResult, Status
 from skyquill.optimize.solve import FitResult, solve
+from skyquill.optimize.workspace import Workspace
 from skyquill.solvers import DEFAULT_BACKEND
 from skyquill.validation import FloatArray, as_array, as_float, as_int
 
@@ -74,6 +76,8 @@ class _Search:
     n_ctrl: int
     n_solves: int = 0
     grad_time: float = 0.0
+    #: Every solve of the run shares it: the problems differ only in the times.
+    workspace: Workspace = field(default_factory=Workspace)
 
     def evaluate(self, T: FloatArray) -> tuple[FloatArray, FitResult] | None:
         """Times and solve for segments ``T``; ``None`` if infeasible."""
@@ -84,7 +88,7 @@ class _Search:
         check_problem(problem, tt, self.n_ctrl)
         self.n_solves += 1
         try:
-            return tt, solve(problem, self.solver)
+            return tt, solve(problem, self.solver, workspace=self.workspace)
         except InfeasibleError:
             return None
 
@@ -95,7 +99,10 @@ class _Search:
     def gradient(self, t: FloatArray, res: FitResult) -> FloatArray:
         """Gradient of the objective in ``T``, projected on ``sum(dT) = 0`` in fixed mode."""
         tic = time.perf_counter()
-        g = time_gradient(t, self.make_problem, self.solver, res).grad_segments + self.rho
+        g = time_gradient(
+            t, self.make_problem, self.solver, res, workspace=self.workspace
+        ).grad_segments
+        g = g + self.rho
         self.grad_time += time.perf_counter() - tic
         return g - g.mean() if self.mode == "fixed" else g
 
@@ -130,6 +137,22 @@ class _Search:
         return None
 
 
+def _start(search: _Search, t: FloatArray, initial: FitResult | None) -> tuple[_Search, FitResult]:
+    """``search`` with its control-point count, and the solve at the initial times ``t``.
+
+    The caller's solve ``initial`` is taken when given (its problem checked
+    against ``t``); else ``make_problem(t)`` is solved.
+    """
+    if initial is not None:
+        check_initial(initial.problem, t)
+        search.n_ctrl = initial.problem.n_ctrl
+        return search, initial
+    first = search.make_problem(t)
+    check_problem(first, t, None)
+    search.n_ctrl, search.n_solves = first.n_ctrl, 1
+    return search, solve(first, search.solver, workspace=search.workspace)
+
+
 def _initial_times(times: FloatArray, n: int) -> FloatArray:
     """Validated times (n,), shifted to start at 0."""
     t = as_array("times", times, shape=(n,))
@@ -148,6 +171,8 @@ def resegment(
     ftol: float = 1e-10,
     step_rule: Literal["bb", "double"] = "bb",
     solver: str = DEFAULT_BACKEND,
+    initial_result: FitResult | None = None,
+    workspace: Workspace | None = None,
 ) -> ResegmentResult:
     """Re-segment the point times by gradient descent (paper 000 §5.4).
 
@@ -188,6 +213,16 @@ def resegment(
         (2-4x fewer iterations on the spiral, ``bench/resegment.py``).
     solver
         QP backend for problems with inequalities.
+    initial_result
+        The caller's solve of ``make_problem(times)``, if it has one: used
+        as the first iterate instead of solving the same problem again. Its
+        problem must be made for ``times`` (checked: duration, control points,
+        point-deviation times).
+    workspace
+        Shared by every solve and gradient of the run
+        (:class:`~skyquill.optimize.workspace.Workspace`); a fresh one if
+        ``None``. A caller that solved the first problem with a workspace
+        passes it on, so that the run starts from its assembly and PIQP setup.
 
     Returns
     -------
@@ -214,10 +249,19 @@ def resegment(
     as_float("ftol", ftol, nonneg=True)
     if make_problem is None:
         make_problem = point_fit_factory(pts, pts.shape[0] + 5)
-    first = make_problem(t)
-    check_problem(first, t, None)
-    search = _Search(make_problem, mode, rho, solver, float(t[-1]), first.n_ctrl, n_solves=1)
-    res = solve(first, solver)
+    search, res = _start(
+        _Search(
+            make_problem,
+            mode,
+            rho,
+            solver,
+            float(t[-1]),
+            0,
+            workspace=workspace if workspace is not None else Workspace(),
+        ),
+        t,
+        initial_result,
+    )
     T = np.diff(t)
     F = search.objective(t, res)
     g = search.gradient(t, res)

@@ -43,12 +43,13 @@ from collections.abc import Callable
 import numpy as np
 from numpy.typing import NDArray
 
-from skyquill.optimize.assemble import _params
+from skyquill.optimize.assemble import AssemblyCache, _params, design_matrix
 from skyquill.optimize.problem import PointDeviation, SmoothingProblem
 from skyquill.optimize.resegment.multipliers import Multipliers, multipliers
 from skyquill.optimize.resegment.problems import ProblemFactory, check_problem, zero_based
 from skyquill.optimize.resegment.results import TimeGradient
 from skyquill.optimize.solve import FitResult, solve
+from skyquill.optimize.workspace import Workspace
 from skyquill.solvers import DEFAULT_BACKEND
 from skyquill.validation import FloatArray
 
@@ -61,6 +62,8 @@ def time_gradient(
     make_problem: ProblemFactory,
     solver: str = DEFAULT_BACKEND,
     result: FitResult | None = None,
+    *,
+    workspace: Workspace | None = None,
 ) -> TimeGradient:
     """Optimal cost ``f`` at ``times`` and its analytic gradient (module docstring).
 
@@ -74,6 +77,10 @@ def time_gradient(
         QP backend for problems with inequalities.
     result
         A solve of ``make_problem(times)`` to reuse (skips the solve).
+    workspace
+        Shared with the solves of a sequence (:mod:`skyquill.optimize.workspace`):
+        the solve (when ``result`` is None) and the multipliers re-use its
+        assembly blocks and PIQP setup.
 
     Returns
     -------
@@ -83,9 +90,10 @@ def time_gradient(
     if result is None:
         problem = make_problem(t)
         check_problem(problem, t, None)
-        result = solve(problem, solver)
-    mult = multipliers(result) if _needs_multipliers(result) else None
-    grad_t = _lagrangian_gradient(result.problem, result.trajectory.control_points, mult, t)
+        result = solve(problem, solver, workspace=workspace)
+    mult = multipliers(result, workspace) if _needs_multipliers(result) else None
+    cache = workspace.assembly if workspace is not None else None
+    grad_t = _lagrangian_gradient(result.problem, result.trajectory.control_points, mult, t, cache)
     grad_T = np.cumsum(grad_t[::-1])[::-1][1:].copy()
     if mult is None:
         return TimeGradient(result.cost, grad_t, grad_T, result, 0, 0.0, result.cost)
@@ -126,9 +134,13 @@ def _positions(term_times: FloatArray, t: FloatArray) -> NDArray[np.intp] | None
 
 
 def _lagrangian_gradient(
-    problem: SmoothingProblem, C: FloatArray, mult: Multipliers | None, t: FloatArray
+    problem: SmoothingProblem,
+    C: FloatArray,
+    mult: Multipliers | None,
+    t: FloatArray,
+    cache: AssemblyCache | None = None,
 ) -> FloatArray:
-    """``df/dt`` (N,) by the envelope theorem (module docstring)."""
+    """``df/dt`` (N,) by the envelope theorem (module docstring); ``cache``: design matrices."""
     basis, alpha = problem.basis, problem.alpha
     if mult is not None:
         C = mult.C
@@ -158,9 +170,8 @@ def _lagrangian_gradient(
             g_alpha += (2 * order - 1) * sigma * alpha ** (2 * order - 2) * energy
     for term in problem.deviations:
         if isinstance(term, PointDeviation) and term.weight:
-            s = _params(problem, term.times)
-            r = basis.design_matrix(s) @ C - term.points
-            v = basis.design_matrix(s, 1) @ C
+            r = design_matrix(problem, term.times, 0, cache) @ C - term.points
+            v = design_matrix(problem, term.times, 1, cache) @ C
             at_times(term.times, 2.0 * term.weight * np.sum(r * v, axis=1))
     grad_t[-1] += g_alpha * (-alpha / problem.duration)
     return grad_t

@@ -20,6 +20,7 @@ other limit a family of rows of ``G_ineq``, in the order of
 from __future__ import annotations
 
 import logging
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -28,7 +29,8 @@ from skyquill.limits import NormLimit
 from skyquill.optimize.assemble import Assembled, assemble, problem_cost
 from skyquill.optimize.problem import SmoothingProblem
 from skyquill.optimize.resegment.polish import polish
-from skyquill.optimize.solve import FitResult, _to_qp
+from skyquill.optimize.solve import FitResult, _closed_form_kkt, _to_qp
+from skyquill.optimize.workspace import Workspace
 from skyquill.validation import FloatArray
 
 log = logging.getLogger(__name__)
@@ -77,19 +79,24 @@ class Multipliers:
     cost: float
 
 
-def multipliers(result: FitResult) -> Multipliers:
-    """The multipliers of ``result``'s solve (polished on the QP route), with the residual."""
+def multipliers(result: FitResult, workspace: Workspace | None = None) -> Multipliers:
+    """The multipliers of ``result``'s solve (polished on the QP route), with the residual.
+
+    ``workspace``: the one ``result`` was solved with, whose assembly of the
+    same problem is then re-used.
+    """
     problem = result.problem
-    # Assembled again rather than kept in FitResult: the matrices are 4-5x the
-    # size of the rest of a result, which missions pickle across processes.
-    asm = assemble(problem)
+    # Assembled again (or taken from the solve's workspace) rather than kept in
+    # FitResult: the matrices are 4-5x the size of the rest of a result, which
+    # missions pickle across processes.
+    asm = workspace.assemble(problem) if workspace is not None else assemble(problem)
     # The QP the solve handed its backend (h tightened by the margin it needed).
-    qp = _to_qp(asm, result.margin)
+    qp = _to_qp(asm, result.margin, workspace)
     C, cost = result.trajectory.control_points, result.cost
     x, y, z = C.ravel(), result.y, result.z
     cone_z = result.cone_z if result.cone_z is not None else np.zeros(0)
     if result.method == "qp":
-        polished = polish(qp, x, z, result.cone_z)
+        polished = polish(qp, x, z, result.cone_z, equality_solve=_equality_solve(asm))
         if polished is None:
             log.debug("no polished point; using the solver's point and duals")
         else:
@@ -97,7 +104,8 @@ def multipliers(result: FitResult) -> Multipliers:
             if polished.cone_z is not None:
                 cone_z = polished.cone_z
             C = x.reshape(C.shape)
-            cost = problem_cost(problem, C)["total"]
+            cache = workspace.assembly if workspace is not None else None
+            cost = problem_cost(problem, C, cache)["total"]
     orders, cone_orders = _row_orders(problem, asm)
     A_c = qp.cones.A if qp.cones is not None else None
     quad = qp.P @ x
@@ -121,6 +129,18 @@ def multipliers(result: FitResult) -> Multipliers:
         residual,
         cost,
     )
+
+
+def _equality_solve(asm: Assembled) -> Callable[[], tuple[FloatArray, FloatArray]] | None:
+    """The per-axis closed form of ``asm`` for :func:`polish` when nothing is held."""
+    if not asm.separable:
+        return None
+
+    def solve_per_axis() -> tuple[FloatArray, FloatArray]:
+        C, y = _closed_form_kkt(asm)
+        return C.ravel(), y
+
+    return solve_per_axis
 
 
 def _row_orders(problem: SmoothingProblem, asm: Assembled) -> tuple[FloatArray, FloatArray]:

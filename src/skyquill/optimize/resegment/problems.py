@@ -110,3 +110,22 @@ def check_problem(problem: SmoothingProblem, t: FloatArray, n_ctrl: int | None) 
             f"make_problem: got n_ctrl = {problem.n_ctrl}, expected the same n_ctrl = {n_ctrl} "
             "for every call (f is only smooth in the times at a fixed knot count)"
         )
+
+
+def check_initial(problem: SmoothingProblem, t: FloatArray) -> None:
+    """Raise :class:`InputError` unless ``problem`` (of a given result) is made for times ``t``.
+
+    Its duration must be ``t[-1]`` and every point-deviation time one of ``t``
+    (the factory's contract); the result is then taken as the solve at ``t``.
+    """
+    check_problem(problem, t, None)
+    tol = 1e-12 * max(1.0, float(t[-1]))
+    for term in problem.deviations:
+        if not isinstance(term, PointDeviation):
+            continue
+        idx = np.clip(np.searchsorted(t, term.times - tol), 0, t.size - 1)
+        if not bool(np.all(np.abs(t[idx] - term.times) <= tol)):
+            raise InputError(
+                "initial_result: got a solve whose point times are not the times given, "
+                "expected the solve of make_problem(times)"
+            )
