@@ -82,12 +82,10 @@ class PlanOutput:
 
 def parts_of(request: PlanRequest) -> list[Strokes]:
     """What each drone writes: the drawing or the text, shared out in consecutive parts."""
-    from skyquill.strokes import split_text, typed_strokes
+    from skyquill.strokes import typed_parts
 
     if request.text is not None:
-        text = request.text
-        chunks = [text] if request.drones == 1 else split_text(text, request.drones)
-        return [typed_strokes(c) for c in chunks]
+        return typed_parts(request.text, request.drones)  # one scale across drones
     assert request.strokes is not None  # the model guarantees exactly one input
     drawing = Strokes(
         paths=tuple(np.asarray(s, dtype=float) for s in request.strokes),
