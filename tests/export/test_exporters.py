@@ -10,11 +10,9 @@ from scipy.interpolate import make_interp_spline
 
 from skyquill.errors import InputError
 from skyquill.export import EXPORTERS, ExportOptions, exporter
-from skyquill.export.refit import as_spline
 from skyquill.io.trajectory_json import PlannedTrajectory
 from skyquill.limits import VehicleLimits
 from skyquill.trajectory import RetimedPath, SplineTrajectory, Trajectory
-from skyquill.verify import verify
 
 LIMITS = VehicleLimits(2.0, 4.0, 20.0).derivative_limits(3)
 #: Exact formats to float rounding; Skybrush's cubics on its ms/mm grid to 2 mm; sampled
@@ -57,11 +55,8 @@ def test_every_format_reads_back_within_its_tolerance(tmp_path: Path, name: str,
         return
     report = chosen(plans, tmp_path / f"out{chosen.suffix}", ExportOptions(100.0))
     assert report.format == name and report.files and all(f.is_file() for f in report.files)
-    refit = report.details.get("refit_max_deviation_m", 0.0)
-    assert report.max_error_m <= TOLERANCE_M[name] + refit
+    assert report.max_error_m <= TOLERANCE_M[name]
     assert report.as_dict()["max_error_m"] == report.max_error_m
-    if kind == "spline":
-        assert refit == 0.0
 
 
 def test_two_drones_get_two_files_or_one_show(tmp_path: Path) -> None:
@@ -70,15 +65,6 @@ def test_two_drones_get_two_files_or_one_show(tmp_path: Path) -> None:
     assert [f.name for f in csv.files] == ["x_trajectory_0.csv", "x_trajectory_1.csv"]
     show = EXPORTERS["skyc"](plans, tmp_path / "show.skyc", ExportOptions())
     assert [f.name for f in show.files] == ["show.skyc"]
-
-
-def test_refit_keeps_the_limits_and_reports_its_deviation() -> None:
-    traj = _retimed()
-    fitted = as_spline(traj, LIMITS)
-    assert not fitted.exact and 0.0 < fitted.max_deviation_m < 1e-3
-    assert verify(fitted.spline, LIMITS).max_excess <= 1e-9
-    same = as_spline(_spline(), LIMITS)
-    assert same.exact and same.max_deviation_m == 0.0
 
 
 def test_unknown_format_is_named() -> None:

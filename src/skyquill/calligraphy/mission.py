@@ -679,6 +679,7 @@ def _resegment(
             mode="free" if opts.resegment == "free" else "fixed",
             time_penalty=penalty,
             max_iter=opts.resegment_iterations,
+            initial_result=fit,  # the plan just made at these times: not solved again
         )
     except InfeasibleError:
         return (*current, times)

@@ -64,7 +64,7 @@ class ExportReport:
     message
         One sentence for the command line.
     details
-        Format-specific numbers (pieces, uploads, rate, refit deviation, ...).
+        Format-specific numbers (pieces, uploads, rate, segments, ...).
     delivered
         Per drone, the check of what its consumer will fly
         (:func:`check_delivered`).

@@ -53,8 +53,8 @@ class PlannedTrajectory:
         ``(start, end)`` times in s when the pen is down, in order; empty when
         the task has no pen.
     limits
-        The limits it was planned for (an exporter that must refit it keeps
-        them).
+        The limits it was planned for (every exporter checks what its
+        consumer will fly against them).
     """
 
     trajectory: Trajectory
