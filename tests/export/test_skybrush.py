@@ -38,7 +38,7 @@ OFFSET_M = np.array([1.5, 0.0, 0.0])
 def plans() -> list[NamedPlan]:
     mission = plan_writing(hanzi_strokes("永"))
     first = PlannedTrajectory(
-        mission.vehicle_trajectory(), tuple(mission.pen_windows), mission.fit.problem.limits
+        mission.vehicle_trajectory(), tuple(mission.pen_windows), mission.limits
     )
     traj = first.trajectory
     assert isinstance(traj, SplineTrajectory)

@@ -45,6 +45,7 @@ from skyquill.limits import DerivativeLimit, VehicleLimits
 from skyquill.optimize import Boundary, PointDeviation, SmoothingProblem, resegment, solve
 from skyquill.optimize.solve import FitResult
 from skyquill.optimize.timing import allocate_path_times
+from skyquill.optimize.workspace import Workspace
 from skyquill.strokes import Strokes, turning_points
 from skyquill.strokes.model import MAX_STROKES
 from skyquill.targets import Strategy as TargetStrategy
@@ -547,7 +548,9 @@ class RouteSamples:
 
     ``roles[i]`` is the index into ``strokes_world`` of the stroke sample ``i``
     belongs to, or -1 for lifts and transits; ``max_spans`` caps the knot spans
-    of its spline (``None``: as many as ``knot_interval`` asks).
+    of its spline (``None``: as many as ``knot_interval`` asks). ``workspace``
+    carries the assembly and the QP setup from one solve of the route to the
+    next (stretches, re-segmentation steps): only the times change between them.
     """
 
     points: FloatArray
@@ -555,6 +558,7 @@ class RouteSamples:
     corners: FloatArray
     strokes_world: tuple[FloatArray, ...]
     max_spans: int | None = None
+    workspace: Workspace = field(default_factory=Workspace, compare=False, repr=False)
 
 
 @dataclass(frozen=True)
@@ -643,7 +647,8 @@ def _plan_at(
             times,
             opts,
             max_spans=samples.max_spans,
-        )
+        ),
+        workspace=samples.workspace,
     )
     windows = _pen_windows(samples.roles, times, len(samples.strokes_world))
     deviation = measure_deviation(fit.trajectory, windows, samples.strokes_world)
@@ -680,6 +685,7 @@ def _resegment(
             time_penalty=penalty,
             max_iter=opts.resegment_iterations,
             initial_result=fit,  # the plan just made at these times: not solved again
+            workspace=samples.workspace,
         )
     except InfeasibleError:
         return (*current, times)
