@@ -37,7 +37,6 @@ import os
 import subprocess
 import sys
 import sysconfig
-import tarfile
 import tempfile
 import time
 from pathlib import Path
@@ -45,7 +44,7 @@ from typing import Any
 
 import numpy as np
 
-from common import gc_off, jsonable, machine_info
+from common import export_base, gc_off, jsonable, machine_info
 
 ROOT = Path(__file__).resolve().parents[1]
 RESULTS = ROOT / "bench" / "results" / "calligraphy.json"
@@ -128,15 +127,6 @@ class Worker:
 
 
 # --- driver -------------------------------------------------------------------------------
-
-
-def export_base(rev: str, into: Path) -> Path:
-    """``git archive`` of ``rev`` unpacked in ``into``; returns its ``src`` folder."""
-    archive = into / "base.tar"
-    subprocess.run(["git", "archive", "-o", str(archive), rev], cwd=ROOT, check=True)
-    with tarfile.open(archive) as tar:
-        tar.extractall(into / "base", filter="data")
-    return into / "base" / "src"
 
 
 def inputs(n_bundled: int | None, n_kanjivg: int) -> tuple[list[dict[str, Any]], str | None]:

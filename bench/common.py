@@ -6,11 +6,14 @@ import gc
 import math
 import os
 import platform
+import subprocess
 import sys
+import tarfile
 import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from importlib import metadata
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -88,3 +91,16 @@ def time_stats(times: npt.NDArray[np.float64], warmup: int) -> dict[str, Any]:
         "runs": int(times.size),
         "warmup_runs": warmup,
     }
+
+
+def export_base(rev: str, into: Path) -> Path:
+    """``git archive`` of ``rev`` unpacked in ``into``; returns its ``src`` folder."""
+    archive = into / "base.tar"
+    subprocess.run(
+        ["git", "archive", "-o", str(archive), rev],
+        cwd=Path(__file__).resolve().parents[1],
+        check=True,
+    )
+    with tarfile.open(archive) as tar:
+        tar.extractall(into / "base", filter="data")
+    return into / "base" / "src"

@@ -23,13 +23,12 @@ import json
 import os
 import subprocess
 import sys
-import tarfile
 import tempfile
 import time
 from pathlib import Path
 from typing import Any
 
-from common import machine_info
+from common import export_base, machine_info
 
 ROOT = Path(__file__).resolve().parents[1]
 RESULTS = ROOT / "bench" / "results"
@@ -72,15 +71,6 @@ JOBS: tuple[tuple[str, list[str], str], ...] = (
 ENTRY = "from skyquill.cli.main import app; app(prog_name='skyquill')"
 #: Flags the base revision does not know, and what it takes instead.
 OLD_FLAGS = {"--amax-axis": "--amax", "--jmax-axis": "--jmax"}
-
-
-def export_base(rev: str, into: Path) -> Path:
-    """``git archive`` of ``rev`` unpacked in ``into``; returns its ``src`` folder."""
-    archive = into / "base.tar"
-    subprocess.run(["git", "archive", "-o", str(archive), rev], cwd=ROOT, check=True)
-    with tarfile.open(archive) as tar:
-        tar.extractall(into / "base", filter="data")
-    return into / "base" / "src"
 
 
 def run_job(src: Path, args: list[str], out: Path) -> float:

@@ -37,17 +37,6 @@ from skyquill.io.trajectory_json import PlannedTrajectory
 from skyquill.limits import VehicleLimits
 
 
-def load_input(
-    text: str | None, strokes: Path | None, svg: Path | None, hanzi: Path | None, font: str
-) -> Any:
-    """The single input as :class:`~skyquill.strokes.Strokes` (imported lazily).
-
-    ``--hanzi FILE`` without TEXT writes that one character's file (``永.json``).
-    """
-    (part,) = load_parts(text, strokes, svg, hanzi, font)
-    return part
-
-
 def load_parts(
     text: str | None,
     strokes: Path | None,
