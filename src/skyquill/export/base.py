@@ -127,17 +127,17 @@ class DeliveredCheck:
         }
 
 
-def check_delivered(
-    drone: str, planned: PlannedTrajectory, back: Trajectory, offset_s: float = 0.0
-) -> DeliveredCheck:
+def check_delivered(drone: str, planned: PlannedTrajectory, back: Trajectory) -> DeliveredCheck:
     """Check ``back`` (the export read back with its consumer's arithmetic) against the plan.
 
     The dense limit check runs on ``back`` itself, so a limit broken by the
     format's rounding or resampling shows here; the distances are measured at
-    the plan's dense times (``back`` evaluated at ``t + offset_s``).
+    the plan's dense times (a file whose clock ends a rounding early is held
+    at its end).
     """
     t = dense_times(planned.trajectory.breakpoints)
-    error = _distances(planned.trajectory, back, t, offset_s)
+    back_p = back.evaluate(np.minimum(t, back.duration))
+    error = np.linalg.norm(planned.trajectory.evaluate(t) - back_p, axis=1)
     down = pen_down(t, planned.pen_windows_s).astype(bool)
     check = verify(back, planned.limits, guaranteed=False)
     return DeliveredCheck(
@@ -169,20 +169,3 @@ class Exporter(Protocol):
 def target(out: Path, name: str, several: bool, suffix: str) -> Path:
     """The file for drone ``name``: ``out`` itself, or ``<out stem>_<name><suffix>`` for several."""
     return out.with_name(f"{out.stem}_{name}{suffix}") if several else out.with_suffix(suffix)
-
-
-def max_distance(reference: Trajectory, back: Trajectory, offset_s: float = 0.0) -> float:
-    """Largest distance between ``back`` and ``reference`` at the reference's dense times, m.
-
-    ``back`` is evaluated at ``t + offset_s`` (a file whose clock starts
-    elsewhere); times past its end are held at its end.
-    """
-    t = dense_times(reference.breakpoints)
-    return float(_distances(reference, back, t, offset_s).max())
-
-
-def _distances(
-    reference: Trajectory, back: Trajectory, t: np.ndarray, offset_s: float
-) -> np.ndarray:
-    here = np.clip(t + offset_s, 0.0, back.duration)
-    return np.asarray(np.linalg.norm(reference.evaluate(t) - back.evaluate(here), axis=1))
