@@ -470,3 +470,30 @@ def test_contradictory_equalities_in_closed_form_are_infeasible() -> None:
     with pytest.raises(InfeasibleError, match="contradict") as info:
         solve(problem)
     assert info.value.families == ("equalities",)
+
+
+def test_accel_gain_is_the_least_squares_fit_of_p_plus_c_a() -> None:
+    """The deviation of ``p(t_i) + c a(t_i)`` with gains per axis: the engine's optimum is
+    the dense least-squares solution built here from the basis rows directly."""
+    rng = np.random.default_rng(3)
+    n, M, k = 30, 14, 5
+    times = np.sort(rng.uniform(0.0, 3.0, n))
+    times[0], times[-1] = 0.0, 3.0
+    pts = rng.normal(0.0, 0.2, (n, 3))
+    gain = np.array([-0.03, -0.03, 0.0])
+    problem = SmoothingProblem(
+        3, k, M, 3.0, smoothness={3: 1e-4}, deviations=(PointDeviation(times, pts, 1.0, gain),)
+    )
+    got = solve(problem).trajectory
+    basis, alpha = problem.basis, problem.alpha
+    B0 = basis.design_matrix(alpha * times, 0).toarray()
+    B2 = basis.design_matrix(alpha * times, 2).toarray() * alpha**2
+    gram = 1e-4 * alpha**5 * basis.gram(3).toarray()
+    for axis in range(3):
+        rows = B0 + gain[axis] * B2
+        expected = np.linalg.solve(gram + rows.T @ rows, rows.T @ pts[:, axis])
+        assert np.allclose(got.control_points[:, axis], expected, rtol=1e-7, atol=1e-9)
+    tip = got.evaluate(times) + gain * got.evaluate(times, 2)
+    residual = float(np.sum((tip - pts) ** 2))
+    assert got.duration == 3.0
+    assert problem_cost(problem, got.control_points)["deviation"] == pytest.approx(residual)

@@ -36,7 +36,7 @@ from skyquill.calligraphy.mission import (
     RoutePlan,
     RouteSamples,
     WritingOptions,
-    measure_deviation,
+    fidelity,
     plan_route,
     resegmented,
 )
@@ -125,7 +125,7 @@ def plan_for_target(
     if "one-upload" in opts.target_strategies:
         whole = _attempt(budget, times, board, inner)
         if whole is not None:
-            plan = _refined(budget, whole, inner)
+            plan = _refined(budget, whole, board, inner)
             trajectory: Trajectory = plan.fit.trajectory
             fallback = _mission((plan,), (trajectory, plan.windows), samples, board, opts)
             if whole.faithful(inner):
@@ -135,7 +135,7 @@ def plan_for_target(
         groups = _groups(budget, cuts, board, inner)
         if all(g.plan is not None for g in groups):
             plans = tuple(
-                _refined(_sub(budget, cuts, g.first, g.stop), g.plan, inner)
+                _refined(_sub(budget, cuts, g.first, g.stop), g.plan, board, inner)
                 for g in groups
                 if g.plan is not None
             )
@@ -162,11 +162,13 @@ def _attempt(
         return None
 
 
-def _refined(samples: RouteSamples, plan: RoutePlan, opts: WritingOptions) -> RoutePlan:
+def _refined(
+    samples: RouteSamples, plan: RoutePlan, board: Board, opts: WritingOptions
+) -> RoutePlan:
     """``plan`` re-segmented as :func:`plan_writing` does (kept only if still faithful)."""
-    if plan.compensated or opts.resegment == "off" or opts.resegment_iterations == 0:
+    if opts.resegment == "off" or opts.resegment_iterations == 0:
         return plan
-    return resegmented(samples, plan, opts)
+    return resegmented(samples, plan, board, opts)
 
 
 def _cuts(samples: RouteSamples, board: Board) -> list[int]:
@@ -266,8 +268,7 @@ def _mission(
     strokes = samples.strokes_world
     # A split into one group would be the whole route again: it is tried as one upload.
     strategy: Strategy = "one-upload" if len(plans) == 1 else "split"
-    brush = opts.brush_length_m if any(p.compensated for p in plans) else 0.0
-    deviation = measure_deviation(trajectory, windows, strokes, brush)
+    deviation, contact = fidelity(trajectory, windows, strokes, board, opts)
     return Mission(
         tuple(p.fit for p in plans),
         trajectory,
@@ -279,6 +280,7 @@ def _mission(
         0.0,  # set when it is returned (_timed)
         opts,
         TargetPlan(opts.target, strategy, uploads),
+        contact,
     )
 
 

@@ -24,6 +24,22 @@ few long knot spans, or several flown one after another with hovers between.
 The plan is of the brush tip; the vehicle flies it offset by the brush
 (:meth:`Mission.vehicle_trajectory`). The pen is down (``pen = 1``) from a stroke's first
 sample time to its last.
+
+On a horizontal board the brush hangs along the thrust axis, so the tip swings
+as the vehicle tilts to accelerate: it is at ``P + L (e_z - b3)`` for the
+untilted tip ``P``, ``b3 = (a + g e_z) / |a + g e_z|`` (:func:`swung_tip`).
+By default (``follow="tip"``) the strokes are fitted by that swung tip, which
+is what leaves the ink: to first order its horizontal part is
+``P_xy - (L / g) a_xy``, linear in the control points, so the QP's point
+deviation carries that acceleration term
+(:class:`~skyquill.optimize.PointDeviation`'s ``accel_gain``); the rest (the
+second-order part, and the tip's rise ``L (1 - cos tilt)``, up to 6 mm at
+2 m/s^2 with a 0.3 m brush) is taken off the targets by a fixed-point polish
+(:data:`TIP_POLISH_PASSES` more solves). The pen-down targets lie the brush's
+pressing depth below the surface, and the plan is kept only if the swung tip
+stays pressed within the bearing's travel while the pen is down and leaves the
+board between strokes (:class:`Contact`). ``follow="path"`` fits the untilted
+tip (paper 000: the vehicle's path, offset by the brush), as on a wall.
 """
 
 from __future__ import annotations
@@ -36,8 +52,10 @@ from functools import cached_property
 from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
+from numpy.typing import NDArray
 
 from skyquill.calligraphy.board import Board
+from skyquill.calligraphy.brush import Brush
 from skyquill.errors import InfeasibleError, InputError
 from skyquill.geometry import polyline_distance
 from skyquill.io.trajectory_json import pen_down
@@ -60,6 +78,10 @@ if TYPE_CHECKING:  # the simulator is imported only to fly
 
 #: Spacing of the samples that hold lifts and transits near their straight lines, m.
 TRANSIT_SPACING_M = 0.01
+#: Route roles of the samples that are not on a stroke (those carry the stroke's
+#: index): the brush going straight down to a stroke or up from it, and the
+#: moves between, above the board.
+LIFT, TRANSIT = -2, -1
 #: Largest input a mission takes, points: a tablet at 200 Hz for 15 minutes.
 MAX_INPUT_POINTS = 200_000
 #: Character sizes accepted, m. Below 1 cm a character is narrower than a brush
@@ -68,9 +90,6 @@ MAX_INPUT_POINTS = 200_000
 #: above 20 m the route (sampled every TRANSIT_SPACING_M) and the flight grow
 #: past a board and a battery: that is sky writing, not calligraphy.
 SIZE_RANGE_M = (0.01, 20.0)
-#: Longest brush accepted, m: the tip is modelled as rigid along the thrust
-#: axis (``L (e_z - b3)``); a longer "brush" is a tether that swings on its own.
-MAX_BRUSH_LENGTH_M = 2.0
 #: Most route samples (stroke points plus lifts and transits every
 #: TRANSIT_SPACING_M), estimated from the route's length before it is built:
 #: each is a row of the QP's deviation block (~1 kB with its factors).
@@ -79,8 +98,20 @@ MAX_ROUTE_SAMPLES = 400_000
 #: unknowns and a hull block per span and limit; 20 000 spans is 1000 s of
 #: flight at the default 0.05 s, and ~1 GB of KKT factors.
 MAX_SPANS = 20_000
-#: Solves of the tilt compensation's fixed-point iteration.
-TILT_PASSES = 3
+#: How far the vehicle's frame and propellers reach below its centre (on a
+#: wall: in front of it), m. A shorter brush cannot reach the board: the
+#: frame would touch it first.
+FRAME_CLEARANCE_M = 0.05
+#: The flight volume's ceiling, m above the ground (z = 0): the 120 m of the
+#: small-drone rules (EU open category, FAA part 107).
+MAX_ALTITUDE_M = 120.0
+#: Sampling step of the planned ink (:func:`planned_ink`), s: 2 mm at 1 m/s.
+INK_SAMPLE_S = 0.002
+#: Solves after the first that take the swung tip's second-order part off the
+#: targets (``follow="tip"``): the part is ~1e-4 m horizontally and the tip's
+#: rise (<= L amax^2 / 2 g^2) vertically, and each pass shrinks what is left by
+#: about that ratio again, so two leave well under 0.1 mm.
+TIP_POLISH_PASSES = 2
 GRAVITY = 9.81  # m/s^2
 #: How fast the pen-down deviation falls with the timing stretch, ``deviation ~ scale^-p``,
 #: taken on the fast side of what is measured (p ~ 3.1) so that a predicted stretch never
@@ -116,9 +147,17 @@ class WritingOptions:
         Seconds per knot span.
     degree
         Spline degree.
-    brush_length_m
-        Tip to vehicle distance along the board normal, m, at most
-        :data:`MAX_BRUSH_LENGTH_M` (the default simulated vehicle's brush).
+    brush
+        The brush: its length (tip to vehicle, along the board normal when
+        level), the bearing's travel and the pressing depth that sets the
+        stroke width (:class:`~skyquill.calligraphy.brush.Brush`).
+    follow
+        What is fitted to the strokes on a horizontal board: ``"tip"`` (the
+        default) the swung brush tip, which leaves the ink (module
+        docstring); ``"path"`` the untilted tip, i.e. the vehicle's path
+        offset by the brush (paper 000), which is faster to plan and leaves
+        the ink up to a few centimetres off at these limits. Walls and a
+        zero-length brush are always ``"path"``.
     resegment
         Time re-segmentation after the first feasible, faithful plan (paper
         000 §5.4): ``"fixed"`` keeps the total time, ``"free"`` lets it move
@@ -127,14 +166,6 @@ class WritingOptions:
         time grows); ``"off"`` skips it.
     resegment_iterations
         Descent steps at most (each is one solve and one analytic gradient).
-    tilt_compensation
-        Horizontal boards: the brush hangs along the thrust axis, so tilting to
-        accelerate swings the tip by ``L (e_z - b3)`` (~3 cm on a 0.5 m
-        character at these limits). When on, the stroke targets are shifted
-        against the swing and the plan solved again (a fixed-point iteration,
-        :data:`TILT_PASSES` solves), and fidelity is measured on the swung tip.
-        Off by default: on the bundled characters it needs ~1.5-2.5x the
-        writing time to get the swung tip within 5 mm, and ~1 s of planning.
     stretch_factor, max_stretches
         Timing stretch when infeasible or unfaithful.
     best_effort
@@ -164,10 +195,10 @@ class WritingOptions:
     transit_weight: float = 1e2
     knot_interval: float = 0.05
     degree: int = 5
-    brush_length_m: float = 0.3
+    brush: Brush = field(default_factory=Brush)
+    follow: Literal["tip", "path"] = "tip"
     resegment: Literal["off", "fixed", "free"] = "fixed"
     resegment_iterations: int = 8
-    tilt_compensation: bool = False
     stretch_factor: float = 1.25
     max_stretches: int = 8
     best_effort: bool = False
@@ -177,6 +208,10 @@ class WritingOptions:
     def __post_init__(self) -> None:
         if not isinstance(self.limits, VehicleLimits):
             raise InputError(f"limits: got {type(self.limits).__name__}, expected VehicleLimits")
+        if not isinstance(self.brush, Brush):
+            raise InputError(f"brush: got {type(self.brush).__name__}, expected Brush")
+        if self.follow not in ("tip", "path"):
+            raise InputError(f"follow: got {self.follow!r}, expected 'tip' or 'path'")
         if self.target is not None and not isinstance(self.target, UploadTarget):
             raise InputError(
                 f"target: got {type(self.target).__name__}, expected UploadTarget or None"
@@ -194,18 +229,13 @@ class WritingOptions:
         self.limits.timing_bounds()  # the route is timed with a speed and an acceleration
         for name in ("size_m", "knot_interval", "stretch_factor"):
             as_float(name, getattr(self, name), positive=True)
-        for name in ("data_weight", "turning_weight", "transit_weight", "brush_length_m"):
+        for name in ("data_weight", "turning_weight", "transit_weight"):
             as_float(name, getattr(self, name), nonneg=True)
         low, high = SIZE_RANGE_M
         if not low <= self.size_m <= high:
             raise InputError(
                 f"size_m: got {self.size_m:g} m, expected {low:g} to {high:g} m (a character "
                 "legible with a brush, within the position accuracy, on one board)"
-            )
-        if self.brush_length_m > MAX_BRUSH_LENGTH_M:
-            raise InputError(
-                f"brush_length_m: got {self.brush_length_m:g} m, expected at most "
-                f"{MAX_BRUSH_LENGTH_M:g} m (the brush is modelled as rigid)"
             )
         for name in ("tolerance_m", "turning_threshold_m"):
             if getattr(self, name) is not None:
@@ -231,6 +261,17 @@ class WritingOptions:
     def derivative_limits(self) -> tuple[DerivativeLimit, ...]:
         """The vehicle limits in 3-D, as the engine imposes them."""
         return self.limits.derivative_limits(3, sides=self.norm_sides)
+
+    def follows_tip(self, board: Board) -> bool:
+        """Whether the swung tip is fitted on ``board`` (``follow="tip"``, horizontal, a brush)."""
+        return self.follow == "tip" and board.kind == "horizontal" and self.brush.length_m > 0
+
+    def tip_gain(self, board: Board) -> FloatArray | None:
+        """The swung tip's acceleration gain ``(-L/g, -L/g, 0)``, s^2; ``None`` for the path."""
+        if not self.follows_tip(board):
+            return None
+        c = -self.brush.length_m / GRAVITY
+        return np.array([c, c, 0.0])
 
 
 @dataclass(frozen=True)
@@ -261,6 +302,49 @@ class Deviation:
 
 
 @dataclass(frozen=True)
+class Contact:
+    """The swung brush tip against the board (``follow="tip"``): the ink the plan leaves.
+
+    Attributes
+    ----------
+    min_depth_m, max_depth_m
+        The shallowest press while the pen is down and the deepest anywhere,
+        m (positive: into the board; the shallowest is at a touch-down or a
+        lift-off).
+    clearance_m
+        The least, over the pen-up gaps, of the highest the tip rises, m.
+    travel_m
+        The brush bearing's travel, m.
+    ink_strokes, strokes
+        Runs of contact, and input strokes.
+    """
+
+    min_depth_m: float
+    max_depth_m: float
+    clearance_m: float
+    travel_m: float
+    ink_strokes: int
+    strokes: int
+
+    @property
+    def holds(self) -> bool:
+        """One ink stroke per input stroke, pressed within the bearing's travel."""
+        return self.ink_strokes == self.strokes and self.max_depth_m <= self.travel_m
+
+    def as_dict(self) -> dict[str, float | int | bool]:
+        """``summary.json`` form."""
+        return {
+            "min_depth_m": self.min_depth_m,
+            "max_depth_m": self.max_depth_m,
+            "clearance_m": self.clearance_m,
+            "travel_m": self.travel_m,
+            "ink_strokes": self.ink_strokes,
+            "strokes": self.strokes,
+            "holds": self.holds,
+        }
+
+
+@dataclass(frozen=True)
 class Mission:
     """A planned writing flight.
 
@@ -280,7 +364,9 @@ class Mission:
     pen_windows
         ``(t_start, t_end)`` of every stroke, s.
     deviation
-        Fidelity of the pen-down path.
+        Fidelity of the pen-down path: of the swung tip in the board's plane
+        when it is fitted (``options.follows_tip``), else of the planned tip
+        in 3-D.
     time_scale
         Stretch applied to the initial timing (the largest over the parts).
     planning_time_s
@@ -290,6 +376,8 @@ class Mission:
     target
         How the plan fits ``options.target`` (strategy and uploads); ``None``
         without a target.
+    contact
+        The swung tip against the board when it is fitted; ``None`` otherwise.
     """
 
     fits: tuple[FitResult, ...]
@@ -302,6 +390,7 @@ class Mission:
     planning_time_s: float
     options: WritingOptions
     target: TargetPlan | None = None
+    contact: Contact | None = None
 
     @property
     def limits(self) -> tuple[DerivativeLimit, ...]:
@@ -322,7 +411,7 @@ class Mission:
     @property
     def brush_offset(self) -> FloatArray:
         """Vehicle position minus tip position (3,), m."""
-        return self.options.brush_length_m * self.board.normal
+        return self.options.brush.length_m * self.board.normal
 
     def vehicle_trajectory(self) -> Trajectory:
         """The vehicle's trajectory: the tip's, offset by the brush along the board normal.
@@ -334,8 +423,9 @@ class Mission:
 
     @property
     def faithful(self) -> bool:
-        """Whether the pen-down path is within the tolerance of the input."""
-        return self.deviation.max_m <= self.options.tolerance
+        """Whether the pen-down path is within the tolerance (and the contact holds)."""
+        held = self.contact is None or self.contact.holds
+        return self.deviation.max_m <= self.options.tolerance and held
 
     def summary(self) -> dict[str, Any]:
         """Timing, the dense check, fidelity: a drone's entry in ``summary.json`` (SI units)."""
@@ -351,9 +441,12 @@ class Mission:
             "deviation": self.deviation.as_dict(),
             "tolerance_m": self.options.tolerance,
             "faithful": self.faithful,
+            "follow": "tip" if self.options.follows_tip(self.board) else "path",
             "strokes": len(self.strokes_world),
             "time_scale": self.time_scale,
         }
+        if self.contact is not None:
+            entry["contact"] = self.contact.as_dict()
         if self.target is not None:
             entry["target"] = self.target.as_dict()
         return entry
@@ -391,7 +484,7 @@ def densify(polyline: FloatArray, spacing: float = TRANSIT_SPACING_M) -> FloatAr
 
 @dataclass
 class _Route:
-    """The mission polyline with a role per sample: stroke index or -1 (transit)."""
+    """The mission polyline with a role per sample: stroke index, :data:`TRANSIT` or :data:`LIFT`."""
 
     points: list[FloatArray] = field(default_factory=list)
     role: list[FloatArray] = field(default_factory=list)
@@ -400,11 +493,11 @@ class _Route:
         self.points.append(points)
         self.role.append(np.full(len(points), role))
 
-    def go_to(self, target: FloatArray, include_target: bool = True) -> None:
+    def go_to(self, target: FloatArray, include_target: bool = True, role: int = -1) -> None:
         if np.linalg.norm(target - self.points[-1][-1]) < 1e-9:
             return  # already there: no repeated sample (times must increase)
         line = _segment(self.points[-1][-1], target)
-        self.add(line if include_target else line[:-1], -1)
+        self.add(line if include_target else line[:-1], role)
 
 
 def _route(
@@ -422,9 +515,10 @@ def _route(
         route.add(first[None, :], -1)
     for i, stroke in enumerate(strokes_world):
         route.go_to(stroke[0] + lift)
-        route.go_to(stroke[0], include_target=False)  # touch down: the stroke's first point
+        # Touch down on the stroke's first point, lift straight up from its last.
+        route.go_to(stroke[0], include_target=False, role=LIFT)
         route.add(densify(stroke), i)
-        route.go_to(stroke[-1] + lift)
+        route.go_to(stroke[-1] + lift, role=LIFT)
     if home is not None:
         route.go_to(np.array([home[0], home[1], route.points[-1][-1][2]]))
         route.go_to(home)
@@ -464,6 +558,33 @@ def _check_route_size(
         )
 
 
+def check_reach(board: Board, opts: WritingOptions) -> None:
+    """Refuse a brush or a board the vehicle cannot write with.
+
+    The brush must reach past the frame (:data:`FRAME_CLEARANCE_M`), and the
+    writing must lie in the flight volume: above the ground, with the vehicle
+    (the brush's length above a horizontal board, plus the lift) below
+    :data:`MAX_ALTITUDE_M`.
+    """
+    length = opts.brush.length_m
+    if length < FRAME_CLEARANCE_M:
+        raise InputError(
+            f"brush length_m: got {length:g} m, expected at least {FRAME_CLEARANCE_M:g} m "
+            "(a shorter brush cannot reach the board past the vehicle's frame)"
+        )
+    bottom = float(board.origin[2])
+    if board.kind == "horizontal":
+        top = bottom + length + board.lift_m
+    else:
+        top = bottom + opts.size_m
+    if bottom <= 0.0 or top > MAX_ALTITUDE_M:
+        raise InputError(
+            f"board: got the writing from {bottom:g} m up, the vehicle up to {top:g} m, "
+            f"expected both within the flight volume, above the ground (z > 0) and below "
+            f"{MAX_ALTITUDE_M:g} m"
+        )
+
+
 def plan_writing(
     strokes: Strokes,
     board: Board | None = None,
@@ -482,13 +603,14 @@ def plan_writing(
         :class:`WritingOptions`.
     home
         The vehicle's take-off and landing position (3,), m (the tip hangs
-        ``brush_length_m`` below it); ``None`` starts and ends hovering above
+        ``options.brush.length_m`` below it); ``None`` starts and ends hovering above
         the first and last stroke.
 
     Raises
     ------
     InputError
-        More than :data:`MAX_INPUT_POINTS` points or :data:`MAX_STROKES` strokes, a
+        A brush or board the vehicle cannot write with (:func:`check_reach`),
+        more than :data:`MAX_INPUT_POINTS` points or :data:`MAX_STROKES` strokes, a
         route of more than :data:`MAX_ROUTE_SAMPLES` samples (estimated by
         :func:`route_length` before it is built) or a solve of more than
         :data:`MAX_SPANS` knot spans (before it is assembled).
@@ -511,9 +633,10 @@ def plan_writing(
         )
     opts = options or WritingOptions()
     board = board or Board()
+    check_reach(board, opts)
     home_pos = None if home is None else as_array("home", home, shape=(3,))
     if home_pos is not None:
-        home_pos = home_pos - opts.brush_length_m * board.normal  # the tip's home
+        home_pos = home_pos - opts.brush.length_m * board.normal  # the tip's home
     scaled = strokes.scaled(opts.size_m)
     strokes_world = tuple(board.to_world(path) for path in scaled.paths)
     _check_route_size(strokes_world, board, home_pos)
@@ -531,8 +654,8 @@ def plan_writing(
     plan = plan_route(samples, times, board, opts)
     if not plan.faithful(opts) and not opts.best_effort:
         raise fidelity_error(plan, opts)
-    if not plan.compensated and opts.resegment != "off" and opts.resegment_iterations > 0:
-        plan = resegmented(samples, plan, opts)
+    if opts.resegment != "off" and opts.resegment_iterations > 0:
+        plan = resegmented(samples, plan, board, opts)
     return Mission(
         (plan.fit,),
         plan.fit.trajectory,
@@ -543,6 +666,7 @@ def plan_writing(
         plan.scale,
         time.perf_counter() - start,
         opts,
+        contact=plan.contact,
     )
 
 
@@ -567,18 +691,39 @@ class RouteSamples:
 
 @dataclass(frozen=True)
 class RoutePlan:
-    """One spline along a route: the fit, pen windows (s), fidelity, stretch, sample times (s)."""
+    """One spline along a route and how well it writes.
+
+    Attributes
+    ----------
+    fit
+        The engine's result.
+    windows
+        Pen-down ``(t_start, t_end)`` per stroke, s.
+    deviation, contact
+        Fidelity (:func:`fidelity`); ``contact`` is ``None`` unless the swung
+        tip is fitted.
+    scale
+        Stretch of the initial timing.
+    times
+        Sample times, (N,), s.
+    targets
+        What the samples were fitted to, (N, 3), m: the route itself, or with
+        the swung tip fitted, the route pressed into the board and polished
+        against the swing's second-order part.
+    """
 
     fit: FitResult
     windows: tuple[tuple[float, float], ...]
     deviation: Deviation
     scale: float
     times: FloatArray
-    compensated: bool
+    targets: FloatArray
+    contact: Contact | None
 
     def faithful(self, opts: WritingOptions) -> bool:
-        """Whether the pen-down path is within ``opts.tolerance``."""
-        return self.deviation.max_m <= opts.tolerance
+        """Whether the pen-down path is within ``opts.tolerance`` (and the contact holds)."""
+        held = self.contact is None or self.contact.holds
+        return self.deviation.max_m <= opts.tolerance and held
 
 
 def plan_route(
@@ -587,7 +732,7 @@ def plan_route(
     """One rest-to-rest spline along ``samples`` at ``times`` over ``board``, stretched to fit.
 
     The timing is stretched by ``opts.stretch_factor`` while the limits cannot
-    be met or the pen-down path is beyond the tolerance, at most
+    be met or the plan is not faithful (:meth:`RoutePlan.faithful`), at most
     ``opts.max_stretches`` times; the last plan is returned even if it is not
     faithful (the caller decides). No re-segmentation (:func:`resegmented`).
 
@@ -596,126 +741,168 @@ def plan_route(
     InfeasibleError
         The limits cannot be met even after ``max_stretches`` stretches.
     """
-    compensate = opts.tilt_compensation and board.kind == "horizontal" and opts.brush_length_m > 0
     scale, stretches = 1.0, 0
     while True:
         last = stretches >= opts.max_stretches
         try:
-            # Re-segmenting every attempt is needed only when the swung tip decides.
-            fit, windows, deviation, scaled_times = _plan_at(
-                samples, times * scale, opts, resegment=compensate
-            )
+            plan = _plan_at(samples, times * scale, board, opts, scale)
         except InfeasibleError:
             if last:
                 raise
             scale, stretches = scale * opts.stretch_factor, stretches + 1
             continue
-        if compensate:
-            fit, deviation = _compensate_tilt(samples, scaled_times, fit, windows, opts)
-        if deviation.max_m <= opts.tolerance or last:
-            break
-        # Slower: less tracking error and less brush swing. Skip the stretches that
-        # cannot reach the tolerance (the swung tip does not follow the model).
-        k = 1 if compensate else _stretches_needed(deviation.max_m, opts)
-        k = min(k, opts.max_stretches - stretches)
+        if plan.faithful(opts) or last:
+            return plan
+        # Slower: less tracking error and less brush swing. Skip the stretches
+        # that cannot reach the tolerance.
+        k = min(_stretches_needed(plan, opts), opts.max_stretches - stretches)
         scale, stretches = scale * opts.stretch_factor**k, stretches + k
-    return RoutePlan(fit, windows, deviation, scale, scaled_times, compensate)
 
 
-def _stretches_needed(deviation_m: float, opts: WritingOptions) -> int:
-    """Stretches predicted to bring ``deviation_m`` within the tolerance (at least 1).
+def _stretches_needed(plan: RoutePlan, opts: WritingOptions) -> int:
+    """Stretches predicted to bring ``plan`` within the tolerance (at least 1).
 
     The pen-down deviation falls about as ``scale^-p`` with ``p ~ 3.1`` (it
     halves per x1.25 on the bundled characters: 永 12.3 -> 6.1 -> 4.2 mm). The
     prediction uses :data:`DEVIATION_EXPONENT` = 3.5, a faster fall than seen,
     so it predicts too few stretches rather than too many: the plan lands on
     the same stretch as one step at a time, with the attempts between skipped.
+    A plan within the tolerance whose contact fails is stretched one step.
     """
+    if plan.deviation.max_m <= opts.tolerance:
+        return 1
     per_stretch = DEVIATION_EXPONENT * math.log(opts.stretch_factor)
-    return max(1, math.ceil(math.log(deviation_m / opts.tolerance) / per_stretch))
+    return max(1, math.ceil(math.log(plan.deviation.max_m / opts.tolerance) / per_stretch))
 
 
 def fidelity_error(plan: RoutePlan, opts: WritingOptions) -> InfeasibleError:
-    """The error for a plan whose pen-down path stays beyond the tolerance."""
+    """The error for a plan that stays unfaithful (beyond the tolerance, or out of contact)."""
+    what = "the swung brush tip" if plan.contact is not None else "the pen-down path"
+    if plan.deviation.max_m > opts.tolerance or plan.contact is None:
+        problem = (
+            f"{what} stays {1e3 * plan.deviation.max_m:.3g} mm from the input, expected "
+            f"within the tolerance of {1e3 * opts.tolerance:.3g} mm (1 % of the size "
+            "unless tolerance_m is given)"
+        )
+    else:
+        c = plan.contact
+        problem = (
+            f"{what} leaves {c.ink_strokes} ink strokes for {c.strokes} strokes, pressed up "
+            f"to {1e3 * c.max_depth_m:.3g} mm, expected one ink stroke per stroke within the "
+            f"brush's travel of {1e3 * c.travel_m:.3g} mm"
+        )
     return InfeasibleError(
-        f"strokes: the pen-down path stays {1e3 * plan.deviation.max_m:.3g} mm from the input "
-        f"after {opts.max_stretches} stretches ({plan.scale:.3g}x slower) within "
-        f"{opts.limits.describe()}, expected within the "
-        f"tolerance of {1e3 * opts.tolerance:.3g} mm (1 % of the size unless tolerance_m "
-        "is given); a larger size, a lower speed limit (the route is timed by it) or "
-        "best_effort",
+        f"strokes: {problem}, after {opts.max_stretches} stretches ({plan.scale:.3g}x slower) "
+        f"within {opts.limits.describe()}; a larger size, a lower speed limit (the route is "
+        "timed by it) or best_effort",
         ("fidelity",),
     )
 
 
-def resegmented(samples: RouteSamples, plan: RoutePlan, opts: WritingOptions) -> RoutePlan:
-    """``plan`` after time re-segmentation (paper 000 §5.4), if that stays faithful."""
-    fit, windows, deviation, times = _resegment(
-        samples, plan.times, (plan.fit, plan.windows, plan.deviation), opts
-    )
-    return RoutePlan(fit, windows, deviation, plan.scale, times, plan.compensated)
+def resegmented(
+    samples: RouteSamples, plan: RoutePlan, board: Board, opts: WritingOptions
+) -> RoutePlan:
+    """``plan`` after time re-segmentation (paper 000 §5.4), if that keeps it faithful.
 
-
-def _plan_at(
-    samples: RouteSamples, times: FloatArray, opts: WritingOptions, *, resegment: bool
-) -> tuple[FitResult, tuple[tuple[float, float], ...], Deviation, FloatArray]:
-    """Solve at ``times``, then re-segment if asked; the times it ends with."""
-    fit = solve(
-        _problem(
-            samples.points,
-            samples.roles,
-            samples.corners,
-            times,
-            opts,
-            max_spans=samples.max_spans,
-        ),
-        workspace=samples.workspace,
-    )
-    windows = _pen_windows(samples.roles, times, len(samples.strokes_world))
-    deviation = measure_deviation(fit.trajectory, windows, samples.strokes_world)
-    if not resegment or opts.resegment == "off" or opts.resegment_iterations == 0:
-        return fit, windows, deviation, times
-    return _resegment(samples, times, (fit, windows, deviation), opts)
-
-
-def _resegment(
-    samples: RouteSamples,
-    times: FloatArray,
-    current: tuple[FitResult, tuple[tuple[float, float], ...], Deviation],
-    opts: WritingOptions,
-) -> tuple[FitResult, tuple[tuple[float, float], ...], Deviation, FloatArray]:
-    """Paper 000 §5.4 on the mission's sample times; keep the result only if still faithful."""
-    fit = current[0]
-    n_ctrl = fit.trajectory.control_points.shape[0]
+    The targets stay those of ``plan`` (the polish's corrections are of second
+    order in the swing and move little with the times); fidelity and contact
+    are measured again, and ``plan`` is kept if the result is less faithful.
+    """
+    n_ctrl = plan.fit.trajectory.control_points.shape[0]
+    gain = opts.tip_gain(board)
 
     def make(ts: FloatArray) -> SmoothingProblem:
-        return _problem(samples.points, samples.roles, samples.corners, ts, opts, n_ctrl=n_ctrl)
+        return _problem(samples, plan.targets, ts, opts, gain=gain, n_ctrl=n_ctrl)
 
     penalty = 0.0
     if opts.resegment == "free":
         # Uniform scaling by k multiplies the jerk energy by k^-5: this rho
         # makes the current total time stationary, so the descent trades time
         # between segments and moves the total only where that pays.
-        penalty = 5.0 * fit.cost_terms["smoothness"] / float(times[-1])
+        penalty = 5.0 * plan.fit.cost_terms["smoothness"] / float(plan.times[-1])
     try:
         result = resegment(
             samples.points,
-            times,
+            plan.times,
             make,
             mode="free" if opts.resegment == "free" else "fixed",
             time_penalty=penalty,
             max_iter=opts.resegment_iterations,
-            initial_result=fit,  # the plan just made at these times: not solved again
+            initial_result=plan.fit,  # the plan just made at these times: not solved again
             workspace=samples.workspace,
         )
     except InfeasibleError:
-        return (*current, times)
-    strokes = samples.strokes_world
-    windows = _pen_windows(samples.roles, result.times, len(strokes))
-    deviation = measure_deviation(result.result.trajectory, windows, strokes)
-    if deviation.max_m > max(opts.tolerance, current[2].max_m):
-        return (*current, times)  # never trade fidelity for smoothness
-    return result.result, windows, deviation, result.times
+        return plan
+    new = _measured(samples, result.result, result.times, plan.targets, board, opts, plan.scale)
+    if not new.faithful(opts) and plan.faithful(opts):
+        return plan  # never trade fidelity for smoothness
+    if new.deviation.max_m > max(opts.tolerance, plan.deviation.max_m):
+        return plan
+    return new
+
+
+def _plan_at(
+    samples: RouteSamples, times: FloatArray, board: Board, opts: WritingOptions, scale: float
+) -> RoutePlan:
+    """Solve at ``times``; with the swung tip fitted, polish the targets against the swing."""
+    gain = opts.tip_gain(board)
+    targets = samples.points
+    fit = solve(_problem(samples, targets, times, opts, gain=gain), workspace=samples.workspace)
+    if gain is not None:
+        # The first solve fits the first-order tip; each pass takes what that
+        # model misses (measured on the last fit) off the pressed targets.
+        pressed = samples.points - _press(samples, board, opts)
+        n_ctrl = fit.trajectory.control_points.shape[0]
+        for _ in range(TIP_POLISH_PASSES):
+            targets = pressed - _model_error(fit.trajectory, times, gain, opts.brush.length_m)
+            problem = _problem(samples, targets, times, opts, gain=gain, n_ctrl=n_ctrl)
+            fit = solve(problem, workspace=samples.workspace)
+    return _measured(samples, fit, times, targets, board, opts, scale)
+
+
+def _press(samples: RouteSamples, board: Board, opts: WritingOptions) -> FloatArray:
+    """How far each target goes into the board (N, 3): the pressing depth on stroke samples."""
+    depth = np.where(samples.roles >= 0, opts.brush.press_depth_m, 0.0)
+    return np.asarray(depth[:, None] * board.normal)
+
+
+def _model_error(traj: Trajectory, t: FloatArray, gain: FloatArray, length: float) -> FloatArray:
+    """The swung tip minus its first-order model ``P + c a`` at times ``t`` (N, 3), m."""
+    model = traj.evaluate(t) + gain * traj.evaluate(t, 2)
+    return np.asarray(swung_tip(traj, t, length) - model)
+
+
+def _measured(
+    samples: RouteSamples,
+    fit: FitResult,
+    times: FloatArray,
+    targets: FloatArray,
+    board: Board,
+    opts: WritingOptions,
+    scale: float,
+) -> RoutePlan:
+    windows = _pen_windows(samples.roles, times, len(samples.strokes_world))
+    deviation, contact = fidelity(fit.trajectory, windows, samples.strokes_world, board, opts)
+    return RoutePlan(fit, windows, deviation, scale, times, targets, contact)
+
+
+def fidelity(
+    traj: Trajectory,
+    windows: tuple[tuple[float, float], ...],
+    strokes_world: tuple[FloatArray, ...],
+    board: Board,
+    opts: WritingOptions,
+) -> tuple[Deviation, Contact | None]:
+    """How well ``traj`` (the untilted tip) writes the strokes.
+
+    With the swung tip fitted (``opts.follows_tip``): the ink the plan leaves
+    (:func:`planned_ink`) against the strokes, in the board's plane, and its
+    :class:`Contact`. Otherwise the planned tip's 3-D distance over the pen
+    windows, and no contact.
+    """
+    if not opts.follows_tip(board):
+        return measure_deviation(traj, windows, strokes_world), None
+    return planned_ink(traj, windows, strokes_world, board, opts)
 
 
 def swung_tip(traj: Trajectory, t: FloatArray, brush_length_m: float) -> FloatArray:
@@ -729,32 +916,73 @@ def swung_tip(traj: Trajectory, t: FloatArray, brush_length_m: float) -> FloatAr
     return np.asarray(traj.evaluate(t) + brush_length_m * (np.array([0.0, 0.0, 1.0]) - b3))
 
 
-def _compensate_tilt(
-    samples: RouteSamples,
-    times: FloatArray,
-    fit: FitResult,
+def planned_ink(
+    traj: Trajectory,
     windows: tuple[tuple[float, float], ...],
+    strokes_world: tuple[FloatArray, ...],
+    board: Board,
     opts: WritingOptions,
-) -> tuple[FitResult, Deviation]:
-    """Shift stroke targets against the brush swing; keep the most faithful pass."""
-    length, stroke = opts.brush_length_m, samples.roles >= 0
-    n_ctrl = fit.trajectory.control_points.shape[0]
-    best = (fit, measure_deviation(fit.trajectory, windows, samples.strokes_world, length))
-    targets = samples.points.copy()
-    for _ in range(TILT_PASSES):
-        t = times[stroke]
-        swing = swung_tip(fit.trajectory, t, length) - fit.trajectory.evaluate(t)
-        targets[stroke] = samples.points[stroke] - swing
-        try:
-            fit = solve(
-                _problem(targets, samples.roles, samples.corners, times, opts, n_ctrl=n_ctrl)
-            )
-        except InfeasibleError:
-            break
-        deviation = measure_deviation(fit.trajectory, windows, samples.strokes_world, length)
-        if deviation.max_m < best[1].max_m:
-            best = (fit, deviation)
-    return best
+) -> tuple[Deviation, Contact]:
+    """The ink the swung tip leaves where it touches the board, against the strokes.
+
+    The tip is sampled every :data:`INK_SAMPLE_S` over the whole flight; each
+    run of samples on the board (below its surface, above its underside, over
+    it: :func:`on_board`) is one ink stroke. When there are as
+    many as input strokes, the ``i``-th is measured against stroke ``i`` (in
+    the board's plane, two-sided): a touch-down a little late or a lift-off a
+    little early costs what it leaves out, no more. Otherwise the pen windows
+    are measured as they are (and the contact does not hold).
+    """
+    brush = opts.brush
+    t = np.linspace(0.0, traj.duration, max(2, math.ceil(traj.duration / INK_SAMPLE_S) + 1))
+    tip = board.to_board(swung_tip(traj, t, brush.length_m))
+    depth = -tip[:, 2]
+    runs = _runs(on_board(tip, opts.size_m))
+    pen = pen_down(t, windows) > 0.0
+    contact = Contact(
+        min_depth_m=float(depth[pen].min()) if np.any(pen) else 0.0,
+        max_depth_m=float(max((depth[a:b].max() for a, b in runs), default=0.0)),
+        clearance_m=_clearance(t, -depth, windows, traj.duration),
+        travel_m=brush.travel_m,
+        ink_strokes=len(runs),
+        strokes=len(strokes_world),
+    )
+    if len(runs) != len(strokes_world):
+        length = brush.length_m
+        return measure_deviation(traj, windows, strokes_world, length, plane=board), contact
+    flat = tuple(board.to_board(s)[:, :2] for s in strokes_world)
+    return _two_sided([tip[a:b, :2] for a, b in runs], list(flat)), contact
+
+
+def on_board(local: FloatArray, size_m: float) -> NDArray[np.bool_]:
+    """Which tip positions ``(u, v, height)`` (N, 3), board frame, m, touch the board.
+
+    The board as the simulator has it (:func:`contact_board`): the
+    character's square ``size_m`` wide, :data:`BOARD_MARGIN_M` more on every
+    side, a slab :data:`BOARD_THICKNESS_M` thick.
+    """
+    lo, hi = -BOARD_MARGIN_M, size_m + BOARD_MARGIN_M
+    over = np.all((local[:, :2] >= lo) & (local[:, :2] <= hi), axis=1)
+    return np.asarray(over & (local[:, 2] < 0.0) & (local[:, 2] >= -BOARD_THICKNESS_M))
+
+
+def _runs(mask: NDArray[np.bool_]) -> list[tuple[int, int]]:
+    """``[start, stop)`` of every run of True in ``mask`` (N,)."""
+    edges = np.diff(np.concatenate([[0], mask.astype(np.int8), [0]]))
+    return list(zip(np.flatnonzero(edges == 1).tolist(), np.flatnonzero(edges == -1).tolist()))
+
+
+def _clearance(
+    t: FloatArray, height: FloatArray, windows: tuple[tuple[float, float], ...], end: float
+) -> float:
+    """The least, over the pen-up gaps (and before the first and after the last
+    window), of the highest the tip rises in the gap, m."""
+    edges = [0.0, *itertools.chain.from_iterable(windows), end]
+    highest = []
+    for a, b in zip(edges[::2], edges[1::2], strict=True):
+        inside = (t >= a) & (t <= b)
+        highest.append(float(height[inside].max()) if np.any(inside) else -math.inf)
+    return min(highest)
 
 
 def _turning_samples(
@@ -776,32 +1004,44 @@ def _turning_samples(
 
 
 def _problem(
-    points: FloatArray,
-    roles: FloatArray,
-    corners: FloatArray,
+    samples: RouteSamples,
+    targets: FloatArray,
     times: FloatArray,
     opts: WritingOptions,
     *,
+    gain: FloatArray | None = None,
     n_ctrl: int | None = None,
-    max_spans: int | None = None,
 ) -> SmoothingProblem:
+    """The smoothing problem of ``samples`` fitted to ``targets`` (N, 3) at ``times`` (N,).
+
+    ``gain``: the deviation is of ``p + gain * a`` (the swung tip's first-order
+    model) instead of ``p``; ``n_ctrl``: the control points (re-segmentation
+    keeps them), else from ``opts.knot_interval`` up to ``samples.max_spans``.
+    """
     duration = float(times[-1])
     spans = n_ctrl - opts.degree if n_ctrl else max(1, math.ceil(duration / opts.knot_interval))
-    if max_spans is not None:
-        spans = min(spans, max_spans)
+    if samples.max_spans is not None:
+        spans = min(spans, samples.max_spans)
     if spans > MAX_SPANS:
         raise InputError(
             f"knot_interval: got {opts.knot_interval:g} s for a {duration:.4g} s flight, i.e. "
             f"{spans:,} knot spans, expected at most {MAX_SPANS:,} (a longer knot_interval, "
             "a smaller size_m or fewer strokes)"
         )
-    stroke = roles >= 0
+    # Fitting the tip, lifts are held as firmly as the strokes: a lift the
+    # smoothing cuts short leaves the brush on the board between strokes, and
+    # the ink joins them. Fitting the path (paper 000) they are transits.
+    held = samples.roles != TRANSIT if gain is not None else samples.roles >= 0
+    corners = samples.corners
     deviations = [
-        PointDeviation(times[stroke], points[stroke], opts.data_weight),
-        PointDeviation(times[corners], points[corners], opts.turning_weight),
+        PointDeviation(times[held], targets[held], opts.data_weight, gain),
+        PointDeviation(times[corners], targets[corners], opts.turning_weight, gain),
     ]
-    if np.any(~stroke) and opts.transit_weight > 0:
-        deviations.append(PointDeviation(times[~stroke], points[~stroke], opts.transit_weight))
+    transit = ~held
+    if np.any(transit) and opts.transit_weight > 0:
+        deviations.append(
+            PointDeviation(times[transit], targets[transit], opts.transit_weight, gain)
+        )
     return SmoothingProblem(
         dim=3,
         degree=opts.degree,
@@ -809,7 +1049,7 @@ def _problem(
         duration=duration,
         smoothness={3: 1.0},
         deviations=tuple(deviations),
-        boundary=Boundary.rest(points[0], points[-1], 3),
+        boundary=Boundary.rest(targets[0], targets[-1], 3),
         limits=opts.derivative_limits(),
     )
 
@@ -828,19 +1068,33 @@ def measure_deviation(
     strokes_world: tuple[FloatArray, ...],
     brush_length_m: float = 0.0,
     samples_per_stroke: int = 400,
+    *,
+    plane: Board | None = None,
 ) -> Deviation:
     """Two-sided distance between the pen-down path and the input strokes.
 
     For each stroke: the largest distance from pen-down samples to the
     stroke's polyline, and from the stroke's points to the pen-down path
-    (its dense samples as a polyline). 3-D distances: lifting off the board
-    counts. With ``brush_length_m > 0`` the path is the swung tip
-    (:func:`swung_tip`), else the planned curve itself.
+    (its dense samples as a polyline). With ``brush_length_m > 0`` the path is
+    the swung tip (:func:`swung_tip`), else the planned curve itself. 3-D
+    distances (lifting off the board counts), or with ``plane`` distances in
+    that board's plane (the ink's view: a pressed tip is not off the stroke).
     """
-    forward, backward, total, count = 0.0, 0.0, 0.0, 0
+    paths, strokes = [], []
     for (t0, t1), stroke in zip(windows, strokes_world, strict=True):
         t = np.linspace(t0, t1, samples_per_stroke)
         path = swung_tip(traj, t, brush_length_m) if brush_length_m else traj.evaluate(t)
+        if plane is not None:
+            path, stroke = plane.to_board(path)[:, :2], plane.to_board(stroke)[:, :2]
+        paths.append(path)
+        strokes.append(stroke)
+    return _two_sided(paths, strokes)
+
+
+def _two_sided(paths: list[FloatArray], strokes: list[FloatArray]) -> Deviation:
+    """Distances between each path (K, d) and its stroke (J, d), both ways."""
+    forward, backward, total, count = 0.0, 0.0, 0.0, 0
+    for path, stroke in zip(paths, strokes, strict=True):
         to_input = polyline_distance(path, stroke)
         to_path = polyline_distance(stroke, path)
         forward = max(forward, float(to_input.max()))
@@ -877,26 +1131,36 @@ def check_separation(
     return closest
 
 
-#: How far the simulated board is raised into the brush's planned path, m.
+#: How far the simulated board is raised into the planned tip's path when the
+#: path is fitted (``follow="path"``), m: that plan touches the surface, so
+#: without it tracking errors would lift the brush off.
 PRESS_M = 0.002
 #: How far the simulated board reaches beyond the writing on every side, m.
 BOARD_MARGIN_M = 0.1
+#: The simulated board is a slab this thick, m: a tip below it is under the
+#: board (taking off from the floor beneath it), not pressing on it.
+BOARD_THICKNESS_M = 0.05
 
 
 def contact_board(mission: Mission) -> ContactBoard | None:
     """The simulator's board under a horizontal writing board (``None`` for a wall).
 
-    The plan touches the surface; the simulated board sits :data:`PRESS_M`
-    higher so that the brush presses into it and tracking errors do not lift
-    it off. The simulator's contact model is a horizontal slab only.
+    With the swung tip fitted the plan presses the brush into the surface
+    itself (``brush.press_depth_m``), so the simulated board is the surface;
+    with the path fitted it sits :data:`PRESS_M` higher. The simulator's
+    contact model is a horizontal slab only.
     """
     from skyquill.sim import ContactBoard
 
     if mission.board.kind != "horizontal":
         return None
     corner, size, margin = mission.board.origin, mission.options.size_m, BOARD_MARGIN_M
+    raised = 0.0 if mission.options.follows_tip(mission.board) else PRESS_M
     return ContactBoard(
-        height_m=float(corner[2]) + PRESS_M,
+        height_m=float(corner[2]) + raised,
+        stiffness_n_per_m=mission.options.brush.stiffness_n_per_m,
+        damping_ns_per_m=mission.options.brush.damping_ns_per_m,
+        thickness_m=BOARD_THICKNESS_M,
         extent=(corner[0] - margin, corner[0] + size + margin,
                 corner[1] - margin, corner[1] + size + margin),
     )  # fmt: skip

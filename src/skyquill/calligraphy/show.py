@@ -112,6 +112,7 @@ def plan_show(
     *,
     scheduler: str | None = None,
     board_kind: Literal["horizontal", "wall"] = "horizontal",
+    board_height_m: float = 1.0,
     lift_m: float = 0.05,
     fly: bool = False,
     progress: Progress | None = None,
@@ -139,6 +140,8 @@ def plan_show(
         cluster's workers. The missions are the same as planned locally.
     board_kind
         ``"horizontal"`` boards (paper 000) or ``"wall"``; see :func:`layout`.
+    board_height_m
+        Height of the boards (a wall's: of the writing's bottom), m.
     lift_m
         Brush lift between strokes, m.
     fly
@@ -164,7 +167,10 @@ def plan_show(
     """
     opts = options or WritingOptions()
     separation = as_float("separation_m", separation_m, positive=True)
-    places = layout(len(parts), opts.size_m, separation, kind=board_kind, lift_m=lift_m)
+    height = as_float("board_height_m", board_height_m)
+    places = layout(
+        len(parts), opts.size_m, separation, height_m=height, kind=board_kind, lift_m=lift_m
+    )
     jobs = [(part, board, opts, home) for part, (board, home) in zip(parts, places, strict=True)]
     steps = _Steps(len(jobs) * (2 if fly else 1), progress)
     steps.start(f"planning {len(jobs)} drone(s)")
@@ -189,7 +195,7 @@ def fly_mission(mission: Mission) -> Flight:
 
     return simulate(
         mission.vehicle_trajectory(),
-        Quadrotor(brush_length_m=mission.options.brush_length_m),
+        Quadrotor(brush_length_m=mission.options.brush.length_m),
         board=contact_board(mission),
     )
 

@@ -134,10 +134,21 @@ def write(
     rate: Annotated[float, typer.Option(help="Sample rate of the CSVs, Hz.")] = 100.0,
     fly: Annotated[bool, typer.Option(help="Also fly each drone in simulation (RPT).")] = False,
     board: Annotated[str, typer.Option(help="horizontal (the paper's) or wall.")] = "horizontal",
+    board_height: Annotated[
+        float, typer.Option(help="Height of the board (a wall: of the writing's bottom), m.")
+    ] = 1.0,
     lift: Annotated[float, typer.Option(help="Brush lift between strokes, m.")] = 0.05,
-    tilt_compensation: Annotated[
-        bool, typer.Option(help="Plan against the hanging brush's swing (horizontal board).")
-    ] = False,
+    follow: Annotated[
+        str,
+        typer.Option(
+            help="What follows the strokes on a horizontal board: tip (the swinging brush "
+            "tip, which leaves the ink) or path (the vehicle's path, paper 000)."
+        ),
+    ] = "tip",
+    brush_length: Annotated[float, typer.Option(help="Vehicle centre to brush tip, m.")] = 0.3,
+    press_depth: Annotated[
+        float, typer.Option(help="How deep the brush is pressed while writing (sets the width), m.")
+    ] = 0.005,
     scheduler: Annotated[
         str | None,
         typer.Option(help="dask.distributed scheduler address (or 'local') for large shows."),
@@ -146,6 +157,7 @@ def write(
     force: Force = False,
 ) -> None:
     """Plan pen-up / pen-down writing flights; write CSVs, input_strokes.json, plot, summary."""
+    from skyquill.calligraphy.brush import Brush
     from skyquill.calligraphy.mission import WritingOptions
     from skyquill.calligraphy.show import plan_show
     from skyquill.strokes import typed_parts
@@ -158,7 +170,8 @@ def write(
             limits=VehicleLimits(vmax, amax, jmax, vmax_axis, amax_axis, jmax_axis),
             norm_sides=norm_sides,
             best_effort=best_effort,
-            tilt_compensation=tilt_compensation,
+            brush=Brush(length_m=brush_length, press_depth_m=press_depth),
+            follow=_follow(follow),
             target=upload_target(target),
         )
         if drones < 1:
@@ -178,6 +191,7 @@ def write(
                 options,
                 scheduler=scheduler,
                 board_kind=_board_kind(board, fly),
+                board_height_m=board_height,
                 lift_m=lift,
                 fly=fly,
             )
@@ -199,6 +213,12 @@ def _uploads_note(summary: dict[str, Any]) -> str:
         f", {len(pieces)} upload(s) for {summary['target']['name']} "
         f"({', '.join(map(str, pieces))} pieces)"
     )
+
+
+def _follow(name: str) -> Any:
+    if name not in ("tip", "path"):
+        raise InputError(f"--follow: got {name!r}, expected tip or path")
+    return name
 
 
 def _board_kind(name: str, fly: bool) -> Any:

@@ -233,12 +233,17 @@ def assemble(problem: SmoothingProblem, cache: AssemblyCache | None = None) -> A
     F = np.zeros((M, d))
     coupled: list[tuple[sp.csr_array, FloatArray]] = []
     for term in problem.deviations:
-        if isinstance(term, PointDeviation):
-            H = design_matrix(problem, term.times, 0, cache)
-            G_axis = G_axis + term.weight * (H.T @ H)
-            F -= 2.0 * term.weight * (H.T @ term.points)
-        else:
+        if not isinstance(term, PointDeviation):
             coupled.append(_flat_term(problem, term))
+            continue
+        groups = point_rows(problem, term, cache)
+        for mask, H in groups:
+            F -= 2.0 * term.weight * (H.T @ term.points) * mask
+            if len(groups) == 1:
+                G_axis = G_axis + term.weight * (H.T @ H)
+            else:  # axes with different gains: one block per group of axes
+                block = sp.kron(term.weight * (H.T @ H), sp.diags_array(mask), format="csr")
+                coupled.append((sp.csr_array(block), np.zeros(M * d)))
     G_coupled = f_coupled = None
     if coupled:
         G_coupled = sp.csr_array(sum((g for g, _ in coupled), sp.csr_array((M * d, M * d))))
@@ -284,14 +289,32 @@ def problem_cost(
     deviation = 0.0
     for term in problem.deviations:
         if isinstance(term, PointDeviation):
-            residual = design_matrix(problem, term.times, 0, cache) @ C - term.points
-            deviation += term.weight * float(np.sum(residual**2))
+            for mask, H in point_rows(problem, term, cache):
+                residual = (H @ C - term.points) * mask
+                deviation += term.weight * float(np.sum(residual**2))
         else:
             Q, w = term.quadratic()
             active = _window_controls(problem, term.t_start, term.t_end) > 0
             diff = C[active] - w
             deviation += term.weight * float(np.sum(diff * (diff @ Q)))
     return {"smoothness": smooth, "deviation": deviation, "total": smooth + deviation}
+
+
+def point_rows(
+    problem: SmoothingProblem, term: PointDeviation, cache: AssemblyCache | None = None
+) -> list[tuple[FloatArray, sp.csr_array]]:
+    """The rows ``B(s_i) + c alpha^2 B''(s_i)`` of ``term`` (N, M), per group of axes.
+
+    Returns ``[(mask (d,), rows), ...]``: the axes (``mask`` 1.0) whose gain
+    ``c`` is the same share the rows (:meth:`PointDeviation.axis_groups`); one
+    group, all axes, without a gain. ``d^2/dt^2 = alpha^2 d^2/ds^2``.
+    """
+    H = design_matrix(problem, term.times, 0, cache)
+    groups = term.axis_groups()
+    if len(groups) == 1 and groups[0][1] == 0.0:
+        return [(groups[0][0], H)]
+    H2 = design_matrix(problem, term.times, 2, cache) * problem.alpha**2
+    return [(mask, sp.csr_array(H + gain * H2) if gain else H) for mask, gain in groups]
 
 
 def _params(problem: SmoothingProblem, times: FloatArray) -> FloatArray:

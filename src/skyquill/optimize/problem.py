@@ -43,7 +43,14 @@ def _window(name: str, t_start: float, t_end: float) -> None:
 
 @dataclass(frozen=True)
 class PointDeviation:
-    """Penalise ``weight * sum_i ||p(t_i) - points_i||^2`` (paper 003 eq. 11-12).
+    """Penalise ``weight * sum_i ||p(t_i) + c * a(t_i) - points_i||^2`` (paper 003 eq. 11-12).
+
+    ``a`` is the acceleration and ``c = accel_gain`` a gain per axis (s^2),
+    zero by default: then this is paper 003's point deviation. A non-zero gain
+    puts the deviation on a point the acceleration moves linearly: the tip of
+    a brush hanging ``L`` below a quadrotor swings by ``-(L / g) a_xy`` as it
+    tilts (to first order), so ``c = (-L/g, -L/g, 0)`` fits the tip, not the
+    vehicle (:mod:`skyquill.calligraphy.mission`).
 
     Parameters
     ----------
@@ -53,17 +60,29 @@ class PointDeviation:
         Shape (N, d), m.
     weight
         ``omega >= 0``.
+    accel_gain
+        Shape (d,), s^2, or ``None`` for zero.
     """
 
     times: FloatArray
     points: FloatArray
     weight: float = 1.0
+    accel_gain: FloatArray | None = None
 
     def __post_init__(self) -> None:
         t, p = _points_at_times("points", self.times, self.points)
         as_float("points.weight", self.weight, nonneg=True)
         object.__setattr__(self, "times", t)
         object.__setattr__(self, "points", p)
+        if self.accel_gain is not None:
+            gain = as_array("points.accel_gain", self.accel_gain, shape=(p.shape[1],))
+            object.__setattr__(self, "accel_gain", None if not np.any(gain) else gain)
+
+    def axis_groups(self) -> list[tuple[FloatArray, float]]:
+        """The axes that share a gain: ``[(mask (d,), gain), ...]``, one group if all do."""
+        d = self.points.shape[1]
+        gain = np.zeros(d) if self.accel_gain is None else self.accel_gain
+        return [(np.asarray(gain == g, dtype=float), float(g)) for g in np.unique(gain)]
 
 
 @dataclass(frozen=True)

@@ -126,3 +126,26 @@ def test_terms_on_subsets_of_the_times_move_with_them() -> None:
     analytic = time_gradient(t0, make).grad_segments
     numeric = finite_difference_gradient(t0, make, step=1e-6, scheme="central")
     assert np.allclose(analytic, numeric, rtol=1e-5, atol=1e-6 * np.abs(numeric).max())
+
+
+@pytest.mark.parametrize("gain", [(-0.03, -0.03, 0.0), (-0.05, 0.02, -0.01), (0.04, 0.04, 0.04)])
+def test_accel_gain_gradient_matches_central_differences(gain: tuple[float, ...]) -> None:
+    """A brush tip's deviation ``p + c a`` (gains per axis, some axes sharing one): the
+    gradient gains the third-derivative rows and the explicit ``alpha`` term of ``c a``."""
+    rng = np.random.default_rng(11)
+    n = 12
+    t0 = np.cumsum(np.r_[0.0, rng.uniform(0.2, 0.5, n - 1)])
+    pts = np.cumsum(rng.normal(0.0, 0.1, (n, 3)), axis=0)
+
+    def make(times: np.ndarray) -> SmoothingProblem:
+        return SmoothingProblem(
+            3,
+            5,
+            16,
+            float(times[-1]),
+            deviations=(PointDeviation(times, pts, 1e3, accel_gain=np.array(gain)),),
+            boundary=Boundary.rest(pts[0], pts[-1], 3),
+        )
+
+    grad = time_gradient(t0, make)
+    close(grad.grad_segments, finite_difference_gradient(t0, make, step=1e-5))

@@ -43,7 +43,7 @@ from collections.abc import Callable
 import numpy as np
 from numpy.typing import NDArray
 
-from skyquill.optimize.assemble import AssemblyCache, _params, design_matrix
+from skyquill.optimize.assemble import AssemblyCache, _params, design_matrix, point_rows
 from skyquill.optimize.problem import PointDeviation, SmoothingProblem
 from skyquill.optimize.resegment.multipliers import Multipliers, multipliers
 from skyquill.optimize.resegment.problems import ProblemFactory, check_problem, zero_based
@@ -170,11 +170,40 @@ def _lagrangian_gradient(
             g_alpha += (2 * order - 1) * sigma * alpha ** (2 * order - 2) * energy
     for term in problem.deviations:
         if isinstance(term, PointDeviation) and term.weight:
-            r = design_matrix(problem, term.times, 0, cache) @ C - term.points
-            v = design_matrix(problem, term.times, 1, cache) @ C
-            at_times(term.times, 2.0 * term.weight * np.sum(r * v, axis=1))
+            # Two steps, not "g_alpha += ...": at_times adds to g_alpha during the call.
+            explicit = _point_terms(problem, term, C, at_times, cache)
+            g_alpha += explicit
     grad_t[-1] += g_alpha * (-alpha / problem.duration)
     return grad_t
+
+
+def _point_terms(
+    problem: SmoothingProblem,
+    term: PointDeviation,
+    C: FloatArray,
+    at_times: Callable[[FloatArray, FloatArray], None],
+    cache: AssemblyCache | None,
+) -> float:
+    """A point deviation's ``dJ/ds_i`` (through ``at_times``) and its own ``d/dalpha``.
+
+    The residual ``r_i = B(s_i) C + c alpha^2 B_2(s_i) C - d_i`` (``B_n`` the
+    ``n``-th ``s``-derivative rows) moves with ``s_i`` as
+    ``B_1(s_i) C + c alpha^2 B_3(s_i) C`` and, with a gain ``c``, with
+    ``alpha`` itself as ``2 c alpha B_2(s_i) C``.
+    """
+    alpha = problem.alpha
+    r = np.zeros_like(term.points)
+    for mask, H in point_rows(problem, term, cache):
+        r += (H @ C - term.points) * mask
+    v = design_matrix(problem, term.times, 1, cache) @ C
+    g_alpha = 0.0
+    if term.accel_gain is not None:
+        gain = term.accel_gain
+        v = v + alpha**2 * gain * (design_matrix(problem, term.times, 3, cache) @ C)
+        acc_s = design_matrix(problem, term.times, 2, cache) @ C
+        g_alpha = 2.0 * term.weight * float(np.sum(r * (2.0 * alpha * gain * acc_s)))
+    at_times(term.times, 2.0 * term.weight * np.sum(r * v, axis=1))
+    return g_alpha
 
 
 def _equality_terms(
