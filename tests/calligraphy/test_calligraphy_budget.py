@@ -6,12 +6,12 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
+from ink_check import ink_distance
 
 from skyquill.calligraphy.board import Board
 from skyquill.calligraphy.mission import Mission, WritingOptions, plan_writing
 from skyquill.calligraphy.show import plan_show
 from skyquill.errors import InfeasibleError, InputError
-from skyquill.geometry import polyline_distance
 from skyquill.strokes import Strokes, hanzi_strokes, typed_strokes
 from skyquill.targets import CRAZYFLIE, is_hover, plan_uploads
 from skyquill.trajectory import RestToRestSequence, SplineTrajectory, Trajectory
@@ -70,13 +70,12 @@ def test_uploads_change_at_rest_after_a_hover(mission: Mission) -> None:
         assert len(hovers) == len(uploads) - 1
 
 
-def test_pen_down_path_within_one_percent(mission: Mission) -> None:
-    """Checked on dense samples where the pen is down, not through the planner's windows."""
-    traj = mission.trajectory
-    t = np.linspace(0.0, traj.duration, 40_000)
-    down = traj.evaluate(t[mission.pen(t) > 0])
-    nearest = np.min([polyline_distance(down, s) for s in mission.strokes_world], axis=0)
-    assert nearest.max() <= 0.01 * SIZE_M
+def test_ink_within_one_percent(mission: Mission) -> None:
+    """The swung tip's ink, read densely apart from the planner: one ink stroke per stroke,
+    within 1 % of the size in the board's plane."""
+    distance, ink_strokes = ink_distance(mission)
+    assert distance <= 0.01 * SIZE_M
+    assert ink_strokes == len(mission.strokes_world)
     assert mission.deviation.max_m <= 0.01 * SIZE_M
     assert mission.faithful
 

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from skyquill.calligraphy.board import Board
+from skyquill.calligraphy.brush import Brush
 from skyquill.calligraphy.mission import (
     MAX_STROKES,
     WritingOptions,
@@ -17,7 +18,7 @@ from skyquill.calligraphy.mission import (
 )
 from skyquill.calligraphy.show import layout
 from skyquill.errors import InputError
-from skyquill.strokes import Strokes
+from skyquill.strokes import Strokes, hanzi_strokes
 
 H = Strokes(
     paths=(
@@ -37,12 +38,35 @@ def test_size_out_of_range_is_refused(size: float) -> None:
 
 
 def test_brush_and_lift_are_bounded() -> None:
-    with pytest.raises(InputError, match=r"^brush_length_m: got 3 m, expected at most 2 m"):
-        WritingOptions(brush_length_m=3.0)
+    with pytest.raises(InputError, match=r"^brush length_m: got 3 m, expected at most 2 m"):
+        Brush(length_m=3.0)
+    with pytest.raises(InputError, match=r"^brush press_depth_m: got 0.03 m, expected less "):
+        Brush(press_depth_m=0.03)
+    with pytest.raises(InputError, match=r"^brush: got float, expected Brush"):
+        WritingOptions(brush=0.3)  # type: ignore[arg-type]
+    with pytest.raises(InputError, match=r"^follow: got 'ink', expected 'tip' or 'path'"):
+        WritingOptions(follow="ink")  # type: ignore[arg-type]
     with pytest.raises(InputError, match=r"^lift_m: got 1000 m, expected at most 1 m"):
         Board(lift_m=1000.0)
     with pytest.raises(InputError, match=r"^lift_m: got 1000 m"):
         layout(2, 0.5, 1.0, lift_m=1000.0)
+
+
+@pytest.mark.parametrize(
+    ("board", "brush", "message"),
+    [
+        (Board(), Brush(length_m=0.01), r"^brush length_m: got 0.01 m, expected at least 0.05 m"),
+        (Board(origin=np.array([0.0, 0.0, -0.5])), Brush(), r"^board: got the writing from -0.5 m"),
+        (Board(origin=np.array([0.0, 0.0, 119.9])), Brush(), r"vehicle up to 120.25 m"),
+        (Board("wall", np.array([0.0, 0.0, 0.0])), Brush(), r"above the ground \(z > 0\)"),
+    ],
+    ids=["brush-too-short", "board-underground", "board-too-high", "wall-on-the-ground"],
+)
+def test_a_brush_or_board_the_vehicle_cannot_write_with_is_refused(
+    board: Board, brush: Brush, message: str
+) -> None:
+    with pytest.raises(InputError, match=message):
+        plan_writing(hanzi_strokes("一"), board, WritingOptions(brush=brush))
 
 
 def test_drones_are_bounded() -> None:

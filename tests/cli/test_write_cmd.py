@@ -36,9 +36,16 @@ def test_write_text_gives_pen_column_and_input_strokes(tmp_path: Path) -> None:
     strokes = json.loads((tmp_path / "input_strokes.json").read_text())["strokes"]
     summary = json.loads((tmp_path / "summary.json").read_text())
     assert len(strokes) == summary["strokes"]
-    # Pen-down samples of the CSV lie near the input strokes (same world frame).
-    down = data[data[:, -1] == 1.0, 1:4]
-    nearest = np.min([polyline_distance(down, np.array(s)) for s in strokes], axis=0)
+    # The brush tip read from the CSV (0.3 m along the thrust axis below the vehicle:
+    # the acceleration columns give it) lies, pen down, near the input strokes (given at
+    # the vehicle's height: same frame), in the board's plane.
+    down = data[data[:, -1] == 1.0]
+    thrust = down[:, 7:10] + np.array([0.0, 0.0, 9.81])
+    tip = down[:, 1:4] + 0.3 * (
+        np.array([0.0, 0.0, 1.0]) - thrust / np.linalg.norm(thrust, axis=1)[:, None]
+    )
+    flat = [np.array(s)[:, :2] for s in strokes]
+    nearest = np.min([polyline_distance(tip[:, :2], s) for s in flat], axis=0)
     assert nearest.max() <= 0.01 * 0.4
     for key in (
         "duration_s",

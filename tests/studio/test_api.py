@@ -88,9 +88,10 @@ def test_a_plan_of_two_strokes(planned: dict[str, Any]) -> None:
     assert max(drone["acc"]) <= limits["amax"] + 1e-4
     assert max(drone["jerk"]) <= limits["jmax"] + 1e-4
     assert all(c["relative_excess"] <= 1e-9 for c in drone["checks"])
-    # Pen down, the tip is on the board (h = 0) and within 1 % of 0.5 m of the input.
+    # Pen down, the (swung) tip presses into the board within the brush's travel (2 cm)
+    # and lies within 1 % of 0.5 m of the input.
     down = np.array(drone["path"])[np.array(drone["pen"]) == 1]
-    assert np.abs(down[:, 2]).max() < 5e-3
+    assert down[:, 2].min() >= -0.02 and down[:, 2].max() < 2e-3
     assert drone["deviation_max_m"] <= 0.005 + 1e-9
     assert drone["flight_rmse_m"] < 0.02
     names = [f["name"] for f in result["files"]]

@@ -413,6 +413,15 @@ class Mission:
         """Vehicle position minus tip position (3,), m."""
         return self.options.brush.length_m * self.board.normal
 
+    def tip(self, t: FloatArray) -> FloatArray:
+        """Where the brush tip is at times ``t`` (N,): (N, 3), m.
+
+        The swung tip when it is fitted (:func:`swung_tip`), else the planned one.
+        """
+        if self.options.follows_tip(self.board):
+            return swung_tip(self.trajectory, t, self.options.brush.length_m)
+        return self.trajectory.evaluate(t)
+
     def vehicle_trajectory(self) -> Trajectory:
         """The vehicle's trajectory: the tip's, offset by the brush along the board normal.
 
@@ -484,7 +493,7 @@ def densify(polyline: FloatArray, spacing: float = TRANSIT_SPACING_M) -> FloatAr
 
 @dataclass
 class _Route:
-    """The mission polyline with a role per sample: stroke index, :data:`TRANSIT` or :data:`LIFT`."""
+    """The mission polyline with a role per sample: stroke index, ``TRANSIT`` or ``LIFT``."""
 
     points: list[FloatArray] = field(default_factory=list)
     role: list[FloatArray] = field(default_factory=list)
@@ -573,10 +582,8 @@ def check_reach(board: Board, opts: WritingOptions) -> None:
             "(a shorter brush cannot reach the board past the vehicle's frame)"
         )
     bottom = float(board.origin[2])
-    if board.kind == "horizontal":
-        top = bottom + length + board.lift_m
-    else:
-        top = bottom + opts.size_m
+    # The highest the vehicle goes: a lift above a horizontal board, a wall's top.
+    top = bottom + (length + board.lift_m if board.kind == "horizontal" else opts.size_m)
     if bottom <= 0.0 or top > MAX_ALTITUDE_M:
         raise InputError(
             f"board: got the writing from {bottom:g} m up, the vehicle up to {top:g} m, "
@@ -754,25 +761,24 @@ def plan_route(
         if plan.faithful(opts) or last:
             return plan
         # Slower: less tracking error and less brush swing. Skip the stretches
-        # that cannot reach the tolerance.
-        k = min(_stretches_needed(plan, opts), opts.max_stretches - stretches)
+        # that cannot reach the tolerance (a contact that fails: one at a time).
+        off = plan.deviation.max_m
+        k = _stretches_needed(off, opts) if off > opts.tolerance else 1
+        k = min(k, opts.max_stretches - stretches)
         scale, stretches = scale * opts.stretch_factor**k, stretches + k
 
 
-def _stretches_needed(plan: RoutePlan, opts: WritingOptions) -> int:
-    """Stretches predicted to bring ``plan`` within the tolerance (at least 1).
+def _stretches_needed(deviation_m: float, opts: WritingOptions) -> int:
+    """Stretches predicted to bring ``deviation_m`` within the tolerance (at least 1).
 
     The pen-down deviation falls about as ``scale^-p`` with ``p ~ 3.1`` (it
     halves per x1.25 on the bundled characters: 永 12.3 -> 6.1 -> 4.2 mm). The
     prediction uses :data:`DEVIATION_EXPONENT` = 3.5, a faster fall than seen,
     so it predicts too few stretches rather than too many: the plan lands on
     the same stretch as one step at a time, with the attempts between skipped.
-    A plan within the tolerance whose contact fails is stretched one step.
     """
-    if plan.deviation.max_m <= opts.tolerance:
-        return 1
     per_stretch = DEVIATION_EXPONENT * math.log(opts.stretch_factor)
-    return max(1, math.ceil(math.log(plan.deviation.max_m / opts.tolerance) / per_stretch))
+    return max(1, math.ceil(math.log(deviation_m / opts.tolerance) / per_stretch))
 
 
 def fidelity_error(plan: RoutePlan, opts: WritingOptions) -> InfeasibleError:
@@ -833,7 +839,9 @@ def resegmented(
         )
     except InfeasibleError:
         return plan
-    new = _measured(samples, result.result, result.times, plan.targets, board, opts, plan.scale)
+    new = _measured(
+        samples, result.result, result.times, plan.targets, board=board, opts=opts, scale=plan.scale
+    )
     if not new.faithful(opts) and plan.faithful(opts):
         return plan  # never trade fidelity for smoothness
     if new.deviation.max_m > max(opts.tolerance, plan.deviation.max_m):
@@ -857,7 +865,7 @@ def _plan_at(
             targets = pressed - _model_error(fit.trajectory, times, gain, opts.brush.length_m)
             problem = _problem(samples, targets, times, opts, gain=gain, n_ctrl=n_ctrl)
             fit = solve(problem, workspace=samples.workspace)
-    return _measured(samples, fit, times, targets, board, opts, scale)
+    return _measured(samples, fit, times, targets, board=board, opts=opts, scale=scale)
 
 
 def _press(samples: RouteSamples, board: Board, opts: WritingOptions) -> FloatArray:
@@ -877,6 +885,7 @@ def _measured(
     fit: FitResult,
     times: FloatArray,
     targets: FloatArray,
+    *,
     board: Board,
     opts: WritingOptions,
     scale: float,
@@ -969,7 +978,8 @@ def on_board(local: FloatArray, size_m: float) -> NDArray[np.bool_]:
 def _runs(mask: NDArray[np.bool_]) -> list[tuple[int, int]]:
     """``[start, stop)`` of every run of True in ``mask`` (N,)."""
     edges = np.diff(np.concatenate([[0], mask.astype(np.int8), [0]]))
-    return list(zip(np.flatnonzero(edges == 1).tolist(), np.flatnonzero(edges == -1).tolist()))
+    starts, stops = np.flatnonzero(edges == 1).tolist(), np.flatnonzero(edges == -1).tolist()
+    return list(zip(starts, stops, strict=True))
 
 
 def _clearance(
@@ -1084,10 +1094,12 @@ def measure_deviation(
     for (t0, t1), stroke in zip(windows, strokes_world, strict=True):
         t = np.linspace(t0, t1, samples_per_stroke)
         path = swung_tip(traj, t, brush_length_m) if brush_length_m else traj.evaluate(t)
-        if plane is not None:
-            path, stroke = plane.to_board(path)[:, :2], plane.to_board(stroke)[:, :2]
-        paths.append(path)
-        strokes.append(stroke)
+        if plane is None:
+            paths.append(path)
+            strokes.append(stroke)
+        else:
+            paths.append(plane.to_board(path)[:, :2])
+            strokes.append(plane.to_board(stroke)[:, :2])
     return _two_sided(paths, strokes)
 
 

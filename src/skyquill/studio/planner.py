@@ -220,7 +220,7 @@ def _drone_plan(
         "source_scale": mission.options.size_m / float(np.max(hi - lo)),
         "input": [_round(board.to_board(s)[:, :2]) for s in mission.strokes_world],
         "t": _round(t),
-        "path": _round(board.to_board(traj.evaluate(t))),
+        "path": _round(board.to_board(mission.tip(t))),
         "pen": mission.pen(t).astype(int).tolist(),
         "speed": _round(v),
         "acc": _round(a),
