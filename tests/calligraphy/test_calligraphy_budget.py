@@ -138,7 +138,9 @@ def test_target_must_be_an_upload_target() -> None:
 
 
 def test_a_show_of_targeted_missions_checks_separation() -> None:
-    options = WritingOptions(size_m=0.3, target=CRAZYFLIE)
+    # The vehicle's path fitted: 0.3 m characters fit a Crazyflie's uploads (fitting the
+    # tip, a stroke alone strays 6 mm at 0.4 m: few knot spans for the swing).
+    options = WritingOptions(size_m=0.3, target=CRAZYFLIE, follow="path")
     show = plan_show([hanzi_strokes("人"), hanzi_strokes("中")], options, workers=1)
     assert show.min_separation_m >= 1.0
     for m in show.missions:
@@ -146,8 +148,11 @@ def test_a_show_of_targeted_missions_checks_separation() -> None:
 
 
 def test_one_strategy_alone_is_measured() -> None:
-    """中 does not fit one upload at 1 %: alone, that strategy says so; best effort returns it."""
-    alone = WritingOptions(size_m=SIZE_M, target=CRAZYFLIE, target_strategies=("one-upload",))
+    """Fitting the path, 中 does not fit one upload at 1 %: alone, that strategy says so;
+    best effort returns it. (Fitting the tip, it fits.)"""
+    alone = WritingOptions(
+        size_m=SIZE_M, target=CRAZYFLIE, target_strategies=("one-upload",), follow="path"
+    )
     with pytest.raises(InfeasibleError, match="one upload of 31 pieces strays") as info:
         plan_writing(hanzi_strokes("中"), Board(), alone)
     assert "split at" not in str(info.value)

@@ -39,9 +39,9 @@ from skyquill.calligraphy.mission import (
     fidelity,
     plan_route,
     resegmented,
+    route_times,
 )
 from skyquill.errors import InfeasibleError
-from skyquill.optimize.timing import allocate_path_times
 from skyquill.targets import (
     Strategy,
     Upload,
@@ -207,8 +207,7 @@ def _plan_legs(
 ) -> _Group:
     """Legs ``span = (first, stop)`` planned as one rest-to-rest spline."""
     sub = _sub(samples, cuts, *span)
-    vmax, amax = opts.limits.timing_bounds()
-    times = allocate_path_times(sub.points, vmax, 0.5 * amax)
+    times = route_times(sub.points, sub.roles, board, opts)
     return _Group(*span, _attempt(sub, times, board, opts))
 
 

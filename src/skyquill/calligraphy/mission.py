@@ -105,8 +105,11 @@ FRAME_CLEARANCE_M = 0.05
 #: The flight volume's ceiling, m above the ground (z = 0): the 120 m of the
 #: small-drone rules (EU open category, FAA part 107).
 MAX_ALTITUDE_M = 120.0
-#: Sampling step of the planned ink (:func:`planned_ink`), s: 2 mm at 1 m/s.
-INK_SAMPLE_S = 0.002
+#: Sampling step of the planned ink (:func:`planned_ink`), s: 4 mm at 1 m/s
+#: (distances are to the polyline through the samples).
+INK_SAMPLE_S = 0.004
+#: Plans whose first-order tip is beyond this many tolerances are not polished.
+POLISH_WITHIN = 1.2
 #: Solves after the first that take the swung tip's second-order part off the
 #: targets (``follow="tip"``): the part is ~1e-4 m horizontally and the tip's
 #: rise (<= L amax^2 / 2 g^2) vertically, and each pass shrinks what is left by
@@ -140,9 +143,10 @@ class WritingOptions:
         Fidelity tolerance; ``None``: 1 % of ``size_m``.
     turning_threshold_m
         Split-and-merge threshold; ``None``: a quarter of the tolerance.
-    data_weight, turning_weight, transit_weight
-        Weights of the stroke samples, turning points and transit samples
-        against the jerk cost.
+    data_weight, turning_weight, transit_weight, lift_weight
+        Weights of the stroke samples, turning points, transit samples and
+        (fitting the tip) the samples of the brush's lifts onto and off the
+        board, against the jerk cost.
     knot_interval
         Seconds per knot span.
     degree
@@ -193,6 +197,7 @@ class WritingOptions:
     data_weight: float = 1e4
     turning_weight: float = 1e5
     transit_weight: float = 1e2
+    lift_weight: float = 1e4
     knot_interval: float = 0.05
     degree: int = 5
     brush: Brush = field(default_factory=Brush)
@@ -229,7 +234,7 @@ class WritingOptions:
         self.limits.timing_bounds()  # the route is timed with a speed and an acceleration
         for name in ("size_m", "knot_interval", "stretch_factor"):
             as_float(name, getattr(self, name), positive=True)
-        for name in ("data_weight", "turning_weight", "transit_weight"):
+        for name in ("data_weight", "turning_weight", "transit_weight", "lift_weight"):
             as_float(name, getattr(self, name), nonneg=True)
         low, high = SIZE_RANGE_M
         if not low <= self.size_m <= high:
@@ -551,6 +556,33 @@ def route_length(
     return drawn + moves + legs + 2.0 * len(strokes_world) * board.lift_m
 
 
+def route_times(
+    points: FloatArray, roles: FloatArray, board: Board, opts: WritingOptions
+) -> FloatArray:
+    """Times (N,), s, for the route ``points`` (N, 3) with ``roles`` (N,).
+
+    One rest-to-rest profile within the speed and half the acceleration limit
+    (:func:`~skyquill.optimize.timing.allocate_path_times`). Fitting the tip,
+    each lift (down onto a stroke, up from it) also takes at least the time a
+    minimum-jerk move of its length needs within the jerk limit,
+    ``(60 d / jmax)^(1/3)``: the profile knows no jerk, and a lift that must be
+    flown (the brush leaves the board) but is timed faster makes the jerk
+    limit bind there and every solve a conic one.
+    """
+    vmax, amax = opts.limits.timing_bounds()
+    times = allocate_path_times(points, vmax, 0.5 * amax)
+    jmax = opts.limits.jmax or opts.limits.jmax_axis
+    if not opts.follows_tip(board) or jmax is None:
+        return times
+    steps = np.diff(times)
+    lengths = np.linalg.norm(np.diff(points, axis=0), axis=1)
+    for start, stop in _runs(roles == LIFT):
+        legs = slice(max(start - 1, 0), stop)  # into the lift's first sample, out of its last
+        needed = (60.0 * float(lengths[legs].sum()) / jmax) ** (1.0 / 3.0)
+        steps[legs] *= max(1.0, needed / max(float(steps[legs].sum()), 1e-12))
+    return np.concatenate([[0.0], np.cumsum(steps)])
+
+
 def _check_route_size(
     strokes_world: tuple[FloatArray, ...], board: Board, home: FloatArray | None
 ) -> None:
@@ -648,8 +680,7 @@ def plan_writing(
     strokes_world = tuple(board.to_world(path) for path in scaled.paths)
     _check_route_size(strokes_world, board, home_pos)
     points, roles = _route(strokes_world, board, home_pos)
-    vmax, amax = opts.limits.timing_bounds()
-    times = allocate_path_times(points, vmax, 0.5 * amax)
+    times = route_times(points, roles, board, opts)
     threshold = opts.turning_threshold_m or 0.25 * opts.tolerance
     corners = _turning_samples(strokes_world, board, points, roles, threshold)
     samples = RouteSamples(points, roles, corners, strokes_world)
@@ -854,12 +885,21 @@ def _plan_at(
 ) -> RoutePlan:
     """Solve at ``times``; with the swung tip fitted, polish the targets against the swing."""
     gain = opts.tip_gain(board)
-    targets = samples.points
+    if gain is None:
+        fit = solve(_problem(samples, samples.points, times, opts), workspace=samples.workspace)
+        return _measured(samples, fit, times, samples.points, board=board, opts=opts, scale=scale)
+    pressed = samples.points - _press(samples, board, opts)
+    targets = pressed
     fit = solve(_problem(samples, targets, times, opts, gain=gain), workspace=samples.workspace)
-    if gain is not None:
-        # The first solve fits the first-order tip; each pass takes what that
-        # model misses (measured on the last fit) off the pressed targets.
-        pressed = samples.points - _press(samples, board, opts)
+    windows = _pen_windows(samples.roles, times, len(samples.strokes_world))
+    first = measure_deviation(
+        fit.trajectory, windows, samples.strokes_world, opts.brush.length_m, plane=board
+    )
+    # The polish moves the tip by the model's second-order part (~0.1 mm in the
+    # plane): a plan this far off is stretched without it.
+    if first.max_m <= POLISH_WITHIN * opts.tolerance:
+        # Each pass takes what the first-order model misses (measured on the
+        # last fit) off the pressed targets.
         n_ctrl = fit.trajectory.control_points.shape[0]
         for _ in range(TIP_POLISH_PASSES):
             targets = pressed - _model_error(fit.trajectory, times, gain, opts.brush.length_m)
@@ -1038,27 +1078,29 @@ def _problem(
             f"{spans:,} knot spans, expected at most {MAX_SPANS:,} (a longer knot_interval, "
             "a smaller size_m or fewer strokes)"
         )
-    # Fitting the tip, lifts are held as firmly as the strokes: a lift the
-    # smoothing cuts short leaves the brush on the board between strokes, and
-    # the ink joins them. Fitting the path (paper 000) they are transits.
-    held = samples.roles != TRANSIT if gain is not None else samples.roles >= 0
-    corners = samples.corners
-    deviations = [
-        PointDeviation(times[held], targets[held], opts.data_weight, gain),
-        PointDeviation(times[corners], targets[corners], opts.turning_weight, gain),
+    stroke, lift = samples.roles >= 0, samples.roles == LIFT
+    # Fitting the tip, the lifts are held (lift_weight): a lift the smoothing
+    # cuts short leaves the brush on the board between strokes, and the ink
+    # joins them. Fitting the path (paper 000) they are transits.
+    transit = ~stroke if gain is None else samples.roles == TRANSIT
+    terms = [
+        (stroke, opts.data_weight),
+        (samples.corners, opts.turning_weight),
+        (transit, opts.transit_weight),
+        (lift if gain is not None else np.zeros_like(lift), opts.lift_weight),
     ]
-    transit = ~held
-    if np.any(transit) and opts.transit_weight > 0:
-        deviations.append(
-            PointDeviation(times[transit], targets[transit], opts.transit_weight, gain)
-        )
+    deviations = tuple(
+        PointDeviation(times[which], targets[which], weight, gain)
+        for which, weight in terms
+        if weight > 0 and np.any(which)
+    )
     return SmoothingProblem(
         dim=3,
         degree=opts.degree,
         n_ctrl=spans + opts.degree,
         duration=duration,
         smoothness={3: 1.0},
-        deviations=tuple(deviations),
+        deviations=deviations,
         boundary=Boundary.rest(targets[0], targets[-1], 3),
         limits=opts.derivative_limits(),
     )

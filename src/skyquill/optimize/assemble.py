@@ -85,16 +85,36 @@ class Assembled:
     h_ineq: FloatArray  # (m_in,)
     families: tuple[InequalityFamily, ...]
     cones: NormCones | None = None  # exact norm limits (second-order cones)
+    # (mask (d,), (M, M)): added to G_axis on the axes of mask only (a point
+    # term whose axes differ, e.g. a brush tip's acceleration gain on x, y alone).
+    G_axes: tuple[tuple[FloatArray, sp.csr_array], ...] = ()
 
     @property
     def separable(self) -> bool:
         """Whether every cost and equality term acts on each axis alone."""
         return self.G_coupled is None
 
+    def axis_groups(self) -> list[tuple[list[int], sp.csr_array]]:
+        """The axes that share one ``(M, M)`` Hessian, and that Hessian (separable only)."""
+        d = self.F.shape[1]
+        groups: dict[tuple[int, ...], list[int]] = {}
+        for k in range(d):
+            key = tuple(i for i, (mask, _) in enumerate(self.G_axes) if mask[k])
+            groups.setdefault(key, []).append(k)
+        out = []
+        for key, axes in groups.items():
+            G = self.G_axis
+            for i in key:
+                G = G + self.G_axes[i][1]
+            out.append((axes, sp.csr_array(G)))
+        return out
+
     def hessian(self) -> sp.csr_array:
         """Full ``G`` of ``x' G x`` with ``x = C.ravel()``, shape (Md, Md)."""
         d = self.F.shape[1]
         G = sp.kron(self.G_axis, sp.eye_array(d), format="csr")
+        for mask, block in self.G_axes:
+            G = G + sp.kron(block, sp.diags_array(mask), format="csr")
         return sp.csr_array(G + self.G_coupled) if self.G_coupled is not None else G
 
     def linear(self) -> FloatArray:
@@ -232,6 +252,7 @@ def assemble(problem: SmoothingProblem, cache: AssemblyCache | None = None) -> A
     G_axis = fixed.smooth
     F = np.zeros((M, d))
     coupled: list[tuple[sp.csr_array, FloatArray]] = []
+    axes: list[tuple[FloatArray, sp.csr_array]] = []
     for term in problem.deviations:
         if not isinstance(term, PointDeviation):
             coupled.append(_flat_term(problem, term))
@@ -242,14 +263,15 @@ def assemble(problem: SmoothingProblem, cache: AssemblyCache | None = None) -> A
             if len(groups) == 1:
                 G_axis = G_axis + term.weight * (H.T @ H)
             else:  # axes with different gains: one block per group of axes
-                block = sp.kron(term.weight * (H.T @ H), sp.diags_array(mask), format="csr")
-                coupled.append((sp.csr_array(block), np.zeros(M * d)))
+                axes.append((mask, sp.csr_array(term.weight * (H.T @ H))))
     G_coupled = f_coupled = None
     if coupled:
         G_coupled = sp.csr_array(sum((g for g, _ in coupled), sp.csr_array((M * d, M * d))))
         f_coupled = np.sum([f for _, f in coupled], axis=0)
 
     diagonal = G_axis.diagonal().max(initial=0.0)
+    for _, block in axes:
+        diagonal = max(diagonal, (G_axis + block).diagonal().max(initial=0.0))
     if G_coupled is not None:
         diagonal = max(diagonal, G_coupled.diagonal().max(initial=0.0))
     # Without interpolated points the rows are the boundary's: the same objects
@@ -267,6 +289,7 @@ def assemble(problem: SmoothingProblem, cache: AssemblyCache | None = None) -> A
         fixed.h_ineq,
         fixed.families,
         fixed.cones,
+        tuple(axes),
     )
 
 

@@ -321,8 +321,12 @@ def _closed_form_kkt(asm: Assembled) -> tuple[FloatArray, FloatArray]:
     """
     M, d = asm.F.shape
     if asm.separable:
-        sol = solve_equality_qp(2.0 * asm.G_axis, asm.F, asm.E, asm.e)
-        return sol.x, sol.y.ravel()
+        C, y = np.zeros((M, d)), np.zeros((asm.E.shape[0], d))
+        for axes, G in asm.axis_groups():
+            sol = solve_equality_qp(2.0 * G, asm.F[:, axes], asm.E, asm.e[:, axes])
+            C[:, axes] = sol.x
+            y[:, axes] = sol.y.reshape(-1, len(axes))
+        return C, y.ravel()
     A = sp.csr_array(sp.kron(asm.E, sp.eye_array(d), format="csr"))
     sol = solve_equality_qp(2.0 * asm.hessian(), asm.linear(), A, asm.e.ravel())
     return sol.x.reshape(M, d), sol.y
@@ -348,7 +352,7 @@ def _to_qp(
         held = asm.cones
         cones = memo(f"cones {margin!r}", (held,), lambda: _second_order_cones(held, margin))
     return QuadraticProgram(
-        P=memo("P", (asm.G_axis, asm.G_coupled), lambda: _hessian(asm, workspace)),
+        P=memo("P", (asm.G_axis, asm.G_coupled, asm.G_axes), lambda: _hessian(asm, workspace)),
         q=asm.linear(),
         A_eq=memo("A_eq", (asm.E,), lambda: sp.csc_array(sp.kron(asm.E, sp.eye_array(d)))),
         b_eq=asm.e.ravel(),
@@ -360,7 +364,7 @@ def _to_qp(
 
 def _hessian(asm: Assembled, workspace: Workspace | None) -> sp.csc_array:
     """The QP's ``P = 2 H`` (CSC); separable ``H = G_axis (x) I_d`` through the workspace."""
-    if workspace is None or asm.G_coupled is not None:
+    if workspace is None or asm.G_coupled is not None or asm.G_axes:
         return sp.csc_array(2.0 * asm.hessian())
     return workspace.kron_eye(sp.csr_array(2.0 * asm.G_axis), asm.F.shape[1])
 
