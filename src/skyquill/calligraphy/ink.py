@@ -58,8 +58,8 @@ MERGE_WIDTH_M = 1e-4
 #: Segments per quarter circle of the discs the strokes are swept with.
 QUAD_SEGS = 16
 
-#: Most points per :func:`polyline_distance` call x segments: bounds its temporaries.
-_DISTANCE_BLOCK = 2_000_000
+#: Segments per piece of a polyline that distances are pruned by (:func:`_nearest`).
+_PIECE = 32
 
 
 @dataclass(frozen=True)
@@ -184,27 +184,16 @@ def ink_fidelity(
     -------
     InkFidelity
     """
-    if len(ink_uv) != len(ink_width_m):
-        raise InputError(
-            f"ink_width_m: got {len(ink_width_m)} run(s), expected one per ink run ({len(ink_uv)})"
-        )
+    runs = _ink_runs(ink_uv, ink_width_m)
     width = as_float("width_m", width_m, nonneg=True)
     strokes = [as_array(f"input_uv[{i}]", s, shape=(None, 2)) for i, s in enumerate(input_uv)]
     if not strokes or any(len(s) == 0 for s in strokes):
         raise InputError("input_uv: got no stroke or an empty one, expected (V, 2) with V >= 1")
-    runs = []
-    for i, (raw_uv, raw_width) in enumerate(zip(ink_uv, ink_width_m, strict=True)):
-        uv = as_array(f"ink_uv[{i}]", raw_uv, shape=(None, 2))
-        w = as_array(f"ink_width_m[{i}]", raw_width, shape=(len(uv),))
-        if np.any(w < 0.0):
-            raise InputError(f"ink_width_m[{i}]: got a negative width, expected >= 0")
-        if len(uv):
-            runs.append((uv, w))
     ink_shape = shapely.union_all([_swept(*_merged(uv, w)) for uv, w in runs])
     input_shape = shapely.union_all([_stroke_shape(s, width) for s in strokes])
     to_input, to_ink = _two_sided([uv for uv, _ in runs], strokes)
     return InkFidelity(
-        max_deviation_m=max(to_input.max(initial=0.0), to_ink.max(initial=0.0)),
+        max_deviation_m=float(max(to_input.max(initial=0.0), to_ink.max(initial=0.0))),
         ink_to_input_max_m=float(to_input.max(initial=0.0)),
         input_to_ink_max_m=float(to_ink.max(initial=0.0)),
         mean_m=0.5 * (float(to_input.mean()) + float(to_ink.mean())) if runs else math.inf,
@@ -217,16 +206,37 @@ def ink_fidelity(
     )
 
 
+def _ink_runs(
+    ink_uv: Sequence[FloatArray], ink_width_m: Sequence[FloatArray]
+) -> list[tuple[FloatArray, FloatArray]]:
+    """The non-empty ink runs as checked ``(uv (K, 2), width (K,))`` pairs."""
+    if len(ink_uv) != len(ink_width_m):
+        raise InputError(
+            f"ink_width_m: got {len(ink_width_m)} run(s), expected one per ink run ({len(ink_uv)})"
+        )
+    runs = []
+    for i, (raw_uv, raw_width) in enumerate(zip(ink_uv, ink_width_m, strict=True)):
+        uv = as_array(f"ink_uv[{i}]", raw_uv, shape=(None, 2))
+        width = as_array(f"ink_width_m[{i}]", raw_width, shape=(len(uv),))
+        if np.any(width < 0.0):
+            raise InputError(f"ink_width_m[{i}]: got a negative width, expected >= 0")
+        if len(uv):
+            runs.append((uv, width))
+    return runs
+
+
 def _merged(uv: FloatArray, width: FloatArray) -> tuple[FloatArray, FloatArray]:
-    """``uv`` and ``width`` without the samples that add nothing to the swept shape.
+    """``uv`` and ``width`` without the samples that barely change the swept shape.
 
     A sample is dropped when it is within :data:`MERGE_M` of the last one kept
-    and about as wide (:data:`MERGE_WIDTH_M`); the last sample is always kept,
-    so the run still ends where the brush lifted.
+    and about as wide (within :data:`MERGE_WIDTH_M`), so the outline moves by
+    less than that; the last sample is always kept, so the run still ends where
+    the brush lifted.
     """
     keep = [0]
-    last_u, last_v, last_w = uv[0, 0], uv[0, 1], width[0]
-    for k, (u, v, w) in enumerate(zip(uv[1:, 0], uv[1:, 1], width[1:], strict=True), start=1):
+    (last_u, last_v), last_w = uv[0].tolist(), float(width[0])
+    rest = zip(uv[1:, 0].tolist(), uv[1:, 1].tolist(), width[1:].tolist(), strict=True)
+    for k, (u, v, w) in enumerate(rest, start=1):
         if math.hypot(u - last_u, v - last_v) >= MERGE_M or abs(w - last_w) >= MERGE_WIDTH_M:
             keep.append(k)
             last_u, last_v, last_w = u, v, w
@@ -282,17 +292,40 @@ def _two_sided(ink: list[FloatArray], strokes: list[FloatArray]) -> tuple[FloatA
 
 
 def _nearest(points: FloatArray, polylines: list[FloatArray]) -> FloatArray:
-    """Distance of each point (N, 2) to the nearest of ``polylines`` (each (V, 2), V >= 1)."""
+    """Distance of each point (N, 2) to the nearest of ``polylines`` (each (V, 2), V >= 1).
+
+    Exact, but pruned: the polylines are cut into pieces of :data:`_PIECE`
+    segments, and a piece is measured (:func:`polyline_distance`) only for the
+    points nearer to its bounding box than to any piece measured before, the
+    nearest box first. A flight's ink is thousands of segments, each input
+    point is near a few of them.
+    """
+    pieces = [piece for line in polylines for piece in _pieces(line)]
+    lo = np.array([p.min(axis=0) for p in pieces])
+    hi = np.array([p.max(axis=0) for p in pieces])
+    outside = np.maximum(np.maximum(lo[None] - points[:, None], points[:, None] - hi[None]), 0.0)
+    box_gap = np.hypot(outside[..., 0], outside[..., 1])  # (N, pieces), <= the true distance
     best = np.full(len(points), np.inf)
-    for vertices in polylines:
-        # A dot is a zero-length segment, which polyline_distance takes.
-        line = vertices if len(vertices) >= 2 else np.vstack([vertices, vertices])
-        # Blocks of points keep polyline_distance's (points, segments) temporaries small.
-        step = max(1, _DISTANCE_BLOCK // len(line))
-        for start in range(0, len(points), step):
-            part = slice(start, start + step)
-            best[part] = np.minimum(best[part], polyline_distance(points[part], line))
+    first = box_gap.argmin(axis=1)
+    for k, piece in enumerate(pieces):  # each point's nearest box: a good first bound
+        near = first == k
+        if near.any():
+            best[near] = polyline_distance(points[near], piece)
+    for k, piece in enumerate(pieces):
+        near = (box_gap[:, k] < best) & (first != k)
+        if near.any():
+            best[near] = np.minimum(best[near], polyline_distance(points[near], piece))
     return best
+
+
+def _pieces(vertices: FloatArray) -> list[FloatArray]:
+    """A polyline (V, 2) as consecutive pieces of at most :data:`_PIECE` segments.
+
+    A dot (V = 1) is one zero-length segment, which :func:`polyline_distance` takes.
+    """
+    if len(vertices) == 1:
+        return [np.vstack([vertices, vertices])]
+    return [vertices[i : i + _PIECE + 1] for i in range(0, len(vertices) - 1, _PIECE)]
 
 
 def _simplified(uv: FloatArray) -> FloatArray:
