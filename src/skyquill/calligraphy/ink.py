@@ -8,14 +8,19 @@ board's plane, (u, v) in metres (:meth:`~skyquill.calligraphy.board.Board.to_boa
 
 * the ink as a shape: each segment between consecutive tip samples swept by a
   disc whose diameter goes from the width at one end to the width at the other
-  (the convex hull of the two end discs), all of them unioned;
+  (the convex hull of the two end discs), all of them unioned (samples closer
+  than :data:`MERGE_M` and about as wide merged first);
 * the input as a shape: its strokes swept by a disc of the planned stroke width;
 * their intersection over union (IoU), from the areas of these polygons
-  (shapely, exact for the polygons; the discs are 64-gons, which changes an
-  area by < 0.2 % of the round caps);
+  (shapely, exact for the polygons; the discs are 64-gons, whose area is
+  0.2 % short of the circle's);
 * the two-sided distance between the centre lines (a Hausdorff distance): every
   ink sample to the nearest input stroke, and every input point (the strokes
-  resampled every :data:`SAMPLE_M`) to the nearest ink.
+  resampled every :data:`SAMPLE_M`) to the nearest ink (its centre line
+  simplified within :data:`SIMPLIFY_M`).
+
+Measured: 永 flown for 20 s at 500 Hz (2,700 ink samples) in ~0.2 s, on a
+2-core machine shared with other work; 10,000 ink samples in ~0.5 s.
 """
 
 from __future__ import annotations
