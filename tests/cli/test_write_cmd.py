@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import matplotlib.image
 import numpy as np
 import pytest
 from typer.testing import CliRunner
@@ -80,6 +81,37 @@ def test_four_drones_write_yi_ma_dang_xian_and_fly(tmp_path: Path) -> None:
         assert drone["flight"]["saturations"] == {"thrust_max": 0, "thrust_min": 0, "tilt": 0}
     strokes = json.loads((tmp_path / "input_strokes.json").read_text())
     assert strokes["first_stroke_of_drone"][-1] == len(strokes["strokes"]) == summary["strokes"]
+    # Each drone's ink beside its input, named like its trajectory_<i>.csv.
+    assert sorted(p.name for p in tmp_path.glob("ink*.png")) == [f"ink_{i}.png" for i in range(4)]
+    for drone in summary["drones"]:
+        assert drone["flight"]["ink_strokes"] == drone["flight"]["input_strokes"]
+        assert 0.0 < drone["flight"]["ink_iou"] <= 1.0
+
+
+def test_write_yong_and_fly_draws_and_measures_the_ink(tmp_path: Path) -> None:
+    """Issue 15: ink.png beside the input, and the ink's fidelity in the flight section."""
+    result = runner.invoke(app, ["write", "永", "--fly", "--out", str(tmp_path)])
+    assert result.exit_code == 0, result.output
+    image = matplotlib.image.imread(tmp_path / "ink.png")  # a PNG matplotlib reads back
+    assert image.ndim == 3 and image.shape[1] > 2 * image.shape[0]
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    flight = summary["drones"][0]["flight"]
+    keys = ("ink_max_deviation_m", "ink_strokes", "input_strokes", "ink_iou", "ink_width_m")
+    assert set(keys) <= flight.keys()
+    ink = flight["ink"]
+    assert (
+        flight["ink_max_deviation_m"]
+        == ink["max_deviation_m"]
+        == max(ink["ink_to_input_max_m"], ink["input_to_ink_max_m"])
+    )
+    assert flight["input_strokes"] == summary["strokes"] == ink["input_strokes"]
+    assert flight["ink_strokes"] == ink["ink_strokes"] >= 1
+    assert 0.0 < flight["ink_iou"] == ink["iou"] <= 1.0
+    assert flight["ink_width_m"] == ink["width_m"] == pytest.approx(0.012)  # 2 mm + 2 x 5 mm
+    # Written by write, owned by write: a second run replaces it without --force.
+    again = runner.invoke(app, ["write", "永", "--out", str(tmp_path)])
+    assert again.exit_code == 0, again.output
+    assert not (tmp_path / "ink.png").exists()  # not flown: no ink, the old picture removed
 
 
 @pytest.mark.parametrize(

@@ -104,6 +104,13 @@ def test_a_plan_of_two_strokes(planned: dict[str, Any]) -> None:
         )
 
 
+def test_the_flight_measures_its_ink(planned: dict[str, Any]) -> None:
+    """The simulated ink against the input (calligraphy.ink): in-plane distance and IoU."""
+    (drone,) = planned["result"]["drones"]
+    assert 0.0 <= drone["ink_max_deviation_m"] < 0.05
+    assert 0.0 < drone["ink_iou"] <= 1.0
+
+
 def test_the_files_read_back(client: TestClient, planned: dict[str, Any], tmp_path: Path) -> None:
     """Setpoints, Crazyswarm uploads and the .skyc show agree with each other."""
     files = {f["name"]: client.get(f["url"]) for f in planned["result"]["files"]}

@@ -200,18 +200,6 @@ def fly_mission(mission: Mission) -> Flight:
     )
 
 
-def ink_deviation(flight: Flight, mission: Mission) -> float:
-    """Largest distance from the flight's simulated ink to the nearest input stroke, m (0: none)."""
-    from skyquill.geometry import polyline_distance
-
-    ink = [s for s in flight.ink if len(s)]
-    if not ink:
-        return 0.0
-    points = np.vstack(ink)
-    gaps = [polyline_distance(points, stroke) for stroke in mission.strokes_world]
-    return float(np.min(gaps, axis=0).max())
-
-
 class _Steps:
     """Counts a show's steps and reports each to ``progress`` (if any)."""
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Annotated, Any
+from typing import TYPE_CHECKING, Annotated, Any
 
 import numpy as np
 import typer
@@ -30,11 +30,14 @@ from skyquill.cli.main import (
     user_errors,
 )
 from skyquill.errors import InputError
-from skyquill.io.atomic import write_json
+from skyquill.io.atomic import atomic_path, write_json
 from skyquill.io.outputs import staged_output
 from skyquill.io.plan_dir import trajectory_names, write_plan
 from skyquill.io.trajectory_json import PlannedTrajectory
 from skyquill.limits import VehicleLimits
+
+if TYPE_CHECKING:
+    from skyquill.calligraphy.ink import InkFidelity
 
 
 def load_parts(
@@ -232,7 +235,13 @@ def _board_kind(name: str, fly: bool) -> Any:
 def write_outputs(
     show: Any, out: Path, rate: float, *, force: bool = False, inputs: Sequence[Path] = ()
 ) -> dict[str, Any]:
-    """The plan directory: trajectories, ``input_strokes.json``, ``plot.png``, ``summary.json``."""
+    """The plan directory: trajectories, ``input_strokes.json``, ``plot.png``, ``summary.json``.
+
+    Flown over a horizontal board (``show.flights``), also each drone's
+    simulated ink beside its input: ``ink.png`` (``ink_<i>.png`` for several
+    drones, like ``trajectory_<i>.csv``), and its fidelity in the drone's
+    ``flight`` section of ``summary.json``.
+    """
     from skyquill.viz.writing_plot import plot_missions
 
     missions = list(show.missions)
@@ -240,13 +249,17 @@ def write_outputs(
     per_drone: list[dict[str, Any]] = []
     planned = []
     strokes_json: list[Any] = []
+    inks: dict[str, InkFidelity] = {}  # ink picture name: the fidelity it shows
     for mission, (name, _) in zip(missions, names, strict=True):
         vehicle = mission.vehicle_trajectory()
         limits = mission.limits
         planned.append(PlannedTrajectory(vehicle, tuple(mission.pen_windows), limits))
         strokes_json.append([(s + mission.brush_offset).tolist() for s in mission.strokes_world])
         flight = show.flights[len(per_drone)] if show.flights else None
-        per_drone.append(_drone_summary(mission, name, flight))
+        fidelity = _ink_fidelity(mission, flight)
+        if fidelity is not None:
+            inks[_ink_name(name)] = fidelity
+        per_drone.append(_drone_summary(mission, name, flight, fidelity))
     firsts = np.cumsum([0] + [len(s) for s in strokes_json]).tolist()
     payload: dict[str, Any] = {
         "strokes": [stroke for drone in strokes_json for stroke in drone],
@@ -257,6 +270,7 @@ def write_outputs(
     closest = show.min_separation_m if len(missions) > 1 else None
     with staged_output(out, "write", force=force, inputs=inputs) as stage:
         write_json(stage / "input_strokes.json", payload, indent=None)
+        _write_ink_pictures(stage, inks)
         return write_plan(
             stage,
             planned,
@@ -272,13 +286,47 @@ def write_outputs(
         )
 
 
-def _drone_summary(mission: Any, name: str, flight: Any) -> dict[str, Any]:
-    entry: dict[str, Any] = {"file": name} | mission.summary()
-    if flight is not None:  # flown by plan_show(fly=True): RPT over the contact board
-        from skyquill.calligraphy.show import ink_deviation
+def _ink_fidelity(mission: Any, flight: Any) -> InkFidelity | None:
+    """The flight's ink against the mission's strokes; ``None`` unflown or off a contact board."""
+    if flight is None:
+        return None
+    from skyquill.calligraphy.ink import flight_ink
 
-        ink = ink_deviation(flight, mission)
-        entry["flight"] = flight.summary() | {"ink_max_deviation_m": ink}
+    return flight_ink(flight, mission)
+
+
+def _ink_name(trajectory_csv: str) -> str:
+    """``ink.png`` beside ``trajectory.csv``, ``ink_<i>.png`` beside ``trajectory_<i>.csv``."""
+    return "ink" + trajectory_csv.removeprefix("trajectory").removesuffix(".csv") + ".png"
+
+
+def _write_ink_pictures(out: Path, inks: dict[str, InkFidelity]) -> None:
+    """Draw each drone's ink beside its input (:func:`~skyquill.calligraphy.ink.render_ink`)."""
+    from skyquill.calligraphy.ink import render_ink
+
+    for name, fidelity in inks.items():
+        with atomic_path(out / name) as tmp:
+            render_ink(fidelity, tmp, f"skyquill write, {name.removesuffix('.png')}:")
+
+
+def _drone_summary(
+    mission: Any, name: str, flight: Any, ink: InkFidelity | None = None
+) -> dict[str, Any]:
+    """A drone's entry in ``summary.json``; flown, its flight and (``ink``) its ink's fidelity."""
+    entry: dict[str, Any] = {"file": name} | mission.summary()
+    if flight is None:
+        return entry
+    entry["flight"] = flight.summary()  # flown by plan_show(fly=True): RPT over the board
+    if ink is not None:  # a horizontal (contact) board: the brush left ink
+        numbers = ink.as_dict()
+        entry["flight"] |= {
+            "ink_max_deviation_m": numbers["max_deviation_m"],  # None: no ink at all
+            "ink_strokes": ink.ink_strokes,
+            "input_strokes": ink.input_strokes,
+            "ink_iou": ink.iou,
+            "ink_width_m": ink.width_m,
+            "ink": numbers,
+        }
     return entry
 
 

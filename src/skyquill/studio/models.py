@@ -167,7 +167,16 @@ class DronePlan(BaseModel):
     deviation_max_m: float
     checks: list[LimitReport]
     flight_rmse_m: float | None = None
-    ink_max_deviation_m: float | None = None
+    ink_max_deviation_m: float | None = Field(
+        default=None,
+        description="Two-sided distance between the simulated ink and the input strokes in "
+        "the board's plane, m (None: not flown, no contact board, or no ink).",
+    )
+    ink_iou: float | None = Field(
+        default=None,
+        description="Overlap of the simulated ink with the input drawn at the planned stroke "
+        "width: intersection over union of their areas (None: not flown or no contact board).",
+    )
 
 
 class DownloadFile(BaseModel):

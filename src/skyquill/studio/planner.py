@@ -26,8 +26,9 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from skyquill.calligraphy.board import Board
+from skyquill.calligraphy.ink import flight_ink
 from skyquill.calligraphy.mission import Mission, WritingOptions
-from skyquill.calligraphy.show import Show, ink_deviation, plan_show
+from skyquill.calligraphy.show import Show, plan_show
 from skyquill.errors import InfeasibleError, InputError, SolverError
 from skyquill.export import EXPORTERS, ExportOptions
 from skyquill.io.plan_dir import write_plan
@@ -244,11 +245,14 @@ def _flight_fields(mission: Mission, flight: Flight, t: FloatArray) -> dict[str,
     tip = np.column_stack([np.interp(t, flight.t, flight.p[:, k]) for k in range(3)])
     tip = tip - mission.brush_offset
     ink = [s for s in flight.ink if len(s) >= 2]
+    fidelity = flight_ink(flight, mission)
+    numbers = {} if fidelity is None else fidelity.as_dict()
     return {
         "flight": _round(board.to_board(tip)),
         "ink": [_round(board.to_board(_decimate(s))[:, :2]) for s in ink],
         "flight_rmse_m": flight.rmse_m,
-        "ink_max_deviation_m": ink_deviation(flight, mission),
+        "ink_max_deviation_m": numbers.get("max_deviation_m"),
+        "ink_iou": numbers.get("iou"),
     }
 
 
