@@ -105,6 +105,9 @@ FRAME_CLEARANCE_M = 0.05
 #: The flight volume's ceiling, m above the ground (z = 0): the 120 m of the
 #: small-drone rules (EU open category, FAA part 107).
 MAX_ALTITUDE_M = 120.0
+#: A rest-to-rest move of length d within jerk J takes at least (32 d / J)^(1/3)
+#: (bang-bang jerk); a minimum-jerk (quintic) one peaks at 60 d / T^3.
+LIFT_JERK_FACTOR = 32.0
 #: Sampling step of the planned ink (:func:`planned_ink`), s: 4 mm at 1 m/s
 #: (distances are to the polyline through the samples).
 INK_SAMPLE_S = 0.004
@@ -564,10 +567,10 @@ def route_times(
     One rest-to-rest profile within the speed and half the acceleration limit
     (:func:`~skyquill.optimize.timing.allocate_path_times`). Fitting the tip,
     each lift (down onto a stroke, up from it) also takes at least the time a
-    minimum-jerk move of its length needs within the jerk limit,
-    ``(60 d / jmax)^(1/3)``: the profile knows no jerk, and a lift that must be
-    flown (the brush leaves the board) but is timed faster makes the jerk
-    limit bind there and every solve a conic one.
+    rest-to-rest move of its length needs within the jerk limit,
+    ``(32 d / jmax)^(1/3)`` (:data:`LIFT_JERK_FACTOR`): the profile knows no
+    jerk, and a lift that must be flown (the brush leaves the board) but is
+    timed faster makes the jerk limit bind there and every solve a conic one.
     """
     vmax, amax = opts.limits.timing_bounds()
     times = allocate_path_times(points, vmax, 0.5 * amax)
@@ -578,7 +581,7 @@ def route_times(
     lengths = np.linalg.norm(np.diff(points, axis=0), axis=1)
     for start, stop in _runs(roles == LIFT):
         legs = slice(max(start - 1, 0), stop)  # into the lift's first sample, out of its last
-        needed = (60.0 * float(lengths[legs].sum()) / jmax) ** (1.0 / 3.0)
+        needed = (LIFT_JERK_FACTOR * float(lengths[legs].sum()) / jmax) ** (1.0 / 3.0)
         steps[legs] *= max(1.0, needed / max(float(steps[legs].sum()), 1e-12))
     return np.concatenate([[0.0], np.cumsum(steps)])
 
