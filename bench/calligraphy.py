@@ -1,28 +1,26 @@
-"""Calligraphy benchmark: planning time per character, this tree against a base revision.
+"""Calligraphy benchmark: planning time and ink fidelity per character, tip against path.
 
-Issue 15 (item 3): "median <= 0.3 s per character including re-segmentation,
-with the same fidelity", on the bundled characters and on KanjiVG ones.
+Issue 15: the brush tip is fitted by default (``follow="tip"``); the
+vehicle-path mode (``follow="path"``, paper 000) is its peer, run in the same
+process on the same character in turn, so the machine's noise falls on both.
 
-Every bundled Make Me a Hanzi character, and ``--kanjivg N`` characters of
-the ``kanjivg`` package's SVGs (a fixed list of common kanji not in the
-bundled set; skipped with a note when the package is not installed), is
-planned as a writing mission on a 0.5 m horizontal board with the default
-options (limits 1 m/s, 2 m/s^2, 10 m/s^3 as norms), with the default
-re-segmentation (total time fixed, 8 gradient steps) and without it
-(``resegment="off"``).
+Every bundled Make Me a Hanzi character and ``--kanjivg N`` characters of the
+``kanjivg`` package's SVGs (a fixed list of common kanji not in the bundled
+set; the package is in the dev extra) is planned as ``skyquill write`` plans
+it: a 0.5 m horizontal board at 1 m, the vehicle taking off from the ground
+1 m in front, default options (limits 1 m/s, 2 m/s^2, 10 m/s^3 as norms,
+re-segmentation with the total time fixed). Planning is timed ``--runs``
+times (BLAS pinned to one thread with threadpoolctl, the collector off, one
+warm-up call first) and the median kept. Each plan is then flown once in the
+closed-loop simulator over the brush's contact board, and its ink measured
+(:func:`skyquill.calligraphy.ink.measure_ink`: two-sided distance in the
+board's plane, ink strokes against input strokes, IoU with the input drawn at
+the planned width).
 
-Old against new in the same run: the base revision (default :data:`BASE`,
-the last commit before the re-use work) is exported with ``git archive``;
-two worker processes, one per tree (same interpreter and dependencies),
-plan the same character in turn, old then new, ``--runs`` times, so that
-the machine's noise falls on both. Each worker pins BLAS to one thread
-(threadpoolctl) and times one ``plan_writing`` call with the collector off;
-the first call of each worker is a warm-up. Reported per character: median
-planning times, the ratio new / old, and how far the two plans are apart
-(largest control-point difference relative to the largest coordinate, and
-the relative cost difference), with the writing time, the deviation from the
-input and the limit excess of the new plan. Written to
-``bench/results/calligraphy.json``.
+Reported per character and mode: median planning time, writing time, the
+plan's own deviation and limit excess, and the simulated ink; per set: the
+medians, how many inks are within 1 % of the size and whole, and the writing
+time of tip over path. Written to ``bench/results/calligraphy.json``.
 
 Run: ``.venv/bin/python bench/calligraphy.py`` (about 10 minutes);
 ``--quick`` plans 8 bundled and 5 KanjiVG characters once each and writes
@@ -33,25 +31,26 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
-import subprocess
-import sys
 import sysconfig
-import tempfile
 import time
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+from threadpoolctl import threadpool_limits
 
-from common import export_base, gc_off, jsonable, machine_info
+from common import gc_off, jsonable, machine_info
 
 ROOT = Path(__file__).resolve().parents[1]
 RESULTS = ROOT / "bench" / "results" / "calligraphy.json"
 QUICK_RESULTS = ROOT / "bench" / "results" / "calligraphy_quick.json"
-#: The last commit before the solve re-use of issue 15, item 3.
-BASE = "7f8a408"
 TARGET_S = 0.3
+#: The ink must lie within this fraction of the character's size (1 %).
+INK_TOLERANCE = 0.01
+SIZE_M = 0.5
+#: Where ``skyquill write`` puts the vehicle's home for one drone (calligraphy.show.layout).
+HOME = np.array([0.5 * SIZE_M, -1.0, 0.0])
+MODES = ("tip", "path")
 #: Common kanji (school grades 1-3), none of them in the bundled hanzi set.
 KANJIVG = "語書海話間読朝運動教室電線歌鳥魚船橋漢様親新聞館駅顔曜黒楽園遠"
 
@@ -62,75 +61,8 @@ def kanjivg_dir() -> Path | None:
     return folder if (folder / "06c38.svg").is_file() else None
 
 
-# --- worker: runs inside one tree, answers one request per line -------------------------
-
-
-def worker() -> None:
-    """Plan what each stdin line asks (JSON) and answer with one JSON line."""
-    from threadpoolctl import threadpool_limits
-
-    from skyquill.calligraphy.mission import WritingOptions, plan_writing
-    from skyquill.strokes import hanzi_strokes, load_svg
-
-    with threadpool_limits(1):
-        for line in sys.stdin:
-            req = json.loads(line)
-            if req["source"] == "hanzi":
-                strokes = hanzi_strokes(req["char"])
-            else:
-                strokes = load_svg(req["path"])
-            options = WritingOptions(resegment=req["resegment"])
-            with gc_off():
-                start = time.perf_counter()
-                mission = plan_writing(strokes, options=options)
-                elapsed = time.perf_counter() - start
-            # the old tree's Mission has one ``fit``; the new one ``fits`` (several uploads)
-            fit = mission.fits[0] if hasattr(mission, "fits") else mission.fit
-            answer = {
-                "time_s": elapsed,
-                "control_points": fit.trajectory.control_points.tolist(),
-                "cost": fit.cost,
-                "writing_time_s": mission.trajectory.duration,
-                "deviation_max_m": mission.deviation.max_m,
-                "max_excess": fit.verification.max_excess,
-                "faithful": mission.faithful,
-                "time_scale": mission.time_scale,
-                "strokes": len(strokes.paths),
-            }
-            print(json.dumps(answer), flush=True)
-
-
-class Worker:
-    """A worker process on one source tree."""
-
-    def __init__(self, src: Path) -> None:
-        env = os.environ | {"PYTHONPATH": f"{src}{os.pathsep}{ROOT / 'bench'}"}
-        self.proc = subprocess.Popen(
-            [sys.executable, str(Path(__file__).resolve()), "--worker"],
-            stdin=subprocess.PIPE,
-            stdout=subprocess.PIPE,
-            env=env,
-            text=True,
-        )
-
-    def ask(self, request: dict[str, Any]) -> dict[str, Any]:
-        assert self.proc.stdin is not None and self.proc.stdout is not None
-        self.proc.stdin.write(json.dumps(request) + "\n")
-        self.proc.stdin.flush()
-        answer: dict[str, Any] = json.loads(self.proc.stdout.readline())
-        return answer
-
-    def close(self) -> None:
-        assert self.proc.stdin is not None
-        self.proc.stdin.close()
-        self.proc.wait()
-
-
-# --- driver -------------------------------------------------------------------------------
-
-
 def inputs(n_bundled: int | None, n_kanjivg: int) -> tuple[list[dict[str, Any]], str | None]:
-    """The characters to plan (requests without the mode) and a note on KanjiVG."""
+    """The characters to plan and a note on KanjiVG."""
     from skyquill.strokes import bundled_hanzi
 
     chars = sorted(bundled_hanzi())[:n_bundled]
@@ -144,125 +76,140 @@ def inputs(n_bundled: int | None, n_kanjivg: int) -> tuple[list[dict[str, Any]],
     return items, None
 
 
-def compare(old: dict[str, Any], new: dict[str, Any]) -> dict[str, float]:
-    """How far apart the two plans are (NaN when their shapes differ)."""
-    a, b = np.array(old["control_points"]), np.array(new["control_points"])
-    if a.shape != b.shape:
-        return {"control_points_rel": float("nan"), "cost_rel": float("nan")}
-    scale = max(float(np.abs(a).max()), 1e-300)
-    return {
-        "control_points_rel": float(np.abs(a - b).max()) / scale,
-        "cost_rel": abs(new["cost"] - old["cost"]) / abs(old["cost"]),
-    }
+def strokes_of(item: dict[str, Any]) -> Any:
+    from skyquill.strokes import hanzi_strokes, load_svg
+
+    return hanzi_strokes(item["char"]) if item["source"] == "hanzi" else load_svg(item["path"])
 
 
-def measure(workers: dict[str, Worker], item: dict[str, Any], runs: int) -> dict[str, Any]:
-    """Both modes of one character, old and new in turn; medians and agreement."""
-    row: dict[str, Any] = {"set": item["set"], "char": item["char"]}
-    for mode in ("fixed", "off"):
-        request = item | {"resegment": mode}
-        times: dict[str, list[float]] = {"old": [], "new": []}
-        last: dict[str, dict[str, Any]] = {}
-        for _ in range(runs):
-            for which in ("old", "new"):
-                last[which] = workers[which].ask(request)
-                times[which].append(last[which]["time_s"])
-        key = "with_resegment" if mode == "fixed" else "without_resegment"
-        old_s, new_s = float(np.median(times["old"])), float(np.median(times["new"]))
-        row[key] = {
-            "old_s": old_s,
-            "new_s": new_s,
-            "ratio": new_s / old_s,
-            **compare(last["old"], last["new"]),
+def plan_timed(strokes: Any, follow: str, runs: int) -> tuple[Any, float]:
+    """The mission and the median planning time (s) of ``runs`` calls."""
+    from skyquill.calligraphy.board import Board
+    from skyquill.calligraphy.mission import WritingOptions, plan_writing
+
+    options = WritingOptions(size_m=SIZE_M, follow=follow)  # type: ignore[arg-type]
+    times, mission = [], None
+    for _ in range(runs):
+        with gc_off():
+            start = time.perf_counter()
+            mission = plan_writing(strokes, Board(), options, home=HOME)
+            times.append(time.perf_counter() - start)
+    return mission, float(np.median(times))
+
+
+def flown_ink(mission: Any) -> dict[str, Any]:
+    """Fly ``mission`` over its contact board; the ink's fidelity (``InkFidelity.as_dict``)."""
+    from skyquill.calligraphy.ink import flight_ink
+    from skyquill.calligraphy.show import fly_mission
+
+    fidelity = flight_ink(fly_mission(mission), mission)
+    assert fidelity is not None  # a horizontal board
+    return fidelity.as_dict()
+
+
+def measure(item: dict[str, Any], runs: int) -> dict[str, Any]:
+    """Both modes of one character: planning time, the plan, the simulated ink."""
+    strokes = strokes_of(item)
+    row: dict[str, Any] = {"set": item["set"], "char": item["char"], "strokes": len(strokes.paths)}
+    for follow in MODES:
+        mission, median_s = plan_timed(strokes, follow, runs)
+        ink = flown_ink(mission)
+        whole = ink["ink_strokes"] == ink["input_strokes"]
+        within = ink["max_deviation_m"] is not None
+        within = within and ink["max_deviation_m"] <= INK_TOLERANCE * SIZE_M
+        row[follow] = {
+            "planning_s": median_s,
+            "writing_time_s": mission.trajectory.duration,
+            "time_scale": mission.time_scale,
+            "deviation_max_m": mission.deviation.max_m,
+            "faithful": mission.faithful,
+            "max_excess": mission.verification.max_excess,
+            "ink": ink,
+            "ink_within_tolerance": within,
+            "ink_whole": whole,
         }
-        if mode == "fixed":
-            new = last["new"]
-            row |= {
-                k: new[k]
-                for k in (
-                    "strokes",
-                    "writing_time_s",
-                    "deviation_max_m",
-                    "max_excess",
-                    "faithful",
-                    "time_scale",
-                )
-            }
-            row["old_writing_time_s"] = last["old"]["writing_time_s"]
-            row["old_deviation_max_m"] = last["old"]["deviation_max_m"]
+    row["writing_time_ratio"] = row["tip"]["writing_time_s"] / row["path"]["writing_time_s"]
+    row["planning_ratio"] = row["tip"]["planning_s"] / row["path"]["planning_s"]
     return row
 
 
+def _median(rows: list[dict[str, Any]], key: str, follow: str) -> float:
+    return float(np.median([r[follow][key] for r in rows]))
+
+
 def summarise(rows: list[dict[str, Any]]) -> dict[str, Any]:
-    """Medians per set and mode, the target check and the worst disagreement."""
+    """Per set and mode: medians, ink counts, the target check; tip over path."""
     out: dict[str, Any] = {}
     for name in ("bundled", "kanjivg"):
         chosen = [r for r in rows if r["set"] == name]
         if not chosen:
             continue
         entry: dict[str, Any] = {"n_characters": len(chosen)}
-        for key in ("with_resegment", "without_resegment"):
-            old = float(np.median([r[key]["old_s"] for r in chosen]))
-            new = float(np.median([r[key]["new_s"] for r in chosen]))
-            entry[key] = {
-                "median_old_s": old,
-                "median_new_s": new,
-                "median_ratio": float(np.median([r[key]["ratio"] for r in chosen])),
-                "max_new_s": float(max(r[key]["new_s"] for r in chosen)),
-                "max_control_points_rel": float(max(r[key]["control_points_rel"] for r in chosen)),
-                "max_cost_rel": float(max(r[key]["cost_rel"] for r in chosen)),
+        for follow in MODES:
+            inks = [r[follow]["ink"] for r in chosen]
+            deviations = [i["max_deviation_m"] for i in inks if i["max_deviation_m"] is not None]
+            entry[follow] = {
+                "median_planning_s": _median(chosen, "planning_s", follow),
+                "max_planning_s": float(max(r[follow]["planning_s"] for r in chosen)),
+                "median_writing_time_s": _median(chosen, "writing_time_s", follow),
+                "all_faithful": all(r[follow]["faithful"] for r in chosen),
+                "max_excess": float(max(r[follow]["max_excess"] for r in chosen)),
+                "ink_within_tolerance": sum(r[follow]["ink_within_tolerance"] for r in chosen),
+                "ink_whole": sum(r[follow]["ink_whole"] for r in chosen),
+                "median_ink_max_deviation_m": float(np.median(deviations)),
+                "max_ink_max_deviation_m": float(max(deviations)),
+                "median_ink_iou": float(np.median([i["iou"] for i in inks])),
             }
-        entry["meets_target"] = entry["with_resegment"]["median_new_s"] <= TARGET_S
-        entry["all_faithful"] = all(r["faithful"] for r in chosen)
-        entry["all_zero_excess"] = all(r["max_excess"] <= 1e-9 for r in chosen)
-        entry["max_deviation_m"] = max(r["deviation_max_m"] for r in chosen)
-        entry["median_writing_time_s"] = float(np.median([r["writing_time_s"] for r in chosen]))
+        ratios = [r["writing_time_ratio"] for r in chosen]
+        entry["writing_time_tip_over_path"] = {
+            "median": float(np.median(ratios)),
+            "max": float(max(ratios)),
+        }
+        entry["planning_tip_over_path_median"] = float(
+            np.median([r["planning_ratio"] for r in chosen])
+        )
+        entry["meets_target"] = entry["tip"]["median_planning_s"] <= TARGET_S
         out[name] = entry
     return out
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
-    parser.add_argument("--base", default=BASE)
     parser.add_argument("--runs", type=int, default=3)
-    parser.add_argument("--kanjivg", type=int, default=20)
+    parser.add_argument("--kanjivg", type=int, default=30)
     parser.add_argument("--quick", action="store_true")
     opts = parser.parse_args()
-    if opts.worker:
-        worker()
-        return
-    n_bundled = 8 if opts.quick else None
     runs = 1 if opts.quick else opts.runs
-    items, note = inputs(n_bundled, 5 if opts.quick else opts.kanjivg)
+    items, note = inputs(8 if opts.quick else None, 5 if opts.quick else opts.kanjivg)
     rows = []
-    with tempfile.TemporaryDirectory() as tmp:
-        workers = {"old": Worker(export_base(opts.base, Path(tmp))), "new": Worker(ROOT / "src")}
-        try:
-            for which in workers.values():  # warm-up: imports, caches
-                which.ask(items[0] | {"resegment": "fixed"})
-            for i, item in enumerate(items):
-                rows.append(measure(workers, item, runs))
-                r = rows[-1]["with_resegment"]
-                print(
-                    f"{i + 1:3d}/{len(items)} {item['char']} old {r['old_s']:.3f} s "
-                    f"new {r['new_s']:.3f} s ratio {r['ratio']:.2f} "
-                    f"dC {r['control_points_rel']:.1e}",
-                    flush=True,
-                )
-        finally:
-            for which in workers.values():
-                which.close()
+    with threadpool_limits(1):
+        plan_timed(strokes_of(items[0]), "tip", 1)  # warm-up: imports, caches
+        for i, item in enumerate(items):
+            rows.append(measure(item, runs))
+            r = rows[-1]
+            print(
+                f"{i + 1:3d}/{len(items)} {item['char']} "
+                + " ".join(
+                    f"{f} {r[f]['planning_s']:.3f} s {r[f]['writing_time_s']:.1f} s ink "
+                    f"{1e3 * (r[f]['ink']['max_deviation_m'] or float('nan')):.1f} mm "
+                    f"{r[f]['ink']['ink_strokes']}/{r[f]['ink']['input_strokes']} "
+                    f"IoU {r[f]['ink']['iou']:.2f} |"
+                    for f in MODES
+                ),
+                flush=True,
+            )
     result = {
         "what": (
-            "plan_writing per character, default options, with and without the default "
-            "re-segmentation; old (base) and new tree in turn in two worker processes, "
-            "BLAS pinned to 1 thread, medians"
+            "plan_writing per character as `skyquill write` plans it (0.5 m horizontal board, "
+            "home on the ground, default options), fitting the brush tip (default) and the "
+            "vehicle's path (paper 000) in turn in one process, BLAS pinned to 1 thread, median "
+            "planning time; each plan flown once in closed loop over the brush's contact board "
+            "and its ink measured (calligraphy.ink)"
         ),
-        "base": opts.base,
         "runs": runs,
         "target_median_s": TARGET_S,
-        "machine": machine_info(("scipy", "piqp", "clarabel", "threadpoolctl")),
+        "ink_tolerance_m": INK_TOLERANCE * SIZE_M,
+        "machine": machine_info(("scipy", "piqp", "clarabel", "threadpoolctl", "shapely")),
         "note": note,
         "summary": summarise(rows),
         "characters": rows,

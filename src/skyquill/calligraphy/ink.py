@@ -383,7 +383,7 @@ def render_ink(fidelity: InkFidelity, path: str | Path, title: str = "") -> None
     names = (
         f"input at the planned width ({1e3 * fidelity.width_m:.1f} mm)",
         "simulated ink (width from the pressing depth)",
-        "overlay: input grey, ink black, ink off the input red",
+        "overlay (red: ink off the input)",
     )
     for ax, name in zip(axes, names, strict=True):
         ax.set(aspect="equal", title=name, xlabel="u (m)")
