@@ -23,6 +23,8 @@ SUMMARY_KEYS = {
     "max_excess",
     "planning_time_s",
     "pattern",
+    "missed_area_m2",
+    "missed_fraction",
 }
 
 

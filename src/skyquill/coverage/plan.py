@@ -33,6 +33,7 @@ from skyquill.coverage.deadline import (
     check_time_limit,
     is_time_limit,
 )
+from skyquill.coverage.missed import Missed, missed_area
 from skyquill.coverage.paths import (
     ContourMode,
     DriftMode,
@@ -43,7 +44,12 @@ from skyquill.coverage.paths import (
     with_corner_points,
     zigzag,
 )
-from skyquill.coverage.regions import check_width, coverage_fraction, estimate_path_length
+from skyquill.coverage.regions import (
+    check_width,
+    coverage_fraction,
+    estimate_path_length,
+    swept,
+)
 from skyquill.coverage.speed import SpeedPlan, plan_speed
 from skyquill.coverage.target import DeliveredPath, check_target_path, deliver
 from skyquill.errors import InfeasibleError, InputError
@@ -252,6 +258,9 @@ class CoveragePlan:
         With ``options.target``: the re-fit into the target's uploads.
     planned_coverage : float or None
         With a target: the coverage of the planned path before the re-fit.
+    missed : Missed or None
+        What ``path``'s swath misses of the region (area, share, the largest
+        gaps); None only for plans built by hand.
     """
 
     region: Polygon
@@ -265,6 +274,7 @@ class CoveragePlan:
     speed_plan: SpeedPlan | None
     delivered: DeliveredPath | None = None
     planned_coverage: float | None = None
+    missed: Missed | None = None
 
     @property
     def duration(self) -> float:
@@ -292,6 +302,7 @@ class CoveragePlan:
             **self.limits,
             "planning_time_s": self.planning_time,
             "region_area_m2": float(self.region.area),
+            **({} if self.missed is None else self.missed.summary()),
             "options": asdict(self.options),
             "vehicle_limits": self.options.limits.as_dict(),
             "limits_held": "per axis"
@@ -558,17 +569,25 @@ def _plan(region: Polygon, opts: CoverageOptions, deadline: Deadline) -> Coverag
         check = verify(trajectory, coverage_limits(opts), guaranteed=False)
     limits = limits_report(check)
     deadline.check("the coverage measure")
+    coverage, missed = _measured(region, path, opts.width)
     return CoveragePlan(
         region=region,
         options=opts,
         waypoints=waypoints,
         path=path,
         trajectory=trajectory,
-        coverage=coverage_fraction(region, path, opts.width),
+        coverage=coverage,
         limits=limits | {"joins": joins},
         planning_time=time.perf_counter() - start,
         speed_plan=speed_plan,
+        missed=missed,
     )
+
+
+def _measured(region: Polygon, path: FloatArray, width: float) -> tuple[float, Missed]:
+    """Covered fraction of ``region`` by ``path``'s swath and what it misses (one buffer)."""
+    area = swept(path, width)
+    return float(region.intersection(area).area / region.area), missed_area(region, area)
 
 
 def _for_target(plan: CoveragePlan, options: CoverageOptions, deadline: Deadline) -> CoveragePlan:
@@ -579,12 +598,14 @@ def _for_target(plan: CoveragePlan, options: CoverageOptions, deadline: Deadline
     delivered = deliver(plan.path, options.limits, options.width, options.altitude, options.target)
     # The refit holds the limits through the hull: a guaranteed check, unlike the LP's.
     check = verify(delivered.trajectory, coverage_limits(options), guaranteed=True)
+    coverage, missed = _measured(plan.region, delivered.path, options.width)
     return replace(
         plan,
         options=options,
         path=delivered.path,
         trajectory=delivered.trajectory,
-        coverage=coverage_fraction(plan.region, delivered.path, options.width),
+        coverage=coverage,
+        missed=missed,
         limits=limits_report(check) | {"joins": plan.limits["joins"]},
         planning_time=plan.planning_time + time.perf_counter() - start,
         delivered=delivered,

@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 import shapely
 from shapely.geometry import LineString, Polygon, shape
+from shapely.geometry.base import BaseGeometry
 
 from skyquill.errors import InputError
 from skyquill.io.json_read import check_depth, decode_utf8, parse_json
@@ -263,7 +264,12 @@ SIMPLIFY_FRACTION = 1e-4
 
 
 def coverage_fraction(region: Polygon, path: FloatArray, width: float) -> float:
-    """Area of (region ∩ swept discs of diameter ``width`` along ``path`` (N, >=2)) / area.
+    """Area of (region ∩ swept discs of diameter ``width`` along ``path`` (N, >=2)) / area."""
+    return float(region.intersection(swept(path, width)).area / region.area)
+
+
+def swept(path: FloatArray, width: float) -> BaseGeometry:
+    """The area swept by a disc of diameter ``width`` (m) along ``path`` (N, >= 2), m.
 
     The dense path (a point every ~2 cm) is simplified first, to within
     ``SIMPLIFY_FRACTION * width`` of itself: the buffer of the 1 M points of a
@@ -273,7 +279,7 @@ def coverage_fraction(region: Polygon, path: FloatArray, width: float) -> float:
     pts = as_array("path", path, ndim=2)
     radius = 0.5 * as_float("width", width, positive=True)
     line = LineString(pts[:, :2]).simplify(SIMPLIFY_FRACTION * 2.0 * radius)
-    return float(region.intersection(line.buffer(radius)).area / region.area)
+    return line.buffer(radius)
 
 
 def _shown(text: str, limit: int = 200) -> str:

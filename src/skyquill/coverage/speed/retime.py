@@ -36,11 +36,7 @@ def retimed_path(plan: SpeedPlan, z: float | None = None) -> RetimedPath:
     lifted = BSpline(curve.t, coeffs, curve.k)
     if plan.jmax is None and plan._umap is None:
         return RetimedPath(lifted, _exact_law(plan))
-    sig, t = _grid_times(plan)
-    sd, sdd, _ = plan._derivs(sig)
-    sd[0] = sd[-1] = 0.0  # rest at both ends, exactly
-    if plan.jmax is not None:  # b ~ s^(4/3) at a jerk-limited rest end: no acceleration there
-        sdd[0] = sdd[-1] = 0.0
+    t, sig, sd, sdd = _node_rates(plan)
     if plan._umap is None:
         u, ud, udd = sig.copy(), sd, sdd
     else:
@@ -49,6 +45,27 @@ def retimed_path(plan: SpeedPlan, z: float | None = None) -> RetimedPath:
         ud, udd = g1 * sd, g2 * sd**2 + g1 * sdd
     u[0], u[-1] = 0.0, 1.0
     return RetimedPath(lifted, quintic_law(t, u, ud, udd))
+
+
+def planning_law(plan: SpeedPlan) -> PiecewisePolynomial:
+    """The planning parameter ``sigma(t)`` (the LP's, before any grid map), s -> [0, 1].
+
+    The quintic law through the grid nodes and their rates, as
+    :func:`retimed_path` builds it: :meth:`SpeedPlan.walk` samples it.
+    """
+    return quintic_law(*_node_rates(plan))
+
+
+def _node_rates(plan: SpeedPlan) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+    """Times, planning parameter and its first two rates at the law's nodes."""
+    sig, t = _grid_times(plan)
+    sd, sdd, _ = plan._derivs(sig)
+    sd[0] = sd[-1] = 0.0  # rest at both ends, exactly
+    if plan.jmax is not None:  # b ~ s^(4/3) at a jerk-limited rest end: no acceleration there
+        sdd[0] = sdd[-1] = 0.0
+    sig = sig.copy()
+    sig[0], sig[-1] = 0.0, 1.0
+    return t, sig, sd, sdd
 
 
 def quintic_law(
