@@ -69,6 +69,8 @@ def test_cover_tunes_for_a_coverage_target(tmp_path: Path) -> None:
     [
         (["--width", "0"], "width"),
         (["--width", "50"], "width"),
+        (["--width", "0.001"], "width: got 0.001 m on a region of 100 m²"),
+        (["--time-limit", "0"], "time_limit: got 0.0"),
         (["--vmax", "-1"], "vmax"),
         (["--jmax", "0"], "jmax"),
         (["--pattern", "snake"], "pattern"),
@@ -155,3 +157,12 @@ def test_a_spent_time_limit_exits_2_naming_the_step(tmp_path: Path) -> None:
         result.output.split()
     )
     assert not out.exists()
+
+
+def test_a_kilometre_square_at_a_2_m_swath_is_refused_at_once(tmp_path: Path) -> None:
+    region = tmp_path / "km.wkt"
+    region.write_text("POLYGON ((0 0, 1000 0, 1000 1000, 0 1000, 0 0))")
+    result = CliRunner().invoke(app, ["cover", str(region), "--out", str(tmp_path / "o")])
+    assert result.exit_code == 2
+    lines = result.output.strip().splitlines()
+    assert len(lines) == 1 and "a path of about 504 km, expected at most 25 km" in lines[0]
