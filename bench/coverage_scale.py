@@ -19,6 +19,11 @@ growth is read from the log-log slope of planning time against path length
 (1 = linear) and from the time per kilometre, as a ratio to the 1 ha field's
 measured in the same run. Read ratios, not absolute times: the reference
 machine has 2 noisy cores shared with other jobs.
+
+``lp_growth``: the speed LP alone against its grid size (1,000 to 8,000 points
+on the 10 m square's spiral of ``bench/coverage_lp.py``, one timed run each):
+``plan_speed`` with the jerk limit (HiGHS hot starts, let finish), jerk off,
+and toppra (jerk off, the same grid) as the peer; log-log slopes of each.
 """
 
 from __future__ import annotations
@@ -36,7 +41,9 @@ from shapely.geometry import box
 from threadpoolctl import threadpool_info, threadpool_limits
 
 from common import jsonable, machine_info, time_calls, time_stats
+from coverage_lp import spiral
 from skyquill.coverage.plan import CoverageOptions, CoveragePlan, plan_coverage
+from skyquill.coverage.speed import plan_speed
 
 RESULTS = Path(__file__).parent / "results" / "coverage_scale.json"
 QUICK_RESULTS = Path(__file__).parent / "results" / "coverage_scale_quick.json"
@@ -46,6 +53,7 @@ TIME_LIMIT_S = 300.0
 RUNS = 3
 #: Issue 16's target: a 10 ha field at a 5 m swath "well under a minute".
 TARGET_10HA_S = 60.0
+LP_GRIDS = (1000, 2000, 4000, 8000)
 
 
 def options() -> CoverageOptions:
@@ -88,6 +96,77 @@ def growth(cases: list[dict[str, Any]]) -> dict[str, Any]:
     }
 
 
+def _toppra(curve: Any, n: int) -> float | None:
+    """Seconds toppra takes on ``curve`` at ``n`` grid points (jerk off), or None without it."""
+    try:
+        import toppra as ta
+        import toppra.algorithm as algo
+        from toppra import constraint
+        from toppra.interpolator import AbstractGeometricPath
+    except ImportError:
+        return None
+    ta.setup_logging("WARNING")
+
+    class BSplinePath(AbstractGeometricPath):  # type: ignore[misc]
+        """toppra geometric-path adapter around the scipy ``BSpline``."""
+
+        def __call__(self, s: Any, order: int = 0) -> Any:
+            return np.asarray(curve(np.clip(np.asarray(s, dtype=float), 0.0, 1.0), order))
+
+        @property
+        def dof(self) -> int:
+            return 2
+
+        @property
+        def path_interval(self) -> Any:
+            return np.array([0.0, 1.0])
+
+    limits = [
+        constraint.JointVelocityConstraint(np.array([[-100.0, 100.0]] * 2)),
+        constraint.JointAccelerationConstraint(np.array([[-5.0, 5.0]] * 2)),
+    ]
+    grid = np.linspace(0.0, 1.0, n)
+    start = time.perf_counter()
+    algo.TOPPRA(
+        limits, BSplinePath(), gridpoints=grid, parametrizer="ParametrizeConstAccel"
+    ).compute_trajectory(0, 0)
+    return time.perf_counter() - start
+
+
+def lp_growth() -> dict[str, Any]:
+    """The speed LP's time against its grid size, with toppra's as the peer."""
+    curve = spiral(1.0)
+    rows = []
+    for n in LP_GRIDS:
+        start = time.perf_counter()
+        jerk = plan_speed(curve, 3.0, 5.0, 3.0, n=n)
+        jerk_s = time.perf_counter() - start
+        start = time.perf_counter()
+        plan_speed(curve, 100.0, 5.0, None, n=n)
+        free_s = time.perf_counter() - start
+        rows.append(
+            {
+                "grid_points": n,
+                "jerk_plan_s": jerk_s,
+                "jerk_lp_s": jerk.solve_time,
+                "jerk_lp_solves": jerk.lp_solves,
+                "jerk_off_plan_s": free_s,
+                "toppra_s": _toppra(curve, n),
+            }
+        )
+    logn = np.log([r["grid_points"] for r in rows])
+
+    def slope(key: str) -> float | None:
+        if any(r[key] is None for r in rows):
+            return None
+        return float(np.polyfit(logn, np.log([r[key] for r in rows]), 1)[0])
+
+    return {
+        "rows": rows,
+        "loglog_slope": {k: slope(k) for k in ("jerk_plan_s", "jerk_off_plan_s", "toppra_s")},
+    }
+
+
 def print_summary(out: dict[str, Any]) -> None:
     print(f"{'field':>8} {'path km':>8} {'plan s':>8} {'s/km':>6} {'LP s':>6} {'excess':>7}")
     for c in out["cases"]:
@@ -99,6 +178,12 @@ def print_summary(out: dict[str, Any]) -> None:
             f"{lp:>6.2f} {c['max_excess']:>7.4f}"
         )
     print(f"log-log slope (1 = linear): {out['growth']['loglog_slope_time_vs_path_length']:.2f}")
+    for r in out["lp_growth"]["rows"]:
+        print(
+            f"LP n={r['grid_points']:>5}: jerk {r['jerk_plan_s']:.2f} s, jerk off "
+            f"{r['jerk_off_plan_s']:.3f} s, toppra {r['toppra_s'] or float('nan'):.3f} s"
+        )
+    print(f"LP log-log slopes: {out['lp_growth']['loglog_slope']}")
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -113,6 +198,7 @@ def main(argv: list[str] | None = None) -> int:
         blas = threadpool_info()
         plan_coverage(box(0.0, 0.0, 100.0, 100.0), options())  # warm-up: imports, caches
         cases = [field_case(ha, runs) for ha in HECTARES]
+        lp = lp_growth()
     out = {
         "schema": 1,
         "generated_utc": datetime.now(UTC).isoformat(timespec="seconds"),
@@ -130,6 +216,7 @@ def main(argv: list[str] | None = None) -> int:
         "targets": {"10ha_planning_s_below": TARGET_10HA_S},
         "cases": cases,
         "growth": growth(cases),
+        "lp_growth": lp,
     }
     out_path.parent.mkdir(parents=True, exist_ok=True)
     out_path.write_text(json.dumps(jsonable(out), indent=2) + "\n")
