@@ -23,6 +23,8 @@ SUMMARY_KEYS = {
     "max_excess",
     "planning_time_s",
     "pattern",
+    "missed_area_m2",
+    "missed_fraction",
 }
 
 
@@ -67,6 +69,8 @@ def test_cover_tunes_for_a_coverage_target(tmp_path: Path) -> None:
     [
         (["--width", "0"], "width"),
         (["--width", "50"], "width"),
+        (["--width", "0.001"], "width: got 0.001 m on a region of 100 m²"),
+        (["--time-limit", "0"], "time_limit: got 0.0"),
         (["--vmax", "-1"], "vmax"),
         (["--jmax", "0"], "jmax"),
         (["--pattern", "snake"], "pattern"),
@@ -110,3 +114,55 @@ def test_cover_refuses_an_unknown_target_in_one_line(tmp_path: Path) -> None:
     assert result.exit_code == 2
     assert "--target: got 'tello', expected one of crazyflie" in " ".join(result.output.split())
     assert "Traceback" not in result.output
+
+
+#: The issue's 47 m x 30 m field with one reflex corner, in WKT (local metres).
+HEXAGON_WKT = "POLYGON ((0 0, 47 0, 47 15, 30 30, 20 18, 0 30, 0 0))"
+
+
+def test_the_concave_hexagon_writes_a_finite_trajectory(tmp_path: Path) -> None:
+    region = tmp_path / "hexagon.wkt"
+    region.write_text(HEXAGON_WKT)
+    out = tmp_path / "out"
+    result = CliRunner().invoke(app, ["cover", str(region), "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    # Read back what was written: no row of NaN (12 of 15 such files once ended in one).
+    table = np.loadtxt(out / "trajectory.csv", delimiter=",", skiprows=1)
+    assert table.shape[0] > 1000 and np.all(np.isfinite(table))
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["options"]["time_limit"] == 60.0
+    assert summary["planning_time_s"] < 60.0
+
+
+def test_a_time_limit_below_the_estimate_exits_2_in_one_line(tmp_path: Path) -> None:
+    region = tmp_path / "field.wkt"
+    region.write_text("POLYGON ((0 0, 316 0, 316 316, 0 316, 0 0))")
+    out = tmp_path / "out"
+    args = ["cover", str(region), "--out", str(out), "--width", "5", "--time-limit", "5"]
+    result = CliRunner().invoke(app, args)
+    assert result.exit_code == 2
+    lines = result.output.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: time_limit: got 5 s, expected at least")
+    assert not out.exists()
+
+
+def test_a_spent_time_limit_exits_2_naming_the_step(tmp_path: Path) -> None:
+    region = tmp_path / "hexagon.wkt"
+    region.write_text(HEXAGON_WKT)
+    out = tmp_path / "out"
+    args = ["cover", str(region), "--out", str(out), "--time-limit", "1"]
+    result = CliRunner().invoke(app, args)
+    assert result.exit_code == 2
+    assert "time_limit: got 1 s, expected enough for this plan: it stopped at" in " ".join(
+        result.output.split()
+    )
+    assert not out.exists()
+
+
+def test_a_kilometre_square_at_a_2_m_swath_is_refused_at_once(tmp_path: Path) -> None:
+    region = tmp_path / "km.wkt"
+    region.write_text("POLYGON ((0 0, 1000 0, 1000 1000, 0 1000, 0 0))")
+    result = CliRunner().invoke(app, ["cover", str(region), "--out", str(tmp_path / "o")])
+    assert result.exit_code == 2
+    lines = result.output.strip().splitlines()
+    assert len(lines) == 1 and "a path of about 504 km, expected at most 25 km" in lines[0]

@@ -17,7 +17,7 @@ SQUARE = box(0.0, 0.0, 10.0, 10.0)
 def test_a_kilometre_square_at_a_2_m_swath_is_refused_with_what_would_fit() -> None:
     message = (
         r"^width: got 2 m on a region of 1e\+06 m², i\.e\. a path of about 504 km, expected "
-        r"at most 10 km \(a swath of at least 167 m, or a smaller region: split it into "
+        r"at most 25 km \(a swath of at least 47\.6 m, or a smaller region: split it into "
         r"missions\)$"
     )
     with pytest.raises(InputError, match=message):
@@ -34,24 +34,24 @@ def test_a_millimetre_swath_is_refused_before_any_ring_is_made() -> None:
 
 
 def test_epsilon_counts_in_the_estimate() -> None:
-    # 100 m² / 0.011 m + 40 m ~ 9.1 km fits; at epsilon 0.5 the lines are twice as dense.
-    assert check_width(SQUARE, 0.011) == 0.011
-    with pytest.raises(InputError, match="expected at most 10 km"):
-        check_width(SQUARE, 0.011, epsilon=0.5)
+    # 100 m² / 0.005 m + 40 m ~ 20 km fits; at epsilon 0.5 the lines are twice as dense.
+    assert check_width(SQUARE, 0.005) == 0.005
+    with pytest.raises(InputError, match="expected at most 25 km"):
+        check_width(SQUARE, 0.005, epsilon=0.5)
 
 
 def test_a_perimeter_longer_than_the_budget_says_split() -> None:
-    strip = box(0.0, 0.0, 6000.0, 1.0)
+    strip = box(0.0, 0.0, 13000.0, 1.0)
     with pytest.raises(InputError, match="the perimeter alone is too long: split the region"):
         check_width(strip, 0.5)
 
 
 def test_tuning_is_refused_at_its_densest_spacing() -> None:
-    # 1e4 m² / (0.7 * 1.4 m) + 400 m ~ 10.6 km: fits at epsilon 1 (7.5 km), not at 0.7.
-    region = box(0.0, 0.0, 100.0, 100.0)
-    assert estimate_path_length(region, 1.4) < MAX_PATH_LENGTH_M
-    with pytest.raises(InputError, match=r"^width: got 1\.4 m .* expected at most 10 km"):
-        plan_tuned(region, CoverageOptions(width=1.4), 0.97)
+    # 4e4 m² / (0.7 * 2.2 m) + 800 m ~ 26.8 km: fits at epsilon 1 (19 km), not at 0.7.
+    region = box(0.0, 0.0, 200.0, 200.0)
+    assert estimate_path_length(region, 2.2) < MAX_PATH_LENGTH_M
+    with pytest.raises(InputError, match=r"^width: got 2\.2 m .* expected at most 25 km"):
+        plan_tuned(region, CoverageOptions(width=2.2), 0.97)
 
 
 @pytest.mark.parametrize("pattern", ["spiral", "zigzag"])

@@ -41,3 +41,22 @@ def test_exact_law_without_jerk_limit_matches_the_grid_model() -> None:
     assert traj.duration == pytest.approx(plan.duration, rel=1e-12)
     u = traj.timing.evaluate(traj.breakpoints)[:, 0]
     np.testing.assert_allclose(u, plan._sigma, atol=1e-12)
+
+
+def test_quintic_law_is_scipys_hermite_interpolant() -> None:
+    # The closed form replaces BPoly.from_derivatives (a Python loop per piece).
+    from skyquill.coverage.speed.retime import quintic_law
+    from skyquill.trajectory.retimed import RetimedPath as Reference
+
+    rng = np.random.default_rng(7)
+    t = np.concatenate([[0.0], np.cumsum(rng.uniform(0.005, 0.05, 200))])
+    u = np.cumsum(rng.uniform(0.0, 1.0, t.size))
+    u = (u - u[0]) / (u[-1] - u[0])
+    ud, udd = rng.uniform(0.0, 2.0, t.size), rng.normal(0.0, 5.0, t.size)
+    law = quintic_law(t, u, ud, udd)
+    reference = Reference.from_samples(_circle(), t, u, ud, udd).timing
+    probe = np.sort(rng.uniform(0.0, t[-1], 2000))
+    for order in range(4):
+        np.testing.assert_allclose(
+            law.evaluate(probe, order), reference.evaluate(probe, order), rtol=1e-8, atol=1e-8
+        )

@@ -3,7 +3,8 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated
+from types import TracebackType
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 
@@ -21,6 +22,12 @@ from skyquill.cli.main import (
 )
 from skyquill.errors import InputError
 from skyquill.limits import VehicleLimits
+
+if TYPE_CHECKING:
+    from rich.progress import Progress, TaskID
+
+#: The bar is drawn only for planning that takes longer than this, s.
+BAR_AFTER_S = 1.0
 
 
 @app.command()
@@ -61,6 +68,13 @@ def cover(
     ] = None,
     rate: Annotated[float, typer.Option(help="Setpoint rate, Hz.")] = 50.0,
     altitude: Annotated[float, typer.Option(help="Flight height, m.")] = 2.0,
+    time_limit: Annotated[
+        float,
+        typer.Option(
+            help="Planning budget, s: the plan ends within it or stops with an error naming "
+            "the step it was at; a budget below the estimate is refused at once."
+        ),
+    ] = 60.0,
     target: Target = None,
     force: Force = False,
 ) -> None:
@@ -96,12 +110,13 @@ def cover(
             rate=rate,
             altitude=altitude,
             target=upload_target(target),
+            time_limit=time_limit,
         )
-        with console.status("planning the coverage flight"):
+        with _BudgetBar() as bar:
             if min_coverage is None:
-                plan = plan_coverage(shape, options)
+                plan = plan_coverage(shape, options, progress=bar.update)
             else:
-                plan = plan_tuned(shape, options, min_coverage)
+                plan = plan_tuned(shape, options, min_coverage, progress=bar.update)
         # The spray is on along the whole path: every part of it covers.
         planned = PlannedTrajectory(
             plan.trajectory, ((0.0, plan.duration),), coverage_limits(plan.options)
@@ -144,3 +159,51 @@ def _limits(
     if per_axis:
         return VehicleLimits(vmax=vmax, amax_axis=amax_axis, jmax_axis=jmax_axis)
     return VehicleLimits(vmax, 5.0 if amax is None else amax, 3.0 if jmax is None else jmax)
+
+
+class _BudgetBar:
+    """A rich bar of the planning budget spent, labelled with the current step.
+
+    Drawn on the CLI's console (stderr) once planning has taken
+    :data:`BAR_AFTER_S`: a plan of a small region ends before it would flicker.
+    """
+
+    def __init__(self) -> None:
+        self._bar: Progress | None = None
+        self._task: TaskID | None = None
+
+    def __enter__(self) -> _BudgetBar:
+        return self
+
+    def __exit__(
+        self,
+        kind: type[BaseException] | None,
+        value: BaseException | None,
+        trace: TracebackType | None,
+    ) -> None:
+        if self._bar is not None:
+            self._bar.stop()
+
+    def update(self, step: str, elapsed_s: float, limit_s: float) -> None:
+        """``progress`` of :func:`~skyquill.coverage.plan.plan_coverage`."""
+        if self._bar is None:
+            if elapsed_s < BAR_AFTER_S:
+                return
+            self._bar = _progress()
+            self._task = self._bar.add_task(step, total=limit_s)
+            self._bar.start()
+        assert self._task is not None  # added with the bar
+        self._bar.update(self._task, description=step, completed=min(elapsed_s, limit_s))
+
+
+def _progress() -> Progress:
+    """Step, and the budget spent (moved at every step: each LP solve, each check)."""
+    from rich.progress import BarColumn, Progress, TextColumn
+
+    return Progress(
+        TextColumn("planning: {task.description}"),
+        BarColumn(),
+        TextColumn("{task.completed:.0f} s of the {task.total:.0f} s time limit"),
+        console=console,
+        transient=True,
+    )

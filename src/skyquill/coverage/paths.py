@@ -147,6 +147,22 @@ def _dedupe(pts: FloatArray, *, closed: bool = False) -> FloatArray:
     return out
 
 
+def merge_close(points: FloatArray, tol: float) -> FloatArray:
+    """``points`` (K, 2) without the points closer than ``tol`` (m) to their predecessor.
+
+    A leg of nanometres (a perimeter lap starting at the sweep line nudged
+    1e-9 m inside the region's corner) makes the spline's parametric speed
+    vary by 1e5-1e8 along the path; the speed LP's columns ``b ~ 1 / |C'|^2``
+    then span ten and more orders of magnitude, HiGHS's hot starts stall and
+    the cold ``linprog`` solves that replace them ran for minutes.
+    """
+    if len(points) < 2:
+        return points
+    keep = np.ones(len(points), dtype=bool)
+    keep[1:] = np.linalg.norm(np.diff(points, axis=0), axis=1) > tol
+    return points[keep]
+
+
 def _aligned(rings: list[FloatArray]) -> list[FloatArray]:
     """Roll each ring to start at its vertex nearest the previous ring's start."""
     out: list[FloatArray] = []

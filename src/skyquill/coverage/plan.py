@@ -26,16 +26,30 @@ import numpy as np
 from numpy.typing import NDArray
 from shapely.geometry import LineString, Polygon
 
+from skyquill.coverage.deadline import (
+    DEFAULT_TIME_LIMIT_S,
+    Deadline,
+    Progress,
+    check_time_limit,
+    is_time_limit,
+)
+from skyquill.coverage.missed import Missed, missed_area
 from skyquill.coverage.paths import (
     ContourMode,
     DriftMode,
     contours,
+    merge_close,
     spiral_control_points,
     spiral_curve,
     with_corner_points,
     zigzag,
 )
-from skyquill.coverage.regions import check_width, coverage_fraction
+from skyquill.coverage.regions import (
+    check_width,
+    coverage_fraction,
+    estimate_path_length,
+    swept,
+)
 from skyquill.coverage.speed import SpeedPlan, plan_speed
 from skyquill.coverage.target import DeliveredPath, check_target_path, deliver
 from skyquill.errors import InfeasibleError, InputError
@@ -58,12 +72,18 @@ TUNING_DELTAS = (2.0, 1.5, 1.0, 0.6, 0.3, 0.15)
 #: Spacing of the speed LP's grid along the path, m (the grid needs several
 #: points per corner feature; see :func:`grid_points`).
 GRID_SPACING_M = 0.05
+#: Waypoints closer than this fraction of ``delta`` are one (see :func:`covering_waypoints`).
+MERGE_FRACTION = 0.01
 #: Bounds on the LP's grid size (LP time grows faster than linearly).
 GRID_POINTS = (300, 2000)
 #: Spacing of the dense samples that coverage is measured on, m.
 COVERAGE_SPACING_M = 0.02
 #: Largest region side accepted, m (beyond it the LP grid would be too coarse).
 MAX_REGION_SIZE_M = 1000.0
+#: Planning time per metre of estimated path assumed before any work, s/m: measured
+#: 0.7 ms/m (a 316 m square at a 5 m swath, 19.8 km, in 14.5 s on 2 shared cores),
+#: rounded up. A budget below the estimate is refused at once rather than spent.
+PLANNING_S_PER_M = 1e-3
 
 
 @dataclass(frozen=True)
@@ -109,6 +129,12 @@ class CoverageOptions:
         A vehicle's upload budget (:data:`skyquill.targets.TARGETS`): the
         planned path is then re-fitted into its uploads, degree-7 pieces flown
         rest to rest between uploads (:mod:`skyquill.coverage.target`).
+    time_limit : float
+        Wall-time budget of one plan (all of :func:`plan_tuned`'s trials
+        together), s, > 0: the plan is returned within it (plus one step), or
+        an ``InfeasibleError`` with family ``"time_limit"`` names the step it
+        stopped at; a budget below the estimate (:data:`PLANNING_S_PER_M`
+        times the estimated path length) is refused before any work.
     """
 
     width: float = 2.0
@@ -124,6 +150,7 @@ class CoverageOptions:
     grid: int | None = None
     norm_sides: int = 16
     target: UploadTarget | None = None
+    time_limit: float = DEFAULT_TIME_LIMIT_S
 
     def __post_init__(self) -> None:
         for name in ("width", "delta", "rate"):
@@ -146,6 +173,7 @@ class CoverageOptions:
         sides = as_int("norm_sides", self.norm_sides, low=4, high=1024)
         if sides % 2:
             raise InputError(f"norm_sides: got {sides}, expected an even integer from 4 to 1024")
+        check_time_limit(self.time_limit)
         if self.target is not None and not isinstance(self.target, UploadTarget):
             name = type(self.target).__name__
             raise InputError(f"target: got {name}, expected an UploadTarget or None")
@@ -230,6 +258,9 @@ class CoveragePlan:
         With ``options.target``: the re-fit into the target's uploads.
     planned_coverage : float or None
         With a target: the coverage of the planned path before the re-fit.
+    missed : Missed or None
+        What ``path``'s swath misses of the region (area, share, the largest
+        gaps); None only for plans built by hand.
     """
 
     region: Polygon
@@ -243,6 +274,7 @@ class CoveragePlan:
     speed_plan: SpeedPlan | None
     delivered: DeliveredPath | None = None
     planned_coverage: float | None = None
+    missed: Missed | None = None
 
     @property
     def duration(self) -> float:
@@ -270,6 +302,7 @@ class CoveragePlan:
             **self.limits,
             "planning_time_s": self.planning_time,
             "region_area_m2": float(self.region.area),
+            **({} if self.missed is None else self.missed.summary()),
             "options": asdict(self.options),
             "vehicle_limits": self.options.limits.as_dict(),
             "limits_held": "per axis"
@@ -304,8 +337,14 @@ def covering_waypoints(region: Polygon, options: CoverageOptions) -> FloatArray:
     """The pattern's waypoints: a spline's control polygon, or the stop points.
 
     Concave regions are decomposed into convex parts, covered one after the
-    other along one continuous path.
+    other along one continuous path. Waypoints closer than
+    :data:`MERGE_FRACTION` of ``delta`` to the previous one are merged
+    (:func:`~skyquill.coverage.paths.merge_close`).
     """
+    return merge_close(_waypoints(region, options), MERGE_FRACTION * options.delta)
+
+
+def _waypoints(region: Polygon, options: CoverageOptions) -> FloatArray:
     w, d, eps = options.width, options.delta, options.epsilon
     if options.pattern == "spiral":
         if is_convex(region):
@@ -321,7 +360,9 @@ def covering_waypoints(region: Polygon, options: CoverageOptions) -> FloatArray:
         from skyquill.coverage.joined import multi_zigzag
 
         stops = multi_zigzag(region, eps * w, perimeter=options.perimeter)
-    return stops if options.pattern == "zigzag-stop" else with_corner_points(stops, d)
+    if options.pattern == "zigzag-stop":
+        return stops
+    return with_corner_points(merge_close(stops, MERGE_FRACTION * d), d)
 
 
 def covering_path(region: Polygon, options: CoverageOptions) -> tuple[FloatArray, FloatArray]:
@@ -343,7 +384,13 @@ def tune_coverage(
     return plan.options, plan.coverage
 
 
-def plan_tuned(region: Polygon, options: CoverageOptions, target: float) -> CoveragePlan:
+def plan_tuned(
+    region: Polygon,
+    options: CoverageOptions,
+    target: float,
+    *,
+    progress: Progress | None = None,
+) -> CoveragePlan:
     """The fastest plan whose path covers ``target`` of the region.
 
     For every ``epsilon`` in :data:`TUNING_EPSILONS` and, for zigzags, without
@@ -355,20 +402,32 @@ def plan_tuned(region: Polygon, options: CoverageOptions, target: float) -> Cove
     length alone misjudges it: a denser spacing with rounder corners can fly
     faster than a wider one with sharp corners.
 
+    All trials share one ``options.time_limit``; ``progress`` is told every
+    step (see :class:`~skyquill.coverage.deadline.Deadline`).
+
     Raises
     ------
     InfeasibleError
-        No candidate reaches ``target``, or none that does can be timed.
+        No candidate reaches ``target``, or none that does can be timed; the
+        time limit is spent (family ``"time_limit"``).
     """
     goal = as_float("min_coverage", target, positive=True)
     if goal > 1.0:
         raise InputError(f"min_coverage: got {goal:g}, expected a fraction in (0, 1]")
     # Every trial is checked against the budget at the densest spacing tried.
     _check_region(region, replace(options, epsilon=min(TUNING_EPSILONS)))
+    deadline = Deadline(options.time_limit, progress)
     if options.target is not None:
         # Trials are compared as planned; only the winner is re-fitted for the target.
-        untargeted = plan_tuned(region, replace(options, target=None), goal)
-        return _for_target(untargeted, replace(untargeted.options, target=options.target))
+        untargeted = _tuned(region, replace(options, target=None), goal, deadline)
+        return _for_target(untargeted, replace(untargeted.options, target=options.target), deadline)
+    return _tuned(region, options, goal, deadline)
+
+
+def _tuned(
+    region: Polygon, options: CoverageOptions, goal: float, deadline: Deadline
+) -> CoveragePlan:
+    """:func:`plan_tuned` after its checks, within ``deadline``."""
     deltas = (options.delta,) if options.pattern == "zigzag-stop" else TUNING_DELTAS
     laps = (False,) if options.pattern == "spiral" else (False, True)
     candidates: list[CoverageOptions] = []
@@ -376,6 +435,7 @@ def plan_tuned(region: Polygon, options: CoverageOptions, target: float) -> Cove
     for eps, lap in itertools.product(TUNING_EPSILONS, laps):
         for delta in sorted(deltas, reverse=True):
             trial = replace(options, epsilon=eps, perimeter=lap, delta=delta)
+            deadline.check(f"the tuning trial epsilon={eps:g}, delta={delta:g}")
             covered = coverage_fraction(region, covering_path(region, trial)[1], trial.width)
             best = max(best, covered)
             if covered >= goal:
@@ -387,7 +447,7 @@ def plan_tuned(region: Polygon, options: CoverageOptions, target: float) -> Cove
             f"{best:.4f} of the region (tried epsilon {TUNING_EPSILONS}, delta {deltas})",
             ("coverage",),
         )
-    plans = [plan for trial in candidates if (plan := _plan_or_none(region, trial))]
+    plans = [plan for trial in candidates if (plan := _plan_or_none(region, trial, deadline))]
     if not plans:
         raise InfeasibleError(
             f"min_coverage: {len(candidates)} {options.pattern} path(s) cover {goal:g} of the "
@@ -398,7 +458,8 @@ def plan_tuned(region: Polygon, options: CoverageOptions, target: float) -> Cove
 
 
 def _check_region(region: Polygon, options: CoverageOptions) -> None:
-    """Refuse a region too large, or a path too long, before any path is built."""
+    """Refuse a region too large, a path too long or a budget too short, before any path is
+    built."""
     if not isinstance(region, Polygon):
         raise InputError(f"region: got {type(region).__name__}, expected a shapely Polygon")
     minx, miny, maxx, maxy = region.bounds
@@ -408,15 +469,35 @@ def _check_region(region: Polygon, options: CoverageOptions) -> None:
             f"{MAX_REGION_SIZE_M:g} m across (split it into several missions)"
         )
     check_width(region, options.width, options.epsilon)
+    _check_budget(region, options)
     if options.target is not None:
         check_target_path(region, options.width, options.epsilon, options.target)
 
 
-def _plan_or_none(region: Polygon, options: CoverageOptions) -> CoveragePlan | None:
-    """The plan, or ``None`` where the path cannot be timed within the limits."""
+def _check_budget(region: Polygon, options: CoverageOptions) -> None:
+    """Refuse a time limit shorter than the estimated planning time (nothing is built)."""
+    length = estimate_path_length(region, options.epsilon * options.width)
+    need = PLANNING_S_PER_M * length
+    if need > options.time_limit:
+        raise InputError(
+            f"time_limit: got {options.time_limit:g} s, expected at least {need:.3g} s for a "
+            f"path of about {length / 1e3:.3g} km ({1e3 * PLANNING_S_PER_M:g} ms per metre "
+            "estimated): allow more time, widen the swath or split the region"
+        )
+
+
+def _plan_or_none(
+    region: Polygon, options: CoverageOptions, deadline: Deadline
+) -> CoveragePlan | None:
+    """The plan, or ``None`` where the path cannot be timed within the limits.
+
+    A spent budget is not such a path: it is raised.
+    """
     try:
-        return plan_coverage(region, options)
-    except InfeasibleError:
+        return _plan(region, options, deadline)
+    except InfeasibleError as exc:
+        if is_time_limit(exc):
+            raise
         return None
 
 
@@ -424,7 +505,12 @@ def _length(path: FloatArray) -> float:
     return float(np.linalg.norm(np.diff(path, axis=0), axis=1).sum())
 
 
-def plan_coverage(region: Polygon, options: CoverageOptions | None = None) -> CoveragePlan:
+def plan_coverage(
+    region: Polygon,
+    options: CoverageOptions | None = None,
+    *,
+    progress: Progress | None = None,
+) -> CoveragePlan:
     """Plan a coverage flight of ``region``: path, speed, setpoints, coverage, limits.
 
     Parameters
@@ -434,14 +520,16 @@ def plan_coverage(region: Polygon, options: CoverageOptions | None = None) -> Co
         :func:`~skyquill.coverage.regions.load_region`.
     options
         :class:`CoverageOptions` (defaults: the paper's §4 limits, spiral).
+    progress
+        Told ``(step, elapsed_s, time_limit_s)`` at every step (a CLI's bar).
 
     Raises
     ------
     InputError
         Width not positive or too large for the region, bad options; a path
-        estimated longer than :data:`~skyquill.coverage.regions.MAX_PATH_LENGTH_M`
-        (refused before it is built; the speed LP's size is capped by
-        :data:`GRID_POINTS` and ``grid``).
+        estimated longer than :data:`~skyquill.coverage.regions.MAX_PATH_LENGTH_M`,
+        or a ``time_limit`` below its estimated planning time (refused before
+        it is built; the speed LP's size is capped by :data:`GRID_POINTS` and ``grid``).
     InfeasibleError
         The path cannot be timed within the limits. A concave region's
         spiral whose joins are too tight to time is flown part by part,
@@ -449,55 +537,75 @@ def plan_coverage(region: Polygon, options: CoverageOptions | None = None) -> Co
         With ``options.target``: the re-fit needs more uploads than
         :data:`~skyquill.optimize.budget.MAX_UPLOADS` (a path estimated longer
         than :data:`~skyquill.coverage.target.MAX_TARGET_PATH_M` is an
-        :class:`InputError` before any work).
+        :class:`InputError` before any work). The time limit is spent
+        (family ``"time_limit"``, the message names the step).
     """
     opts = options or CoverageOptions()
+    return _plan(region, opts, Deadline(opts.time_limit, progress))
+
+
+def _plan(region: Polygon, opts: CoverageOptions, deadline: Deadline) -> CoveragePlan:
+    """:func:`plan_coverage` within ``deadline``."""
     if opts.target is not None:
         _check_region(region, opts)
-        return _for_target(plan_coverage(region, replace(opts, target=None)), opts)
+        return _for_target(_plan(region, replace(opts, target=None), deadline), opts, deadline)
     start = time.perf_counter()
     _check_region(region, opts)
+    deadline.check("the covering path")
     waypoints, path = covering_path(region, opts)
     try:
-        timed = _timed_path(waypoints, path, opts)
+        timed = _timed_path(waypoints, path, opts, deadline)
         joins = "continuous"
-    except InfeasibleError:
-        if opts.pattern != "spiral" or is_convex(region):
+    except InfeasibleError as exc:
+        if is_time_limit(exc) or opts.pattern != "spiral" or is_convex(region):
             raise
         # A join squeezed past a reflex corner can be too tight to time: fly
         # each part's spiral rest to rest instead, joined by straight legs.
-        waypoints, path, timed = _stop_between_parts(region, opts)
+        waypoints, path, timed = _stop_between_parts(region, opts, deadline)
         joins = "stop"
     trajectory, speed_plan, check = timed
     if check is None:  # stop-and-go legs and parts at rest were not checked on the way
+        deadline.check("the dense check")
         check = verify(trajectory, coverage_limits(opts), guaranteed=False)
     limits = limits_report(check)
+    deadline.check("the coverage measure")
+    coverage, missed = _measured(region, path, opts.width)
     return CoveragePlan(
         region=region,
         options=opts,
         waypoints=waypoints,
         path=path,
         trajectory=trajectory,
-        coverage=coverage_fraction(region, path, opts.width),
+        coverage=coverage,
         limits=limits | {"joins": joins},
         planning_time=time.perf_counter() - start,
         speed_plan=speed_plan,
+        missed=missed,
     )
 
 
-def _for_target(plan: CoveragePlan, options: CoverageOptions) -> CoveragePlan:
+def _measured(region: Polygon, path: FloatArray, width: float) -> tuple[float, Missed]:
+    """Covered fraction of ``region`` by ``path``'s swath and what it misses (one buffer)."""
+    area = swept(path, width)
+    return float(region.intersection(area).area / region.area), missed_area(region, area)
+
+
+def _for_target(plan: CoveragePlan, options: CoverageOptions, deadline: Deadline) -> CoveragePlan:
     """``plan`` re-fitted into ``options.target``'s uploads, its coverage measured again."""
     assert options.target is not None  # only called with a target
+    deadline.check("the re-fit for the target")
     start = time.perf_counter()
     delivered = deliver(plan.path, options.limits, options.width, options.altitude, options.target)
     # The refit holds the limits through the hull: a guaranteed check, unlike the LP's.
     check = verify(delivered.trajectory, coverage_limits(options), guaranteed=True)
+    coverage, missed = _measured(plan.region, delivered.path, options.width)
     return replace(
         plan,
         options=options,
         path=delivered.path,
         trajectory=delivered.trajectory,
-        coverage=coverage_fraction(plan.region, delivered.path, options.width),
+        coverage=coverage,
+        missed=missed,
         limits=limits_report(check) | {"joins": plan.limits["joins"]},
         planning_time=plan.planning_time + time.perf_counter() - start,
         delivered=delivered,
@@ -534,19 +642,21 @@ def _lifted(points: FloatArray, altitude: float) -> FloatArray:
     return np.column_stack([points, np.full(points.shape[0], altitude)])
 
 
-def _timed_path(waypoints: FloatArray, path: FloatArray, opts: CoverageOptions) -> _Timed:
+def _timed_path(
+    waypoints: FloatArray, path: FloatArray, opts: CoverageOptions, deadline: Deadline
+) -> _Timed:
     """The path's trajectory at the flight height and its speed plan (``None`` for stop-and-go)."""
     if opts.pattern == "zigzag-stop":
         legs = LegLimits(opts.vmax, opts.amax, opts.jmax, per_axis=opts.per_axis)
         flown = stop_and_go(_lifted(waypoints, opts.altitude), legs)
         return flown.trajectory, None, None
     n = opts.grid or grid_points(_length(path))
-    speed_plan, trajectory, check = _timed(spiral_curve(waypoints), opts, n)
+    speed_plan, trajectory, check = _timed(spiral_curve(waypoints), opts, n, deadline)
     return trajectory, speed_plan, check
 
 
 def _stop_between_parts(
-    region: Polygon, opts: CoverageOptions
+    region: Polygon, opts: CoverageOptions, deadline: Deadline
 ) -> tuple[FloatArray, FloatArray, _Timed]:
     """Each part's spiral timed on its own, the joins flown as stop-and-go legs."""
     from skyquill.coverage.joined import multi_spiral_pieces
@@ -558,20 +668,20 @@ def _stop_between_parts(
     pieces: list[tuple[FloatArray, FloatArray, _Timed]] = []
     for k, spiral in enumerate(spirals):
         if k > 0 and len(routes[k - 1]) > 1 and _length(routes[k - 1]) > 1e-9:
-            pieces.append(_piece(routes[k - 1], stop, _densified(routes[k - 1])))
+            pieces.append(_piece(routes[k - 1], stop, _densified(routes[k - 1]), deadline))
         if len(spiral) > SPLINE_DEGREE:
-            pieces.append(_piece(spiral, opts, _dense(spiral_curve(spiral))))
+            pieces.append(_piece(spiral, opts, _dense(spiral_curve(spiral)), deadline))
         elif _length(spiral) > 1e-9:  # a part narrower than the swath: along its spine
-            pieces.append(_piece(spiral, stop, _densified(spiral)))
+            pieces.append(_piece(spiral, stop, _densified(spiral), deadline))
     waypoints = np.vstack([p[0] for p in pieces])
     path = np.vstack([p[1] for p in pieces])
     return waypoints, path, (concatenate([p[2][0] for p in pieces]), None, None)
 
 
 def _piece(
-    waypoints: FloatArray, opts: CoverageOptions, path: FloatArray
+    waypoints: FloatArray, opts: CoverageOptions, path: FloatArray, deadline: Deadline
 ) -> tuple[FloatArray, FloatArray, _Timed]:
-    return waypoints, path, _timed_path(waypoints, path, opts)
+    return waypoints, path, _timed_path(waypoints, path, opts, deadline)
 
 
 #: Degree of the covering splines (paper 001: 4, so that jerk is differentiable).
@@ -587,7 +697,7 @@ GRID_LADDER: tuple[tuple[int, Literal["uniform", "adaptive"]], ...] = (
 
 
 def _timed(
-    curve: Any, options: CoverageOptions, n: int
+    curve: Any, options: CoverageOptions, n: int, deadline: Deadline
 ) -> tuple[SpeedPlan, Trajectory, Verification]:
     """The speed plan on the first grid of :data:`GRID_LADDER` that verifies, its trajectory
     and that check.
@@ -605,7 +715,8 @@ def _timed(
     Raises
     ------
     InfeasibleError
-        No grid gives a plan within :data:`MAX_EXCESS` of the limits.
+        No grid gives a plan within :data:`MAX_EXCESS` of the limits; the
+        deadline is spent.
     """
     period = 1.0 / options.rate
     seen: list[str] = []
@@ -614,12 +725,16 @@ def _timed(
             plan = plan_speed(
                 curve, options.vmax, options.amax, options.jmax,
                 n=factor * n, control_period=period, grid=kind,
-                norm_sides=options.limit_norm_sides,
+                norm_sides=options.limit_norm_sides, deadline=deadline,
             )  # fmt: skip
         except InfeasibleError as exc:
+            if is_time_limit(exc):
+                raise
             seen.append(f"{kind} grid of {factor * n}: {exc}")
             continue
+        deadline.check("the timing law")
         trajectory = plan.trajectory(options.altitude)
+        deadline.check("the dense check")
         check = verify(trajectory, coverage_limits(options), guaranteed=False)
         excess = check.max_excess
         if excess <= MAX_EXCESS:

@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 import shapely
 from shapely.geometry import LineString, Polygon, shape
+from shapely.geometry.base import BaseGeometry
 
 from skyquill.errors import InputError
 from skyquill.io.json_read import check_depth, decode_utf8, parse_json
@@ -209,13 +210,12 @@ def _check_spikes(ring: FloatArray, name: str) -> None:
         )
 
 
-#: Longest covering path accepted, m, estimated before any path is made.
-#: Planning time grows with it (a 100 m square at a 2 m swath, ~5 km, plans in
-#: ~15 s) and the speed LP's grid is capped (``GRID_POINTS`` of
-#: :mod:`skyquill.coverage.plan`), so beyond ~10 km it is too coarse to hold
-#: the limits (a 200 m square at 2 m, ~20 km, fails after planning); 10 km at
-#: 3 m/s is also about an hour of flight, more than one battery.
-MAX_PATH_LENGTH_M = 10_000.0
+#: Longest covering path accepted, m, estimated before any path is made: a
+#: 10 ha field at a 4 m swath. Planning time grows linearly with it (~0.7 ms
+#: per metre: a 316 m square at a 5 m swath, 19.8 km, plans in ~15 s; see
+#: ``bench/coverage_scale.py``); 25 km at 3 m/s is also over two hours of
+#: flight, several batteries.
+MAX_PATH_LENGTH_M = 25_000.0
 
 
 def estimate_path_length(region: Polygon, spacing: float) -> float:
@@ -259,11 +259,27 @@ def what_fits(region: Polygon, epsilon: float, budget_m: float = MAX_PATH_LENGTH
     return f"a swath of at least {least:.3g} m, or a smaller region: split it into missions"
 
 
+#: The swept path is simplified to this fraction of the swath before it is buffered.
+SIMPLIFY_FRACTION = 1e-4
+
+
 def coverage_fraction(region: Polygon, path: FloatArray, width: float) -> float:
     """Area of (region ∩ swept discs of diameter ``width`` along ``path`` (N, >=2)) / area."""
+    return float(region.intersection(swept(path, width)).area / region.area)
+
+
+def swept(path: FloatArray, width: float) -> BaseGeometry:
+    """The area swept by a disc of diameter ``width`` (m) along ``path`` (N, >= 2), m.
+
+    The dense path (a point every ~2 cm) is simplified first, to within
+    ``SIMPLIFY_FRACTION * width`` of itself: the buffer of the 1 M points of a
+    20 km path took 10.5 s, of its 30k-point simplification 1.3 s with the
+    same area to 1e-6 (the buffer's own 16-gon discs differ from circles by more).
+    """
     pts = as_array("path", path, ndim=2)
-    swept = LineString(pts[:, :2]).buffer(0.5 * as_float("width", width, positive=True))
-    return float(region.intersection(swept).area / region.area)
+    radius = 0.5 * as_float("width", width, positive=True)
+    line = LineString(pts[:, :2]).simplify(SIMPLIFY_FRACTION * 2.0 * radius)
+    return line.buffer(radius)
 
 
 def _shown(text: str, limit: int = 200) -> str:

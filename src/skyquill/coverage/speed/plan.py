@@ -10,6 +10,7 @@ import numpy as np
 import numpy.typing as npt
 from scipy import sparse
 
+from skyquill.coverage.deadline import Deadline
 from skyquill.coverage.speed.curve import PathCurve, _derivs3, _eval, _Reparam
 from skyquill.coverage.speed.grid import _grid_map
 from skyquill.coverage.speed.iteration import _initial_solve, _refine
@@ -49,6 +50,7 @@ def plan_speed(
     lp_backend: str = "auto",
     grid: str = "uniform",
     norm_sides: int | None = None,
+    deadline: Deadline | None = None,
 ) -> SpeedPlan:
     """Plan the time-optimal rest-to-rest speed profile along ``curve``.
 
@@ -115,6 +117,9 @@ def plan_speed(
         ``excess_estimate`` measure the norm itself.  2-D paths; on a 3-D
         path the polygon holds the horizontal norm and ``|a_z| <= amax``,
         ``|j_z| <= jmax`` the vertical component.
+    deadline : Deadline, optional
+        A wall-time budget: checked before every LP solve, whose HiGHS time
+        limit is what is left of it (see :class:`~skyquill.coverage.deadline.Deadline`).
 
     Returns
     -------
@@ -126,7 +131,7 @@ def plan_speed(
     InputError
         Malformed argument.
     InfeasibleError
-        The LP has no solution.
+        The LP has no solution; or the deadline is spent (family ``"time_limit"``).
     SolverError
         HiGHS failed otherwise.
     """
@@ -168,7 +173,7 @@ def plan_speed(
     jlim = None if jmax_a is None else component_limits(jmax_a, norm)
     if jlim is not None:
         a = sparse.vstack([a, _jerk_matrix((p1, p2, p3), jlim * args.safety, vb)], format="csr")
-    lp = _GridLP(a, backend=backend, time_scale=p1.shape[1] / d)
+    lp = _GridLP(a, backend=backend, time_scale=p1.shape[1] / d, deadline=deadline)
     bounds = _Bounds(ub, None if jlim is None else vb, p1.shape[1], *_ones(n))
     log: tuple[list[float], list[float]] = ([], [])
     stop = (args.jerk_iterations, args.jerk_tol)
