@@ -10,12 +10,15 @@ set; the package is in the dev extra) is planned as ``skyquill write`` plans
 it: a 0.5 m horizontal board at 1 m, the vehicle taking off from the ground
 1 m in front, default options (limits 1 m/s, 2 m/s^2, 10 m/s^3 as norms,
 re-segmentation with the total time fixed). Planning is timed ``--runs``
-times (BLAS pinned to one thread with threadpoolctl, the collector off, one
-warm-up call first) and the median kept. Each plan is then flown once in the
-closed-loop simulator over the brush's contact board, and its ink measured
+times, and also without the home (the flight starting and ending at rest
+above the first and last stroke: ``plan_writing``'s default, which the
+issue's 0.3 s target was measured on); BLAS pinned to one thread with
+threadpoolctl, the collector off, one warm-up call first, the median kept.
+Each plan is then flown once in the closed-loop simulator over the brush's
+contact board, and its ink measured
 (:func:`skyquill.calligraphy.ink.measure_ink`: two-sided distance in the
-board's plane, ink strokes against input strokes, IoU with the input drawn at
-the planned width).
+board's plane, ink strokes against input strokes, IoU with the input drawn
+at the planned width).
 
 Reported per character and mode: median planning time, writing time, the
 plan's own deviation and limit excess, and the simulated ink; per set: the
@@ -82,7 +85,9 @@ def strokes_of(item: dict[str, Any]) -> Any:
     return hanzi_strokes(item["char"]) if item["source"] == "hanzi" else load_svg(item["path"])
 
 
-def plan_timed(strokes: Any, follow: str, runs: int) -> tuple[Any, float]:
+def plan_timed(
+    strokes: Any, follow: str, runs: int, home: np.ndarray | None = HOME
+) -> tuple[Any, float]:
     """The mission and the median planning time (s) of ``runs`` calls."""
     from skyquill.calligraphy.board import Board
     from skyquill.calligraphy.mission import WritingOptions, plan_writing
@@ -92,7 +97,7 @@ def plan_timed(strokes: Any, follow: str, runs: int) -> tuple[Any, float]:
     for _ in range(runs):
         with gc_off():
             start = time.perf_counter()
-            mission = plan_writing(strokes, Board(), options, home=HOME)
+            mission = plan_writing(strokes, Board(), options, home=home)
             times.append(time.perf_counter() - start)
     return mission, float(np.median(times))
 
@@ -113,12 +118,14 @@ def measure(item: dict[str, Any], runs: int) -> dict[str, Any]:
     row: dict[str, Any] = {"set": item["set"], "char": item["char"], "strokes": len(strokes.paths)}
     for follow in MODES:
         mission, median_s = plan_timed(strokes, follow, runs)
+        _, hovering_s = plan_timed(strokes, follow, runs, None)
         ink = flown_ink(mission)
         whole = ink["ink_strokes"] == ink["input_strokes"]
         within = ink["max_deviation_m"] is not None
         within = within and ink["max_deviation_m"] <= INK_TOLERANCE * SIZE_M
         row[follow] = {
             "planning_s": median_s,
+            "planning_from_hover_s": hovering_s,
             "writing_time_s": mission.trajectory.duration,
             "time_scale": mission.time_scale,
             "deviation_max_m": mission.deviation.max_m,
@@ -150,6 +157,7 @@ def summarise(rows: list[dict[str, Any]]) -> dict[str, Any]:
             deviations = [i["max_deviation_m"] for i in inks if i["max_deviation_m"] is not None]
             entry[follow] = {
                 "median_planning_s": _median(chosen, "planning_s", follow),
+                "median_planning_from_hover_s": _median(chosen, "planning_from_hover_s", follow),
                 "max_planning_s": float(max(r[follow]["planning_s"] for r in chosen)),
                 "median_writing_time_s": _median(chosen, "writing_time_s", follow),
                 "all_faithful": all(r[follow]["faithful"] for r in chosen),
@@ -168,7 +176,10 @@ def summarise(rows: list[dict[str, Any]]) -> dict[str, Any]:
         entry["planning_tip_over_path_median"] = float(
             np.median([r["planning_ratio"] for r in chosen])
         )
-        entry["meets_target"] = entry["tip"]["median_planning_s"] <= TARGET_S
+        entry["meets_target"] = {
+            "from_home": entry["tip"]["median_planning_s"] <= TARGET_S,
+            "from_hover": entry["tip"]["median_planning_from_hover_s"] <= TARGET_S,
+        }
         out[name] = entry
     return out
 

@@ -5,9 +5,7 @@ from __future__ import annotations
 import json
 import math
 import re
-from pathlib import Path
 
-import matplotlib.image
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
@@ -21,7 +19,6 @@ from skyquill.calligraphy.ink import (
     flight_ink,
     ink_fidelity,
     measure_ink,
-    render_ink,
 )
 from skyquill.calligraphy.mission import Mission, WritingOptions, contact_board, plan_writing
 from skyquill.errors import InputError
@@ -222,16 +219,3 @@ def test_measure_ink_takes_any_ink(mission: Mission, runs: list[tuple[np.ndarray
     assert f.max_deviation_m == max(f.ink_to_input_max_m, f.input_to_ink_max_m)
     assert f.ink_to_input_max_m <= f.max_deviation_m
     json.dumps(f.as_dict(), allow_nan=False)
-
-
-# --- the picture ---------------------------------------------------------------------------
-
-
-@pytest.mark.parametrize("offset", [0.004, None])
-def test_render_ink_writes_a_png(tmp_path: Path, offset: float | None) -> None:
-    none = offset is None  # no ink at all: the input alone, and no deviation in the title
-    f = ink_fidelity([], [], [[[0, 0], [L, 0]]], W) if none else straight(offset=offset)
-    render_ink(f, tmp_path / "ink.png", "test")
-    image = matplotlib.image.imread(tmp_path / "ink.png")
-    assert image.ndim == 3 and image.shape[1] > 2 * image.shape[0]  # three panels side by side
-    assert image[..., :3].min() < 0.3  # something dark was drawn

@@ -301,8 +301,8 @@ def _ink_name(trajectory_csv: str) -> str:
 
 
 def _write_ink_pictures(out: Path, inks: dict[str, InkFidelity]) -> None:
-    """Draw each drone's ink beside its input (:func:`~skyquill.calligraphy.ink.render_ink`)."""
-    from skyquill.calligraphy.ink import render_ink
+    """Draw each drone's ink beside its input (:func:`~skyquill.viz.ink_plot.render_ink`)."""
+    from skyquill.viz.ink_plot import render_ink
 
     for name, fidelity in inks.items():
         with atomic_path(out / name) as tmp:
