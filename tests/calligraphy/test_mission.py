@@ -252,3 +252,39 @@ def test_a_wall_is_written_by_the_path() -> None:
     mission = plan_writing(hanzi_strokes("一"), wall, WritingOptions())
     assert not mission.options.follows_tip(wall)
     assert mission.contact is None
+
+
+def test_route_times_lifts_for_the_jerk_limit_and_settle_after_the_approach() -> None:
+    """Fitting the tip, every lift lasts at least a jerk-limited rest-to-rest move of its
+    length; coming from home, the legs to and from it are slower and the vehicle pauses
+    above the first stroke. Fitting the path, only the home legs change."""
+    from skyquill.calligraphy.mission import (
+        HOME_LEG_SPEED,
+        LIFT,
+        LIFT_JERK_FACTOR,
+        SETTLE_S,
+        _route,
+        _runs,
+        route_times,
+    )
+    from skyquill.optimize.timing import allocate_path_times
+
+    board, opts = Board(), WritingOptions()
+    strokes = tuple(board.to_world(p) for p in hanzi_strokes("人").scaled(0.5).paths)
+    home = HOME - 0.3 * board.normal
+    points, roles = _route(strokes, board, home)
+    tip = np.diff(route_times(points, roles, board, opts))
+    path = np.diff(route_times(points, roles, board, WritingOptions(follow="path")))
+    base = np.diff(allocate_path_times(points, 1.0, 1.0))
+    lengths = np.linalg.norm(np.diff(points, axis=0), axis=1)
+    lifts = _runs(roles == LIFT)
+    assert len(lifts) == 4  # down onto and up from each of its two strokes
+    for start, stop in lifts:
+        legs = slice(start - 1, stop)
+        least = (LIFT_JERK_FACTOR * lengths[legs].sum() / 10.0) ** (1 / 3)
+        extra = SETTLE_S if start == lifts[0][0] else 0.0
+        assert tip[legs].sum() >= least + extra - 1e-9
+    approach = slice(0, lifts[0][0] - 1)
+    assert np.allclose(path[approach], base[approach] / HOME_LEG_SPEED)
+    inside = slice(lifts[0][0], lifts[-1][1])
+    assert np.allclose(path[inside], base[inside])  # the path's writing keeps its timing

@@ -108,6 +108,8 @@ MAX_ALTITUDE_M = 120.0
 #: A rest-to-rest move of length d within jerk J takes at least (32 d / J)^(1/3)
 #: (bang-bang jerk); a minimum-jerk (quintic) one peaks at 60 d / T^3.
 LIFT_JERK_FACTOR = 32.0
+#: Fraction of the speed limit the legs from and to home are timed at.
+HOME_LEG_SPEED = 0.9
 #: Pause above the first stroke after the approach from home, s. The approach
 #: is the flight's fastest leg; paper 000's outer loop (w_n ~ 1.8 rad/s,
 #: zeta 0.5) is still ~3 mm off after it, and the tip, swinging forward as the
@@ -577,24 +579,30 @@ def route_times(
     ``(32 d / jmax)^(1/3)`` (:data:`LIFT_JERK_FACTOR`): the profile knows no
     jerk, and a lift that must be flown (the brush leaves the board) but is
     timed faster makes the jerk limit bind there and every solve a conic one.
-    Coming from a home, the vehicle pauses :data:`SETTLE_S` above the first
-    stroke before it touches down.
+    Coming from a home, the legs from and to it are flown at
+    :data:`HOME_LEG_SPEED` of the speed limit, and fitting the tip the vehicle
+    pauses :data:`SETTLE_S` above the first stroke before it touches down.
     """
     vmax, amax = opts.limits.timing_bounds()
-    times = allocate_path_times(points, vmax, 0.5 * amax)
+    steps = np.diff(allocate_path_times(points, vmax, 0.5 * amax))
+    lifts = _runs(roles == LIFT)
+    from_home = lifts[0][0] > 1  # else the route starts right above the first stroke
+    if from_home:
+        # The legs from and to home are long and straight, timed at the speed
+        # limit: the smoothed spline would brush past it there and make every
+        # solve a conic one. A margin keeps them off it.
+        steps[: lifts[0][0] - 1] /= HOME_LEG_SPEED
+        steps[lifts[-1][1] :] /= HOME_LEG_SPEED
     jmax = opts.limits.jmax or opts.limits.jmax_axis
     if not opts.follows_tip(board) or jmax is None:
-        return times
-    steps = np.diff(times)
+        return np.concatenate([[0.0], np.cumsum(steps)])
     lengths = np.linalg.norm(np.diff(points, axis=0), axis=1)
-    lifts = _runs(roles == LIFT)
     for start, stop in lifts:
         legs = slice(max(start - 1, 0), stop)  # into the lift's first sample, out of its last
         needed = (LIFT_JERK_FACTOR * float(lengths[legs].sum()) / jmax) ** (1.0 / 3.0)
         steps[legs] *= max(1.0, needed / max(float(steps[legs].sum()), 1e-12))
-    first = lifts[0][0]
-    if first > 1:  # the flight comes from a home: settle above the first stroke
-        steps[first - 1] += SETTLE_S
+    if from_home:  # settle above the first stroke
+        steps[lifts[0][0] - 1] += SETTLE_S
     return np.concatenate([[0.0], np.cumsum(steps)])
 
 
