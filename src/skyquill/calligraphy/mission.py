@@ -115,7 +115,7 @@ HOME_LEG_SPEED = 0.9
 #: zeta 0.5) is still ~3 mm off after it, and the tip, swinging forward as the
 #: vehicle stops, would touch down that far past the stroke's start (simulated:
 #: 5.2 mm on 中 without the pause, 4.4 mm with 0.5 s, 3.2 mm with 1 s).
-SETTLE_S = 0.5
+SETTLE_S = 1.0
 #: Sampling step of the planned ink (:func:`planned_ink`), s: 4 mm at 1 m/s
 #: (distances are to the polyline through the samples).
 INK_SAMPLE_S = 0.004
