@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import dataclasses
+import re
+
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
@@ -288,3 +291,18 @@ def test_route_times_lifts_for_the_jerk_limit_and_settle_after_the_approach() ->
     assert np.allclose(path[approach], base[approach] / HOME_LEG_SPEED)
     inside = slice(lifts[0][0], lifts[-1][1])
     assert np.allclose(path[inside], base[inside])  # the path's writing keeps its timing
+
+
+def test_a_character_beyond_the_tolerance_is_refused_with_the_measured_distance() -> None:
+    """Too tight a tolerance: the error says how far the swung tip stays, after how many
+    stretches, and what would help; best effort returns the plan, marked unfaithful."""
+    tight = WritingOptions(tolerance_m=0.0002, max_stretches=1)
+    with pytest.raises(InfeasibleError) as info:
+        plan_writing(hanzi_strokes("人"), Board(), tight)
+    message = str(info.value)
+    assert re.search(r"the swung brush tip stays \d+(\.\d+)? mm from the input", message)
+    assert "expected within the tolerance of 0.2 mm" in message
+    assert "after 1 stretches (1.25x slower)" in message
+    assert "best_effort" in message
+    best = plan_writing(hanzi_strokes("人"), Board(), dataclasses.replace(tight, best_effort=True))
+    assert not best.faithful and best.deviation.max_m > 0.0002

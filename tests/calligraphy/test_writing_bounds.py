@@ -6,6 +6,8 @@ import re
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from skyquill.calligraphy.board import Board
 from skyquill.calligraphy.brush import Brush
@@ -13,6 +15,7 @@ from skyquill.calligraphy.mission import (
     MAX_STROKES,
     WritingOptions,
     _route,
+    check_reach,
     plan_writing,
     route_length,
 )
@@ -124,3 +127,33 @@ def test_the_route_estimate_bounds_the_route() -> None:
 def test_solve_counts_are_bounded(kwargs: dict[str, int], message: str) -> None:
     with pytest.raises(InputError, match=f"^{message}"):
         WritingOptions(**kwargs)  # type: ignore[arg-type]
+
+
+_any_float = st.one_of(
+    st.floats(allow_nan=True, allow_infinity=True), st.integers(-10, 10), st.just("0.3")
+)
+
+
+@settings(max_examples=200, deadline=None, derandomize=True)
+@given(
+    length=_any_float,
+    travel=_any_float,
+    press=_any_float,
+    height=st.floats(-1e3, 1e3),
+    kind=st.sampled_from(["horizontal", "wall"]),
+)
+def test_any_brush_and_board_is_taken_or_refused_by_name(
+    length: object, travel: object, press: object, height: float, kind: str
+) -> None:
+    """Hostile brushes and board heights: a Brush, or an InputError naming the field;
+    a reachable board, or the check's InputError -- never another exception."""
+    try:
+        brush = Brush(length_m=length, travel_m=travel, press_depth_m=press)  # type: ignore[arg-type]
+    except InputError as exc:
+        assert str(exc).startswith("brush ")
+        return
+    board = Board(kind, np.array([0.0, 0.0, height]))  # type: ignore[arg-type]
+    try:
+        check_reach(board, WritingOptions(brush=brush))
+    except InputError as exc:
+        assert str(exc).startswith(("brush length_m", "board: got"))
