@@ -12,11 +12,11 @@ from hypothesis import strategies as st
 from ink_check import ink_distance, tip_on_board
 
 from skyquill.calligraphy.board import Board
+from skyquill.calligraphy.fidelity import contact_runs
 from skyquill.calligraphy.mission import (
     WritingOptions,
     check_separation,
     densify,
-    measure_deviation,
     plan_writing,
 )
 from skyquill.calligraphy.show import layout, plan_show
@@ -81,18 +81,6 @@ def test_vehicle_trajectory_is_offset_by_the_brush(h_mission) -> None:  # type: 
     t = np.linspace(0, vehicle.duration, 50)
     assert np.allclose(vehicle.evaluate(t) - h_mission.trajectory.evaluate(t), [0, 0, 0.3])
     assert np.allclose(vehicle.evaluate(t, 2), h_mission.trajectory.evaluate(t, 2))
-
-
-def test_measure_deviation_is_two_sided() -> None:
-    line = SplineTrajectory(
-        np.column_stack([np.linspace(0, 1, 6), np.zeros(6), np.ones(6)]), 5, 1.0
-    )
-    stroke = np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 1.0]])
-    assert measure_deviation(line, ((0.0, 1.0),), (stroke,)).max_m < 1e-9
-    longer = np.array([[0.0, 0.0, 1.0], [1.5, 0.0, 1.0]])  # the path misses the last 0.5 m
-    dev = measure_deviation(line, ((0.0, 1.0),), (longer,))
-    assert dev.path_to_input_max_m < 1e-9
-    assert dev.input_to_path_max_m == pytest.approx(0.5, abs=1e-6)
 
 
 def test_densify_keeps_vertices_and_spacing() -> None:
@@ -267,7 +255,6 @@ def test_route_times_lifts_for_the_jerk_limit_and_settle_after_the_approach() ->
         LIFT_JERK_FACTOR,
         SETTLE_S,
         _route,
-        _runs,
         route_times,
     )
     from skyquill.optimize.timing import allocate_path_times
@@ -280,7 +267,7 @@ def test_route_times_lifts_for_the_jerk_limit_and_settle_after_the_approach() ->
     path = np.diff(route_times(points, roles, board, WritingOptions(follow="path")))
     base = np.diff(allocate_path_times(points, 1.0, 1.0))
     lengths = np.linalg.norm(np.diff(points, axis=0), axis=1)
-    lifts = _runs(roles == LIFT)
+    lifts = contact_runs(roles == LIFT)
     assert len(lifts) == 4  # down onto and up from each of its two strokes
     for start, stop in lifts:
         legs = slice(start - 1, stop)
