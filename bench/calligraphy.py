@@ -66,9 +66,9 @@ def kanjivg_dir() -> Path | None:
 
 def inputs(n_bundled: int | None, n_kanjivg: int) -> tuple[list[dict[str, Any]], str | None]:
     """The characters to plan and a note on KanjiVG."""
-    from skyquill.strokes import bundled_hanzi
+    from skyquill.strokes.hanzi import BENCHMARK_HANZI
 
-    chars = sorted(bundled_hanzi())[:n_bundled]
+    chars = sorted(BENCHMARK_HANZI)[:n_bundled]
     items = [{"set": "bundled", "char": c, "source": "hanzi"} for c in chars]
     folder = kanjivg_dir()
     if folder is None:

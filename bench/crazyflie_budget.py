@@ -47,7 +47,8 @@ from threadpoolctl import threadpool_info, threadpool_limits
 from common import jsonable, machine_info
 from skyquill.calligraphy.mission import Mission, WritingOptions, plan_writing
 from skyquill.errors import InfeasibleError
-from skyquill.strokes import Strokes, bundled_hanzi, hanzi_strokes
+from skyquill.strokes import Strokes, hanzi_strokes
+from skyquill.strokes.hanzi import BENCHMARK_HANZI
 from skyquill.targets import CRAZYFLIE, plan_uploads
 
 RESULTS = Path(__file__).resolve().parent / "results" / "crazyflie_budget.json"
@@ -229,7 +230,7 @@ def main() -> None:
     info = machine_info(("scipy", "clarabel", "threadpoolctl"))
     with threadpool_limits(1):
         blas = threadpool_info()
-        rows = [_character(c) for c in track(sorted(bundled_hanzi()), description="characters")]
+        rows = [_character(c) for c in track(sorted(BENCHMARK_HANZI), description="characters")]
     data = {
         "machine": info,
         "blas": blas,

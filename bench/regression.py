@@ -39,8 +39,9 @@ PER_AXIS = ("--amax-axis", "5", "--jmax-axis", "3")
 #: A job given as Python code (the same in both trees: ``plan_writing``'s defaults).
 PLAN_ALL = (
     "from skyquill.calligraphy.mission import plan_writing",
-    "from skyquill.strokes import bundled_hanzi, hanzi_strokes",
-    "[plan_writing(hanzi_strokes(c)) for c in bundled_hanzi()]",
+    "from skyquill.strokes import hanzi_strokes",
+    "from skyquill.strokes.hanzi import BENCHMARK_HANZI",
+    "[plan_writing(hanzi_strokes(c)) for c in BENCHMARK_HANZI]",
 )
 #: (name, arguments after ``skyquill``, note). ``{out}`` is a fresh folder.
 JOBS: tuple[tuple[str, list[str], str], ...] = (

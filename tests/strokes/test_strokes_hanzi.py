@@ -10,15 +10,15 @@ import pytest
 
 from skyquill.errors import InputError
 from skyquill.strokes import bundled_hanzi, hanzi_strokes, hanzi_text
+from skyquill.strokes.hanzi import BENCHMARK_HANZI, missing_hanzi
 
 _YI = {"strokes": ["M 0 0 Z"], "medians": [[[121, 393], [417, 402], [920, 401]]]}
 
 
-def test_all_bundled_characters_load() -> None:
+def test_every_shipped_character_loads_inside_its_em_box() -> None:
     chars = bundled_hanzi()
-    assert len(chars) >= 57
-    for c in "永光成一马当先":
-        assert c in chars
+    assert len(chars) == 9574 and "文" in chars and "永" in chars
+    assert set(BENCHMARK_HANZI) <= set(chars)
     for c in chars:
         s = hanzi_strokes(c)
         assert s.n_strokes >= 1
@@ -44,9 +44,11 @@ def test_medians_are_y_up_in_writing_direction() -> None:
     assert yi[-1, 0] > yi[0, 0] + 500
 
 
-def test_unknown_character_is_named_with_places() -> None:
-    with pytest.raises(InputError, match=r"'鑫' \(U\+946B\) not found; looked in the bundled set"):
-        hanzi_strokes("鑫")
+def test_unknown_character_is_named_with_places_and_alternatives() -> None:
+    message = r"'𠀀' \(U\+20000\) not found; looked in the 9,574 characters of hanzi-writer-data"
+    with pytest.raises(InputError, match=message) as info:
+        hanzi_strokes("𠀀")  # CJK extension B: not in the data set
+    assert "--svg FILE" in str(info.value) and "--font" in str(info.value)
 
 
 def test_one_character_only() -> None:
@@ -65,7 +67,7 @@ def test_source_directory(tmp_path: Path) -> None:
     (tmp_path / "一.json").write_text(json.dumps(_YI), encoding="utf-8")
     assert hanzi_strokes("一", source=tmp_path).paths[0].shape == (3, 2)
     # source is exclusive: a character missing there is not taken from the bundle
-    with pytest.raises(InputError, match=rf"'永' \(U\+6C38\) not found; looked in {tmp_path}$"):
+    with pytest.raises(InputError, match=rf"'永' \(U\+6C38\) not found; looked in {tmp_path}; "):
         hanzi_strokes("永", source=tmp_path)
 
 
@@ -82,8 +84,8 @@ def test_env_directory_then_bundle(tmp_path: Path, monkeypatch: pytest.MonkeyPat
     monkeypatch.setenv("SKYQUILL_HANZI_DIR", str(tmp_path))
     assert hanzi_strokes("永").n_strokes == 1  # the directory wins
     assert hanzi_strokes("光").n_strokes == 6  # not there: the bundle
-    with pytest.raises(InputError, match=r"looked in .*SKYQUILL_HANZI_DIR.*; the bundled set"):
-        hanzi_strokes("鑫")
+    with pytest.raises(InputError, match=r"looked in .*SKYQUILL_HANZI_DIR.*; the 9,574 characters"):
+        hanzi_strokes("𠀀")
 
 
 def test_env_directory_missing(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
@@ -121,5 +123,19 @@ def test_hanzi_text_errors() -> None:
         hanzi_text("  ")
     with pytest.raises(InputError, match="advance: got 0, expected a number > 0"):
         hanzi_text("一", advance=0)
-    with pytest.raises(InputError, match="'鑫'"):
-        hanzi_text("一鑫")
+    with pytest.raises(InputError, match="'𠀀'"):
+        hanzi_text("一𠀀")
+
+
+def test_the_shipped_medians_are_the_packages_own() -> None:
+    """Values as hanzi-writer-data 2.0.1 gives them (永's first stroke, and a stroke of
+    懂 whose coordinates are not integers: the packing is exact)."""
+    assert hanzi_strokes("永").paths[0][:3].tolist() == [[428, 824], [503, 781], [533, 756]]
+    fractional = np.concatenate(hanzi_strokes("懂").paths)
+    assert np.any(fractional != np.round(fractional))
+    assert np.allclose(fractional * 36, np.round(fractional * 36), atol=1e-9)
+
+
+def test_missing_hanzi_names_each_missing_character_once() -> None:
+    assert missing_hanzi("永文 永") == ""
+    assert missing_hanzi("a永𠀀a") == "a𠀀"

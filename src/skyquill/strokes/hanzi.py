@@ -1,29 +1,32 @@
 """Strokes of Chinese characters from the Make Me a Hanzi stroke medians.
 
-The data is that of the npm package ``hanzi-writer-data`` (derived from Make Me a
-Hanzi, under the Arphic Public License, see ``data/hanzi/ARPHICPL.TXT``): one
-JSON per character with ``"strokes"`` (SVG outlines of the brush shapes) and
-``"medians"`` (per stroke, the ``[x, y]`` points of its centre line in writing
-direction). Only the medians are used: they are what a brush held by a drone
-follows. Coordinates are in a 1024-unit em box with y already up: top-left
-``(0, 900)``, bottom-right ``(1024, -124)``.
+The data is that of the npm package ``hanzi-writer-data`` 2.0.1 (derived from
+Make Me a Hanzi, under the Arphic Public License, see ``data/hanzi/ARPHICPL.TXT``
+and ``SOURCE.txt``): one JSON per character with ``"strokes"`` (SVG outlines of
+the brush shapes) and ``"medians"`` (per stroke, the ``[x, y]`` points of its
+centre line in writing direction). Only the medians are used: they are what a
+brush held by a drone follows. All 9,574 characters ship with skyquill, packed
+exactly (``data/hanzi/hanzi_medians.npz``, ~2.5 MB; ``tools/pack_hanzi_medians.py``
+makes it from the package). Coordinates are in a 1024-unit em box with y
+already up: top-left ``(0, 900)``, bottom-right ``(1024, -124)``.
 """
 
 from __future__ import annotations
 
-import json
 import os
+from dataclasses import dataclass
 from functools import cache
 from importlib import resources
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from skyquill.errors import InputError
 from skyquill.strokes.json_io import read_json
 from skyquill.strokes.model import Strokes
-from skyquill.validation import as_float
+from skyquill.validation import FloatArray, as_float
 
 #: Environment variable naming a directory of ``<char>.json`` files (for example
 #: an unpacked ``hanzi-writer-data`` package) searched before the bundled set.
@@ -37,19 +40,63 @@ EM = 1024.0
 EM_BOTTOM = -124.0
 EM_TOP = EM_BOTTOM + EM
 
-_BUNDLE = "hanzi_medians.json"
+#: The 57 common characters the benchmarks and paper reproductions plan (they
+#: were the whole bundle before the full data set shipped).
+BENCHMARK_HANZI = (
+    "永光成一马当先的是不了人我在有他这中大来上国个到说们为子和你地出道也时年得就那"
+    "要下以生会自着去之过家学对可里后小么"
+)
+#: What is said about a character outside every data set searched.
+ALTERNATIVES = (
+    "write it from a drawing (--svg FILE, or load_svg in Python), from other stroke "
+    "data (--hanzi FILE|DIR, hanzi-writer-data's format), or as text in a Hershey font "
+    "(--font); `skyquill hanzi TEXT` lists which characters are available"
+)
+
+
+@dataclass(frozen=True)
+class _Bundle:
+    """The packed medians (``tools/pack_hanzi_medians.py`` says how they are laid out)."""
+
+    index: dict[str, int]
+    first_stroke: NDArray[np.int32]
+    first_point: NDArray[np.int32]
+    units: NDArray[np.int32]
+    scale: float
+
+    def medians(self, char: str) -> list[FloatArray] | None:
+        """The strokes of ``char`` (each (K, 2), em-box units), or ``None``."""
+        i = self.index.get(char)
+        if i is None:
+            return None
+        strokes = range(int(self.first_stroke[i]), int(self.first_stroke[i + 1]))
+        bounds = [(int(self.first_point[j]), int(self.first_point[j + 1])) for j in strokes]
+        return [self.units[a:b] / self.scale for a, b in bounds]
 
 
 @cache
-def _bundle() -> dict[str, Any]:
-    ref = resources.files("skyquill.strokes").joinpath("data", "hanzi", _BUNDLE)
-    data: dict[str, Any] = json.loads(ref.read_text(encoding="utf-8"))
-    return data
+def _bundle() -> _Bundle:
+    ref = resources.files("skyquill.strokes").joinpath("data", "hanzi", "hanzi_medians.npz")
+    with resources.as_file(ref) as path, np.load(path) as data:
+        chars = "".join(map(chr, data["codepoints"].tolist()))
+        return _Bundle(
+            {c: i for i, c in enumerate(chars)},
+            data["first_stroke"],
+            data["first_point"],
+            data["units"],
+            float(data["scale"]),
+        )
 
 
 def bundled_hanzi() -> str:
-    """The characters bundled with skyquill, in bundle order, as one string."""
-    return "".join(_bundle())
+    """Every character shipped with skyquill (9,574), by code point, as one string."""
+    return "".join(_bundle().index)
+
+
+def missing_hanzi(text: str) -> str:
+    """The characters of ``text`` (spaces aside) not shipped with skyquill, each once."""
+    index = _bundle().index
+    return "".join(dict.fromkeys(c for c in text if not c.isspace() and c not in index))
 
 
 def _medians_in(entry: Any, char: str, where: str) -> Any:
@@ -95,7 +142,7 @@ def hanzi_strokes(char: str, source: str | Path | None = None) -> Strokes:
 
     Lookup order: ``source`` alone if given; otherwise the directory named by the
     environment variable ``SKYQUILL_HANZI_DIR`` (if set) and then the bundled set
-    (:func:`bundled_hanzi`: 57 common characters, among them 永 光 成 一 马 当 先).
+    (:func:`bundled_hanzi`: all 9,574 characters of hanzi-writer-data 2.0.1).
 
     Parameters
     ----------
@@ -138,12 +185,13 @@ def hanzi_strokes(char: str, source: str | Path | None = None) -> Strokes:
             looked.append(f"{place} (${HANZI_DIR_ENV})")
             where = str(place)
         if medians is None:
-            medians = _bundle().get(char)
-            looked.append(f"the bundled set of {len(_bundle())} characters")
+            medians = _bundle().medians(char)
+            looked.append(f"the {len(_bundle().index):,} characters of hanzi-writer-data 2.0.1")
             where = "bundled hanzi data"
     if medians is None:
         raise InputError(
-            f"char: {char!r} (U+{ord(char):04X}) not found; looked in {'; '.join(looked)}"
+            f"char: {char!r} (U+{ord(char):04X}) not found; looked in {'; '.join(looked)}; "
+            + ALTERNATIVES
         )
     if not isinstance(medians, list):
         raise InputError(
