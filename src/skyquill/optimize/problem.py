@@ -14,6 +14,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 import scipy.optimize
@@ -78,11 +79,15 @@ class PointDeviation:
             gain = as_array("points.accel_gain", self.accel_gain, shape=(p.shape[1],))
             object.__setattr__(self, "accel_gain", None if not np.any(gain) else gain)
 
-    def axis_groups(self) -> list[tuple[FloatArray, float]]:
-        """The axes that share a gain: ``[(mask (d,), gain), ...]``, one group if all do."""
+    @cached_property
+    def _groups(self) -> tuple[tuple[FloatArray, float], ...]:
         d = self.points.shape[1]
         gain = np.zeros(d) if self.accel_gain is None else self.accel_gain
-        return [(np.asarray(gain == g, dtype=float), float(g)) for g in np.unique(gain)]
+        return tuple((np.asarray(gain == g, dtype=float), float(g)) for g in np.unique(gain))
+
+    def axis_groups(self) -> list[tuple[FloatArray, float]]:
+        """The axes that share a gain: ``[(mask (d,), gain), ...]``, one group if all do."""
+        return list(self._groups)  # assembly, cost and gradient ask for it on every solve
 
 
 @dataclass(frozen=True)
