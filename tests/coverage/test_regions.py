@@ -116,7 +116,9 @@ def test_overlapping_fields_are_refused() -> None:
 
 
 def test_a_swath_wider_than_one_field_is_named() -> None:
-    two = load_region("MULTIPOLYGON (((0 0, 10 0, 10 10, 0 10, 0 0)), ((20 0, 21 0, 21 9, 20 9, 20 0)))")
+    two = load_region(
+        "MULTIPOLYGON (((0 0, 10 0, 10 10, 0 10, 0 0)), ((20 0, 21 0, 21 9, 20 9, 20 0)))"
+    )
     with pytest.raises(InputError, match="width: got 2 m, expected less than the field 2's inner"):
         check_width(two, 2.0)
 

@@ -10,10 +10,10 @@ a disc of the coverage diameter (issue 5's metric).
 
 from __future__ import annotations
 
-from pathlib import Path
 import itertools
 from collections.abc import Sequence
-from typing import Any
+from pathlib import Path
+from typing import Any, TypeAlias
 
 import numpy as np
 import shapely
@@ -32,7 +32,7 @@ MAX_BYTES = 16 * 2**20
 MAX_VERTICES = 10_000
 _WHAT = "a GeoJSON Polygon or MultiPolygon in 2-D local metres"
 #: A region: one field (with or without holes) or several fields flown in one mission.
-Region = Polygon | MultiPolygon
+Region: TypeAlias = Polygon | MultiPolygon
 
 
 def region_from_vertices(
@@ -69,7 +69,9 @@ def holes(region: Region) -> list[Polygon]:
 
 def has_keepouts(region: Region) -> bool:
     """Whether ``region`` needs the mission planner: holes, or several fields."""
-    return isinstance(region, MultiPolygon) or bool(region.interiors)
+    if isinstance(region, MultiPolygon):
+        return True
+    return isinstance(region, Polygon) and bool(region.interiors)
 
 
 def load_region(source: str | Path) -> Region:
@@ -231,7 +233,9 @@ def _checked_fields(region: MultiPolygon, name: str) -> Region:
                 f"{name}: got fields {a + 1} and {b + 1} overlapping or touching, expected "
                 "separate fields (merge touching fields into one polygon)"
             )
-    return parts[0] if len(parts) == 1 else MultiPolygon(parts)
+    if len(parts) == 1:
+        return parts[0]
+    return MultiPolygon(parts)
 
 
 def _checked_polygon(polygon: Polygon, name: str) -> Polygon:
