@@ -31,7 +31,7 @@ from skyquill.coverage.deadline import Deadline
 from skyquill.coverage.holes import hole_free_pieces
 from skyquill.coverage.keepout import KeepoutCheck, check_keepout
 from skyquill.coverage.part_order import _EXACT_ORDER, _exact_order, _greedy_order
-from skyquill.coverage.partition import _spine
+from skyquill.coverage.partition import _spine, convex_parts
 from skyquill.coverage.regions import Region, fields, holes, swept
 from skyquill.coverage.transit import transit_route
 from skyquill.errors import InfeasibleError
@@ -124,6 +124,7 @@ def fly_mission(
     altitude: float,
     deadline: Deadline,
     plan_piece: PiecePlanner,
+    convex: bool = False,
 ) -> Mission:
     """Plan every piece of ``region``, order and join them, gate the spray, check the holes.
 
@@ -142,6 +143,12 @@ def fly_mission(
         The plan's budget; checked between pieces.
     plan_piece
         Plans one hole-free piece.
+    convex
+        Split the pieces further into convex parts
+        (:func:`~skyquill.coverage.partition.convex_parts`), each planned on
+        its own: for spirals, whose joined multi-spiral over a concave piece
+        is often too tight to time and then flown part by part anyway, after
+        a long search (a notched half-square: 19 s against 2 s).
 
     Raises
     ------
@@ -151,7 +158,10 @@ def fly_mission(
     """
     keepouts = holes(region)
     flown = []
-    for k, piece in enumerate(hole_free_pieces(region, width)):
+    pieces = hole_free_pieces(region, width)
+    if convex:
+        pieces = [part for piece in pieces for part in _convex(piece, width)]
+    for k, piece in enumerate(pieces):
         deadline.check(f"piece {k + 1} of the region")
         one = _fly_piece(
             piece, width, legs=legs, altitude=altitude, deadline=deadline, plan_piece=plan_piece
@@ -216,6 +226,13 @@ def _fly_piece(
         return None  # no room to fly: its area is reported as missed
     lifted = np.column_stack([spine, np.full(len(spine), altitude)])
     return _Piece(stop_and_go(lifted, legs).trajectory, spine)
+
+
+def _convex(piece: Polygon, width: float) -> list[Polygon]:
+    """``piece``'s convex parts; itself when the swath does not fit (flown along its spine)."""
+    if piece.buffer(-0.5 * width).is_empty:
+        return [piece]
+    return convex_parts(piece, width)
 
 
 def _order(flown: list[_Piece], keepouts: list[Polygon], clearance: float) -> list[int]:

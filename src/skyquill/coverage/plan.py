@@ -20,6 +20,7 @@ off on the transits between them (:mod:`skyquill.coverage.mission`).
 from __future__ import annotations
 
 import itertools
+import logging
 import math
 import time
 from collections.abc import Callable
@@ -68,6 +69,7 @@ from skyquill.validation import as_float, as_int
 from skyquill.verify import Verification, verify
 
 FloatArray = NDArray[np.float64]
+_log = logging.getLogger(__name__)
 Pattern = Literal["spiral", "zigzag", "zigzag-stop"]
 PATTERNS: tuple[Pattern, ...] = ("spiral", "zigzag", "zigzag-stop")
 CONTOUR_MODES: tuple[ContourMode, ...] = ("offset", "homothetic")
@@ -636,9 +638,17 @@ def _plan_mission(
     """The mission over ``region``'s hole-free pieces, each planned by ``plan_piece``."""
     start = time.perf_counter()
     legs = LegLimits(opts.vmax, opts.amax, opts.jmax, per_axis=opts.per_axis)
-    flight = _flight_of(plan_piece)
+    flight = _flight_of(
+        plan_piece if opts.pattern != "spiral" else _spiral_or_zigzag(plan_piece, opts)
+    )
     mission = fly_mission(
-        region, opts.width, legs=legs, altitude=opts.altitude, deadline=deadline, plan_piece=flight
+        region,
+        opts.width,
+        legs=legs,
+        altitude=opts.altitude,
+        deadline=deadline,
+        plan_piece=flight,
+        convex=opts.pattern == "spiral",
     )
     deadline.check("the dense check")
     check = verify(mission.trajectory, coverage_limits(opts), guaranteed=False)
@@ -661,6 +671,33 @@ def _plan_mission(
         missed=missed_area(region, mission.swept),
         mission=mission,
     )
+
+
+#: Share of the remaining budget a spiral piece of a mission may spend before it is zigzagged.
+SPIRAL_SHARE = 0.25
+
+
+def _spiral_or_zigzag(
+    plan_piece: Callable[[Polygon, Deadline], CoveragePlan], opts: CoverageOptions
+) -> Callable[[Polygon, Deadline], CoveragePlan]:
+    """``plan_piece``, but a piece whose spiral takes over :data:`SPIRAL_SHARE` of the
+    remaining budget (or cannot be timed) is zigzagged instead.
+
+    The speed LP of some convex parts stalls (a pentagon of 114 m² next to a
+    round hole: no plan in 60 s, its mirror image in 3 s); one such part must
+    not spend the whole mission's budget.
+    """
+
+    def plan(piece: Polygon, deadline: Deadline) -> CoveragePlan:
+        share = Deadline(SPIRAL_SHARE * deadline.remaining())
+        try:
+            return plan_piece(piece, share)
+        except InfeasibleError as exc:
+            deadline.check("a zigzag for a piece whose spiral failed")
+            _log.warning("piece of %.3g m²: spiral failed (%s), zigzag instead", piece.area, exc)
+            return _plan(piece, replace(opts, pattern="zigzag"), deadline)
+
+    return plan
 
 
 def _flight_of(plan_piece: Callable[[Polygon, Deadline], CoveragePlan]) -> PiecePlanner:

@@ -277,7 +277,11 @@ def _check_rings(polygon: Polygon, name: str) -> None:
                 "a simple ring"
             )
         if not shell.contains(hole):
-            where = "crossing or outside" if not shell.covers(hole) else "touching"
+            where = (
+                "touching"
+                if shell.covers(hole)
+                else ("outside" if shell.disjoint(hole) else "crossing")
+            )
             raise InputError(
                 f"{name}: got a hole {where} the shell (hole {k}), expected holes inside it"
             )

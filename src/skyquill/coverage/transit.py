@@ -63,35 +63,38 @@ def transit_route(
 
 def _graph_geometry(
     holes: Sequence[Polygon], clearance: float
-) -> tuple[list[FloatArray], list[Polygon]]:
-    """The graph's corner points (each grown hull's vertices) and the polygons that block legs."""
+) -> tuple[list[FloatArray], list[tuple[Polygon, Polygon]]]:
+    """The graph's corner points (each grown hull's vertices) and, per hole, the polygon
+    that blocks legs and the hull itself."""
     corners: list[FloatArray] = []
-    blocks: list[Polygon] = []
+    blocks: list[tuple[Polygon, Polygon]] = []
     for hole in holes:
         grown = planning_obstacle(hole, 0.0).buffer(clearance, join_style="mitre")
         corners.append(np.asarray(grown.exterior.coords, dtype=np.float64)[:-1])
-        blocks.append(hole.convex_hull.buffer(_BLOCK_FRACTION * clearance))
+        hull = hole.convex_hull
+        blocks.append((hull.buffer(_BLOCK_FRACTION * clearance), hull))
     if corners:
-        points = np.vstack(corners)
+        points = shapely.points(np.vstack(corners))
         # A corner inside another hole's block is no way round.
-        free = ~np.any([shapely.intersects(shapely.points(points), b) for b in blocks], axis=0)
-        corners = [points[free]]
+        inside = np.any([shapely.intersects(points, b) for b, _ in blocks], axis=0)
+        corners = [np.vstack(corners)[~inside]]
     return corners, blocks
 
 
-def _visible_lengths(nodes: FloatArray, blocks: Sequence[Polygon]) -> FloatArray:
+def _visible_lengths(nodes: FloatArray, blocks: Sequence[tuple[Polygon, Polygon]]) -> FloatArray:
     """Lengths of the legs between ``nodes`` (K, 2) that cross no block (0: no leg)."""
     k = len(nodes)
     pairs = np.array(list(itertools.combinations(range(k), 2)), dtype=np.intp)
     legs = shapely.linestrings(np.stack([nodes[pairs[:, 0]], nodes[pairs[:, 1]]], axis=1))
     blocked = np.zeros(len(pairs), dtype=bool)
-    for block in blocks:
+    for block, hull in blocks:
         hit = shapely.intersects(legs, block)
         # The ends of the transit may lie in a block (a piece ended near its
-        # hole): their legs are judged without that block.
-        own = np.array([block.contains(Point(nodes[e])) for e in (0, 1)])
-        for e in np.flatnonzero(own):
-            hit &= ~np.any(pairs == e, axis=1)
+        # hole): their legs only have to miss the hole's hull.
+        for e in (0, 1):
+            if block.contains(Point(nodes[e])):
+                mine = np.any(pairs == e, axis=1)
+                hit[mine] = shapely.intersects(legs[mine], hull)
         blocked |= hit
     weights = np.zeros((k, k))
     a, b = pairs[~blocked].T
