@@ -135,15 +135,17 @@ def test_a_swath_wider_than_a_field_is_named() -> None:
 
 @st.composite
 def _holed_regions(draw: st.DrawFn) -> Polygon:
-    """A random convex-ish shell (8-16 m) with 0-2 random holes (squares or discs)."""
-    n = draw(st.integers(4, 7))
-    angles = np.sort(draw(st.lists(st.floats(0, 2 * np.pi), min_size=n, max_size=n)))
-    radii = draw(st.lists(st.floats(5.0, 8.0), min_size=n, max_size=n))
+    """A random star-shaped shell (6-9 m from its centre) with 0-2 random holes (squares or
+    discs, some crossing the shell or each other: those must be refused by name)."""
+    n = draw(st.integers(5, 8))
+    jitter = draw(st.lists(st.floats(0.0, 0.8), min_size=n, max_size=n))
+    angles = (np.arange(n) + np.asarray(jitter)) * (2 * np.pi / n)
+    radii = np.asarray(draw(st.lists(st.floats(6.0, 9.0), min_size=n, max_size=n)))
     shell = np.column_stack([radii * np.cos(angles), radii * np.sin(angles)])
     rings = []
     for _ in range(draw(st.integers(0, 2))):
-        x, y = draw(st.floats(-4, 4)), draw(st.floats(-4, 4))
-        r = draw(st.floats(0.3, 2.0))
+        x, y = draw(st.floats(-3.5, 3.5)), draw(st.floats(-3.5, 3.5))
+        r = draw(st.floats(0.3, 1.5))
         if draw(st.booleans()):
             rings.append(_round(x, y, r))
         else:

@@ -51,8 +51,8 @@ def test_geojson_feature_wkt_and_vertices_agree(tmp_path: Path) -> None:
 @pytest.mark.parametrize(
     ("vertices", "message"),
     [
-        ([[0, 0], [1, 1], [0, 1], [1, 0]], "self-intersecting shell"),  # a bow tie
-        ([[0, 0], [1, 1], [2, 2]], "self-intersecting shell|zero area"),
+        ([[0, 0], [1, 1], [0, 1], [1, 0]], "self-intersecting or degenerate shell"),  # a bow tie
+        ([[0, 0], [1, 1], [2, 2]], "self-intersecting or degenerate shell|zero area"),
         ([[0, 0], [1, 0]], r"expected \(K >= 3, 2\)"),
         ([[0, 0], [np.nan, 0], [0, 1]], "NaN"),
         ([[0, 0], [1e9, 0], [0, 1]], "magnitude"),

@@ -33,7 +33,9 @@ class HoleClearance:
     Attributes
     ----------
     hole : int
-        Index of the hole (from 0, in :func:`~skyquill.coverage.regions.holes` order).
+        Index of the hole (from 0, in the order given to :func:`check_keepout`).
+    centroid : tuple of float
+        ``(x, y)`` of the hole's centroid, m (to tell the holes apart on a map).
     closest_m : float
         Smallest distance from the vehicle to the hole, m (0: it flew over it).
     closest_spraying_m : float or None
@@ -41,6 +43,7 @@ class HoleClearance:
     """
 
     hole: int
+    centroid: tuple[float, float]
     closest_m: float
     closest_spraying_m: float | None
 
@@ -72,6 +75,7 @@ class KeepoutCheck:
             "holes": [
                 {
                     "hole": h.hole,
+                    "centroid_m": list(h.centroid),
                     "closest_m": h.closest_m,
                     "closest_spraying_m": h.closest_spraying_m,
                 }
@@ -120,7 +124,8 @@ def check_keepout(
     for k, hole in enumerate(holes):
         near = float(shapely.distance(flight, hole))
         spray = min((float(shapely.distance(g, hole)) for g in sprayed), default=None)
-        clearances.append(HoleClearance(k, near, spray))
+        centre = (float(hole.centroid.x), float(hole.centroid.y))
+        clearances.append(HoleClearance(k, centre, near, spray))
     passed = all(
         h.closest_m > 0.0
         and (h.closest_spraying_m is None or h.closest_spraying_m >= m * (1 - MARGIN_TOLERANCE))

@@ -266,7 +266,8 @@ def _check_rings(polygon: Polygon, name: str) -> None:
     if not shell.is_valid:
         reason = shapely.is_valid_reason(shell)
         raise InputError(
-            f"{name}: got a self-intersecting shell ({reason}), expected a simple boundary"
+            f"{name}: got a self-intersecting or degenerate shell ({reason}), expected a "
+            "simple boundary"
         )
     inner = [Polygon(ring) for ring in polygon.interiors]
     for k, hole in enumerate(inner, start=1):
