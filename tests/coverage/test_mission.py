@@ -170,3 +170,19 @@ def test_random_holed_regions_plan_or_are_refused_by_name(polygon: Polygon) -> N
     assert plan.planning_time <= limit + 2.0  # one step may overrun the budget
     if holes(region):
         _assert_safe(plan)
+
+
+def test_a_flight_that_sprays_into_a_hole_is_refused(monkeypatch: pytest.MonkeyPatch) -> None:
+    from skyquill.coverage import mission
+
+    gated = mission._gated
+
+    def spray_everywhere(*args: object, **kwargs: object) -> object:
+        path, spraying, pen = gated(*args, **kwargs)  # type: ignore[arg-type]
+        return path, np.ones_like(spraying), pen  # a planner that forgot to close the nozzle
+
+    monkeypatch.setattr(mission, "_gated", spray_everywhere)
+    region = region_from_vertices(SQUARE, holes=[_round(8, 8, 2.0)])
+    with pytest.raises(InfeasibleError, match="keepout: got a flight") as info:
+        plan_coverage(region, ZIGZAG)
+    assert info.value.families == ("keepout",)
