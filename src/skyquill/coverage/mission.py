@@ -24,7 +24,7 @@ from typing import Any
 import numpy as np
 import shapely
 from numpy.typing import NDArray
-from shapely.geometry import Polygon
+from shapely.geometry import LineString, Polygon
 from shapely.geometry.base import BaseGeometry
 
 from skyquill.coverage.deadline import Deadline
@@ -224,6 +224,8 @@ def _fly_piece(
     spine = _spine(piece, width)
     if len(spine) < 2 or _length(spine) <= 1e-6 * width:
         return None  # no room to fly: its area is reported as missed
+    if not piece.buffer(1e-9 * width).covers(LineString(spine)):
+        return None  # a thin bent piece (round a hole): its chord would cut across the hole
     lifted = np.column_stack([spine, np.full(len(spine), altitude)])
     return _Piece(stop_and_go(lifted, legs).trajectory, spine)
 
