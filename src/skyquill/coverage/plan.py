@@ -451,12 +451,11 @@ def _tuned(
     region: Region, options: CoverageOptions, goal: float, deadline: Deadline
 ) -> CoveragePlan:
     """:func:`plan_tuned` after its checks, within ``deadline``."""
-    if has_keepouts(region):
+    if has_keepouts(region) or not isinstance(region, Polygon):
         # Each hole-free piece is tuned to the goal on its own.
         return _plan_mission(
             region, options, deadline, lambda piece, dl: _tuned(piece, options, goal, dl)
         )
-    assert isinstance(region, Polygon)  # no keep-outs: one field
     deltas = (options.delta,) if options.pattern == "zigzag-stop" else TUNING_DELTAS
     laps = (False,) if options.pattern == "spiral" else (False, True)
     candidates: list[CoverageOptions] = []
@@ -587,10 +586,9 @@ def plan_coverage(
 
 def _plan(region: Region, opts: CoverageOptions, deadline: Deadline) -> CoveragePlan:
     """:func:`plan_coverage` within ``deadline``."""
-    if has_keepouts(region):
-        _check_region(region, opts)
+    if has_keepouts(region) or not isinstance(region, Polygon):
+        _check_region(region, opts)  # refuses what is no (Multi)Polygon
         return _plan_mission(region, opts, deadline, lambda piece, dl: _plan(piece, opts, dl))
-    assert isinstance(region, Polygon)  # no keep-outs: one field
     if opts.target is not None:
         _check_region(region, opts)
         return _for_target(_plan(region, replace(opts, target=None), deadline), opts, deadline)
