@@ -167,7 +167,7 @@ def test_random_holed_regions_plan_or_are_refused_by_name(polygon: Polygon) -> N
         return
     except SkyquillError:
         return
-    assert plan.planning_time <= limit + 2.0  # one step may overrun the budget
+    assert plan.planning_time <= limit + 4.0  # one step (an LP solve) may overrun the budget
     if holes(region):
         _assert_safe(plan)
 
