@@ -10,11 +10,15 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from shapely.geometry import MultiPolygon, Polygon
 
 from skyquill.coverage.regions import (
     MAX_VERTICES,
     check_width,
     coverage_fraction,
+    fields,
+    has_keepouts,
+    holes,
     load_region,
     region_from_vertices,
 )
@@ -47,8 +51,8 @@ def test_geojson_feature_wkt_and_vertices_agree(tmp_path: Path) -> None:
 @pytest.mark.parametrize(
     ("vertices", "message"),
     [
-        ([[0, 0], [1, 1], [0, 1], [1, 0]], "invalid polygon"),  # a bow tie
-        ([[0, 0], [1, 1], [2, 2]], "invalid polygon|zero area"),
+        ([[0, 0], [1, 1], [0, 1], [1, 0]], "self-intersecting or degenerate shell"),  # a bow tie
+        ([[0, 0], [1, 1], [2, 2]], "self-intersecting or degenerate shell|zero area"),
         ([[0, 0], [1, 0]], r"expected \(K >= 3, 2\)"),
         ([[0, 0], [np.nan, 0], [0, 1]], "NaN"),
         ([[0, 0], [1e9, 0], [0, 1]], "magnitude"),
@@ -59,9 +63,67 @@ def test_bad_polygons_are_named(vertices: list[list[float]], message: str) -> No
         region_from_vertices(vertices)
 
 
-def test_holes_are_refused_not_ignored() -> None:
-    with pytest.raises(InputError, match=r"hole\(s\), expected none \(holes are not supported"):
-        load_region("POLYGON ((0 0, 10 0, 10 10, 0 10, 0 0), (4 4, 6 4, 6 6, 4 6, 4 4))")
+def test_holes_and_several_fields_are_read() -> None:
+    holed = load_region("POLYGON ((0 0, 10 0, 10 10, 0 10, 0 0), (4 4, 6 4, 6 6, 4 6, 4 4))")
+    assert isinstance(holed, Polygon)
+    assert holed.area == pytest.approx(96.0)
+    assert [h.area for h in holes(holed)] == [pytest.approx(4.0)]
+    two = load_region(
+        "MULTIPOLYGON (((0 0, 10 0, 10 10, 0 10, 0 0)), ((20 0, 30 0, 30 10, 20 10, 20 0)))"
+    )
+    assert isinstance(two, MultiPolygon)
+    assert len(fields(two)) == 2
+    assert has_keepouts(two) and has_keepouts(holed)
+    assert not has_keepouts(region_from_vertices(SQUARE))
+
+
+def test_geojson_multipolygon_with_a_hole(tmp_path: Path) -> None:
+    square = [[0, 0], [10, 0], [10, 10], [0, 10], [0, 0]]
+    hole = [[4, 4], [6, 4], [6, 6], [4, 6], [4, 4]]
+    other = [[20, 0], [30, 0], [30, 10], [20, 10], [20, 0]]
+    data = {"type": "MultiPolygon", "coordinates": [[square, hole], [other]]}
+    (tmp_path / "m.geojson").write_text(json.dumps(data))
+    region = load_region(tmp_path / "m.geojson")
+    assert region.area == pytest.approx(196.0)
+    assert len(holes(region)) == 1
+
+
+_SHELL = [[0, 0], [10, 0], [10, 10], [0, 10]]
+_INSIDE = [[4, 4], [6, 4], [6, 6], [4, 6]]
+
+
+@pytest.mark.parametrize(
+    ("hole_list", "message"),
+    [
+        (
+            [_INSIDE, [[20, 20], [22, 20], [22, 22]]],
+            r"got a hole outside the shell \(hole 2\), expected holes inside it",
+        ),
+        ([[[8, 8], [12, 8], [12, 12], [8, 12]]], r"got a hole crossing the shell \(hole 1\)"),
+        ([[[0, 4], [2, 4], [2, 6], [0, 6]]], r"hole touching the shell \(hole 1\)"),
+        ([_INSIDE, [[5, 5], [7, 5], [7, 7], [5, 7]]], "holes 1 and 2 overlapping"),
+        ([_INSIDE, [[6, 4], [7, 4], [7, 6]]], "holes 1 and 2 overlapping or touching"),
+        ([[[4, 4], [6, 6], [6, 4], [4, 6]]], r"self-intersecting or empty hole \(hole 1"),
+    ],
+)
+def test_bad_holes_are_named(hole_list: list[list[list[float]]], message: str) -> None:
+    with pytest.raises(InputError, match=message):
+        region_from_vertices(_SHELL, holes=hole_list)
+
+
+def test_overlapping_fields_are_refused() -> None:
+    with pytest.raises(InputError, match="fields 1 and 2 overlapping"):
+        load_region(
+            "MULTIPOLYGON (((0 0, 10 0, 10 10, 0 10, 0 0)), ((5 0, 15 0, 15 10, 5 10, 5 0)))"
+        )
+
+
+def test_a_swath_wider_than_one_field_is_named() -> None:
+    two = load_region(
+        "MULTIPOLYGON (((0 0, 10 0, 10 10, 0 10, 0 0)), ((20 0, 21 0, 21 9, 20 9, 20 0)))"
+    )
+    with pytest.raises(InputError, match="width: got 2 m, expected less than the field 2's inner"):
+        check_width(two, 2.0)
 
 
 @pytest.mark.parametrize(

@@ -33,7 +33,11 @@ BAR_AFTER_S = 1.0
 @app.command()
 def cover(
     region: Annotated[
-        Path, typer.Argument(help="Region: GeoJSON Polygon/Feature, or a .wkt file; metres.")
+        Path,
+        typer.Argument(
+            help="Region: GeoJSON (Multi)Polygon/Feature, or a .wkt file; metres; "
+            "holes are keep-out zones."
+        ),
     ],
     out: OutDir,
     width: Annotated[float, typer.Option(help="Coverage diameter (swath), m.")] = 2.0,
@@ -117,9 +121,10 @@ def cover(
                 plan = plan_coverage(shape, options, progress=bar.update)
             else:
                 plan = plan_tuned(shape, options, min_coverage, progress=bar.update)
-        # The spray is on along the whole path: every part of it covers.
+        # The spray is on along the whole path, or (holes, several fields) off on the
+        # transits and wherever the swath would reach into a hole.
         planned = PlannedTrajectory(
-            plan.trajectory, ((0.0, plan.duration),), coverage_limits(plan.options)
+            plan.trajectory, plan.pen_windows_s, coverage_limits(plan.options)
         )
         with (
             console.status("writing and checking the plan"),

@@ -5,7 +5,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-from shapely.geometry import Polygon
 from shapely.geometry.base import BaseGeometry
 
 #: Gaps listed in a :class:`Missed` (the largest first).
@@ -65,7 +64,7 @@ class Missed:
         }
 
 
-def missed_area(region: Polygon, swept: BaseGeometry) -> Missed:
+def missed_area(region: BaseGeometry, swept: BaseGeometry) -> Missed:
     """What of ``region`` lies outside ``swept`` (:func:`~skyquill.coverage.regions.swept`)."""
     rest = region.difference(swept)
     pieces = [p for p in getattr(rest, "geoms", [rest]) if not p.is_empty and p.area > 0.0]

@@ -12,19 +12,24 @@ Three patterns, compared on equal terms (paper ``001_61beb0e01a19013a`` §4):
 
 Concave regions are split into convex parts whose spirals (or zigzags) are
 joined into one path (:mod:`skyquill.coverage.joined`, the paper's Fig. 5).
+Regions with holes (keep-out zones) or of several fields are cut into
+hole-free pieces, each planned as above, flown in one mission with the spray
+off on the transits between them (:mod:`skyquill.coverage.mission`).
 """
 
 from __future__ import annotations
 
 import itertools
+import logging
 import math
 import time
+from collections.abc import Callable
 from dataclasses import asdict, dataclass, field, replace
 from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import NDArray
-from shapely.geometry import LineString, Polygon
+from shapely.geometry import LineString, MultiPolygon, Polygon
 
 from skyquill.coverage.deadline import (
     DEFAULT_TIME_LIMIT_S,
@@ -34,6 +39,7 @@ from skyquill.coverage.deadline import (
     is_time_limit,
 )
 from skyquill.coverage.missed import Missed, missed_area
+from skyquill.coverage.mission import Mission, PiecePlanner, fly_mission
 from skyquill.coverage.paths import (
     ContourMode,
     DriftMode,
@@ -45,9 +51,11 @@ from skyquill.coverage.paths import (
     zigzag,
 )
 from skyquill.coverage.regions import (
+    Region,
     check_width,
     coverage_fraction,
     estimate_path_length,
+    has_keepouts,
     swept,
 )
 from skyquill.coverage.speed import SpeedPlan, plan_speed
@@ -61,6 +69,7 @@ from skyquill.validation import as_float, as_int
 from skyquill.verify import Verification, verify
 
 FloatArray = NDArray[np.float64]
+_log = logging.getLogger(__name__)
 Pattern = Literal["spiral", "zigzag", "zigzag-stop"]
 PATTERNS: tuple[Pattern, ...] = ("spiral", "zigzag", "zigzag-stop")
 CONTOUR_MODES: tuple[ContourMode, ...] = ("offset", "homothetic")
@@ -260,10 +269,15 @@ class CoveragePlan:
         With a target: the coverage of the planned path before the re-fit.
     missed : Missed or None
         What ``path``'s swath misses of the region (area, share, the largest
-        gaps); None only for plans built by hand.
+        gaps; holes are not the region's); None only for plans built by hand.
+    mission : Mission or None
+        For a region with holes or several fields: the pieces' mission, with
+        where the spray is on and the keep-out check (``path`` is then the
+        whole flight, transits included, and ``coverage`` counts only what
+        is sprayed); None for a simple polygon (the spray is on throughout).
     """
 
-    region: Polygon
+    region: Region
     options: CoverageOptions
     waypoints: FloatArray
     path: FloatArray
@@ -275,6 +289,14 @@ class CoveragePlan:
     delivered: DeliveredPath | None = None
     planned_coverage: float | None = None
     missed: Missed | None = None
+    mission: Mission | None = None
+
+    @property
+    def pen_windows_s(self) -> tuple[tuple[float, float], ...]:
+        """When the spray is on, ``(start, end)`` in s: throughout, or the mission's windows."""
+        if self.mission is None:
+            return ((0.0, self.duration),)
+        return self.mission.pen_windows_s
 
     @property
     def duration(self) -> float:
@@ -303,6 +325,7 @@ class CoveragePlan:
             "planning_time_s": self.planning_time,
             "region_area_m2": float(self.region.area),
             **({} if self.missed is None else self.missed.summary()),
+            **({} if self.mission is None else self.mission.summary()),
             "options": asdict(self.options),
             "vehicle_limits": self.options.limits.as_dict(),
             "limits_held": "per axis"
@@ -385,7 +408,7 @@ def tune_coverage(
 
 
 def plan_tuned(
-    region: Polygon,
+    region: Region,
     options: CoverageOptions,
     target: float,
     *,
@@ -425,9 +448,14 @@ def plan_tuned(
 
 
 def _tuned(
-    region: Polygon, options: CoverageOptions, goal: float, deadline: Deadline
+    region: Region, options: CoverageOptions, goal: float, deadline: Deadline
 ) -> CoveragePlan:
     """:func:`plan_tuned` after its checks, within ``deadline``."""
+    if has_keepouts(region) or not isinstance(region, Polygon):
+        # Each hole-free piece is tuned to the goal on its own.
+        return _plan_mission(
+            region, options, deadline, lambda piece, dl: _tuned(piece, options, goal, dl)
+        )
     deltas = (options.delta,) if options.pattern == "zigzag-stop" else TUNING_DELTAS
     laps = (False,) if options.pattern == "spiral" else (False, True)
     candidates: list[CoverageOptions] = []
@@ -457,11 +485,13 @@ def _tuned(
     return min(plans, key=lambda plan: plan.duration)
 
 
-def _check_region(region: Polygon, options: CoverageOptions) -> None:
+def _check_region(region: Region, options: CoverageOptions) -> None:
     """Refuse a region too large, a path too long or a budget too short, before any path is
     built."""
-    if not isinstance(region, Polygon):
-        raise InputError(f"region: got {type(region).__name__}, expected a shapely Polygon")
+    if not isinstance(region, Polygon | MultiPolygon):
+        raise InputError(
+            f"region: got {type(region).__name__}, expected a shapely Polygon or MultiPolygon"
+        )
     minx, miny, maxx, maxy = region.bounds
     if max(maxx - minx, maxy - miny) > MAX_REGION_SIZE_M:
         raise InputError(
@@ -471,10 +501,16 @@ def _check_region(region: Polygon, options: CoverageOptions) -> None:
     check_width(region, options.width, options.epsilon)
     _check_budget(region, options)
     if options.target is not None:
+        if has_keepouts(region):
+            raise InputError(
+                "target: got an upload target for a region with holes or several fields, "
+                "expected none (the re-fit would not keep the spray off over the transits)"
+            )
+        assert isinstance(region, Polygon)  # no keep-outs: one field
         check_target_path(region, options.width, options.epsilon, options.target)
 
 
-def _check_budget(region: Polygon, options: CoverageOptions) -> None:
+def _check_budget(region: Region, options: CoverageOptions) -> None:
     """Refuse a time limit shorter than the estimated planning time (nothing is built)."""
     length = estimate_path_length(region, options.epsilon * options.width)
     need = PLANNING_S_PER_M * length
@@ -506,7 +542,7 @@ def _length(path: FloatArray) -> float:
 
 
 def plan_coverage(
-    region: Polygon,
+    region: Region,
     options: CoverageOptions | None = None,
     *,
     progress: Progress | None = None,
@@ -517,7 +553,9 @@ def plan_coverage(
     ----------
     region
         The region (shapely Polygon, m), e.g. from
-        :func:`~skyquill.coverage.regions.load_region`.
+        :func:`~skyquill.coverage.regions.load_region`; with holes, or a
+        MultiPolygon of several fields: flown as one mission of hole-free
+        pieces (see :mod:`skyquill.coverage.mission`).
     options
         :class:`CoverageOptions` (defaults: the paper's §4 limits, spiral).
     progress
@@ -538,14 +576,19 @@ def plan_coverage(
         :data:`~skyquill.optimize.budget.MAX_UPLOADS` (a path estimated longer
         than :data:`~skyquill.coverage.target.MAX_TARGET_PATH_M` is an
         :class:`InputError` before any work). The time limit is spent
-        (family ``"time_limit"``, the message names the step).
+        (family ``"time_limit"``, the message names the step). A region
+        with holes whose flight comes closer to a hole than allowed (family
+        ``"keepout"``; never returned).
     """
     opts = options or CoverageOptions()
     return _plan(region, opts, Deadline(opts.time_limit, progress))
 
 
-def _plan(region: Polygon, opts: CoverageOptions, deadline: Deadline) -> CoveragePlan:
+def _plan(region: Region, opts: CoverageOptions, deadline: Deadline) -> CoveragePlan:
     """:func:`plan_coverage` within ``deadline``."""
+    if has_keepouts(region) or not isinstance(region, Polygon):
+        _check_region(region, opts)  # refuses what is no (Multi)Polygon
+        return _plan_mission(region, opts, deadline, lambda piece, dl: _plan(piece, opts, dl))
     if opts.target is not None:
         _check_region(region, opts)
         return _for_target(_plan(region, replace(opts, target=None), deadline), opts, deadline)
@@ -582,6 +625,87 @@ def _plan(region: Polygon, opts: CoverageOptions, deadline: Deadline) -> Coverag
         speed_plan=speed_plan,
         missed=missed,
     )
+
+
+def _plan_mission(
+    region: Region,
+    opts: CoverageOptions,
+    deadline: Deadline,
+    plan_piece: Callable[[Polygon, Deadline], CoveragePlan],
+) -> CoveragePlan:
+    """The mission over ``region``'s hole-free pieces, each planned by ``plan_piece``."""
+    start = time.perf_counter()
+    legs = LegLimits(opts.vmax, opts.amax, opts.jmax, per_axis=opts.per_axis)
+    flight = _flight_of(
+        plan_piece if opts.pattern != "spiral" else _spiral_or_zigzag(plan_piece, opts)
+    )
+    mission = fly_mission(
+        region,
+        opts.width,
+        legs=legs,
+        altitude=opts.altitude,
+        deadline=deadline,
+        plan_piece=flight,
+        convex=opts.pattern == "spiral",
+    )
+    deadline.check("the dense check")
+    check = verify(mission.trajectory, coverage_limits(opts), guaranteed=False)
+    if check.max_excess > MAX_EXCESS:
+        raise InfeasibleError(
+            f"pattern {opts.pattern!r}: got a mission {100 * check.max_excess:.1f} % over the "
+            f"limits, expected at most {100 * MAX_EXCESS:g} %",
+            ("speed_lp",),
+        )
+    return CoveragePlan(
+        region=region,
+        options=opts,
+        waypoints=mission.waypoints,
+        path=mission.path,
+        trajectory=mission.trajectory,
+        coverage=mission.coverage,
+        limits=limits_report(check) | {"joins": "stop"},
+        planning_time=time.perf_counter() - start,
+        speed_plan=None,
+        missed=missed_area(region, mission.swept),
+        mission=mission,
+    )
+
+
+#: Share of the remaining budget a spiral piece of a mission may spend before it is zigzagged.
+SPIRAL_SHARE = 0.25
+
+
+def _spiral_or_zigzag(
+    plan_piece: Callable[[Polygon, Deadline], CoveragePlan], opts: CoverageOptions
+) -> Callable[[Polygon, Deadline], CoveragePlan]:
+    """``plan_piece``, but a piece whose spiral takes over :data:`SPIRAL_SHARE` of the
+    remaining budget (or cannot be timed) is zigzagged instead.
+
+    The speed LP of some convex parts stalls (a pentagon of 114 m² next to a
+    round hole: no plan in 60 s, its mirror image in 3 s); one such part must
+    not spend the whole mission's budget.
+    """
+
+    def plan(piece: Polygon, deadline: Deadline) -> CoveragePlan:
+        share = Deadline(SPIRAL_SHARE * deadline.remaining())
+        try:
+            return plan_piece(piece, share)
+        except InfeasibleError as exc:
+            deadline.check("a zigzag for a piece whose spiral failed")
+            _log.warning("piece of %.3g m²: spiral failed (%s), zigzag instead", piece.area, exc)
+            return _plan(piece, replace(opts, pattern="zigzag"), deadline)
+
+    return plan
+
+
+def _flight_of(plan_piece: Callable[[Polygon, Deadline], CoveragePlan]) -> PiecePlanner:
+    """A piece planner for :func:`fly_mission`: the plan's trajectory and waypoints."""
+
+    def flight(piece: Polygon, deadline: Deadline) -> tuple[Trajectory, FloatArray]:
+        plan = plan_piece(piece, deadline)
+        return plan.trajectory, plan.waypoints
+
+    return flight
 
 
 def _measured(region: Polygon, path: FloatArray, width: float) -> tuple[float, Missed]:

@@ -1,19 +1,23 @@
-"""Regions to cover: GeoJSON Polygon, WKT or a vertex list, in local metric coordinates.
+"""Regions to cover: GeoJSON (Multi)Polygon, WKT or a vertex list, in local metric coordinates.
 
-A region is a shapely ``Polygon`` that is valid (no self-intersection), has
-positive area and no holes (holes are not supported yet: said, not ignored).
+A region is a shapely ``Polygon`` or ``MultiPolygon`` (several fields flown in
+one mission) that is valid: shells that do not cross themselves, holes
+(keep-out zones: trees, buildings, poles) strictly inside their shell and
+apart from each other, fields apart from each other, positive area.
 :func:`coverage_fraction` measures how much of it a covering path sweeps with
 a disc of the coverage diameter (issue 5's metric).
 """
 
 from __future__ import annotations
 
+import itertools
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeAlias
 
 import numpy as np
 import shapely
-from shapely.geometry import LineString, Polygon, shape
+from shapely.geometry import LineString, MultiPolygon, Polygon, shape
 from shapely.geometry.base import BaseGeometry
 
 from skyquill.errors import InputError
@@ -26,21 +30,51 @@ MAX_COORDINATE_M = 1e5
 MAX_BYTES = 16 * 2**20
 #: Most boundary vertices accepted: a field traced at 1 m over a 10 km boundary.
 MAX_VERTICES = 10_000
-_WHAT = "a GeoJSON Polygon in 2-D local metres"
+_WHAT = "a GeoJSON Polygon or MultiPolygon in 2-D local metres"
+#: A region: one field (with or without holes) or several fields flown in one mission.
+Region: TypeAlias = Polygon | MultiPolygon
 
 
-def region_from_vertices(vertices: Any, name: str = "vertices") -> Polygon:
-    """A region from its boundary vertices (K, 2), m, in order; closing is optional."""
+def region_from_vertices(
+    vertices: Any, name: str = "vertices", *, holes: Sequence[Any] = ()
+) -> Polygon:
+    """A region from its boundary vertices (K, 2), m, in order; closing is optional.
+
+    ``holes`` are keep-out rings ``(K_i, 2)``, m, each strictly inside the shell.
+    """
+    rings = [_ring(name, vertices)]
+    rings += [_ring(f"holes[{i}]", hole) for i, hole in enumerate(holes)]
+    return _checked_polygon(Polygon(rings[0], rings[1:]), name)
+
+
+def _ring(name: str, vertices: Any) -> FloatArray:
     pts = as_array(name, vertices, ndim=2, max_abs=MAX_COORDINATE_M)
     if pts.shape[1] != 2 or pts.shape[0] < 3:
         raise InputError(
             f"{name}: got shape {pts.shape}, expected (K >= 3, 2) boundary vertices "
             "in 2-D local metres"
         )
-    return _checked(Polygon(pts), name)
+    return pts
 
 
-def load_region(source: str | Path) -> Polygon:
+def fields(region: Region) -> list[Polygon]:
+    """The fields of a region: the polygon itself, or a MultiPolygon's parts."""
+    return list(region.geoms) if isinstance(region, MultiPolygon) else [region]
+
+
+def holes(region: Region) -> list[Polygon]:
+    """The keep-out zones (holes) of every field, as polygons (m), in field order."""
+    return [Polygon(ring) for field in fields(region) for ring in field.interiors]
+
+
+def has_keepouts(region: Region) -> bool:
+    """Whether ``region`` needs the mission planner: holes, or several fields."""
+    if isinstance(region, MultiPolygon):
+        return True
+    return isinstance(region, Polygon) and bool(region.interiors)
+
+
+def load_region(source: str | Path) -> Region:
     """Read a region: a ``.geojson``/``.json`` file (Polygon, Feature or one-feature
     FeatureCollection), a ``.wkt`` file, or a WKT string.
 
@@ -55,7 +89,7 @@ def load_region(source: str | Path) -> Polygon:
         Naming the file (or ``region``) and what is wrong.
     """
     text = str(source)
-    if text.lstrip().upper().startswith("POLYGON"):
+    if text.lstrip().upper().startswith(("POLYGON", "MULTIPOLYGON")):
         return _from_wkt(text, "region")
     path = Path(text)
     try:
@@ -78,27 +112,25 @@ def load_region(source: str | Path) -> Polygon:
     return _from_geojson(parse_json(raw, path.name, _WHAT), path.name)
 
 
-def _from_wkt(text: str, name: str) -> Polygon:
+def _from_wkt(text: str, name: str) -> Region:
     try:
         geometry = shapely.from_wkt(text.strip())
     except shapely.errors.GEOSException as exc:
         raise InputError(f"{name}: got unreadable WKT ({exc}), expected a POLYGON") from None
-    if not isinstance(geometry, Polygon):
-        raise InputError(f"{name}: got a {geometry.geom_type}, expected a Polygon")
+    if not isinstance(geometry, Polygon | MultiPolygon):
+        raise InputError(f"{name}: got a {geometry.geom_type}, expected a Polygon or MultiPolygon")
     if geometry.has_z or getattr(geometry, "has_m", False):
         raise InputError(
             f"{name}: got a POLYGON with a third coordinate (Z or M), expected 2-D local "
             "metres (x y)"
         )
-    if len(geometry.exterior.coords) > MAX_VERTICES:
-        raise InputError(
-            f"{name}: got {len(geometry.exterior.coords):,} vertices, expected at most "
-            f"{MAX_VERTICES:,}"
-        )
+    count = int(shapely.get_num_coordinates(geometry))
+    if count > MAX_VERTICES:
+        raise InputError(f"{name}: got {count:,} vertices, expected at most {MAX_VERTICES:,}")
     return _checked(geometry, name)
 
 
-def _from_geojson(data: Any, name: str) -> Polygon:
+def _from_geojson(data: Any, name: str) -> Region:
     check_depth(data, name, _WHAT)
     if isinstance(data, dict) and data.get("type") == "FeatureCollection":
         features = data.get("features")
@@ -108,16 +140,39 @@ def _from_geojson(data: Any, name: str) -> Polygon:
         data = features[0]
     if isinstance(data, dict) and data.get("type") == "Feature":
         data = data.get("geometry")
-    if not isinstance(data, dict) or data.get("type") != "Polygon":
+    if not isinstance(data, dict) or data.get("type") not in ("Polygon", "MultiPolygon"):
         kind = data.get("type") if isinstance(data, dict) else type(data).__name__
-        raise InputError(f"{name}: got GeoJSON of type {str(kind)[:40]!r}, expected a Polygon")
-    _check_coordinates(data.get("coordinates"), name)
+        raise InputError(
+            f"{name}: got GeoJSON of type {str(kind)[:40]!r}, expected a Polygon or MultiPolygon"
+        )
+    if data["type"] == "Polygon":
+        _check_coordinates(data.get("coordinates"), name)
+    else:
+        _check_multi_coordinates(data.get("coordinates"), name)
     try:
         geometry = shape(data)
     except (ValueError, TypeError, IndexError, shapely.errors.GEOSException) as exc:
-        raise InputError(f"{name}: got malformed Polygon coordinates ({exc})") from None
-    assert isinstance(geometry, Polygon)
+        raise InputError(f"{name}: got malformed {data['type']} coordinates ({exc})") from None
+    assert isinstance(geometry, Polygon | MultiPolygon)
     return _checked(geometry, name)
+
+
+def _check_multi_coordinates(polygons: Any, name: str) -> None:
+    """Refuse MultiPolygon coordinates that are not lists of Polygon coordinates."""
+    if not isinstance(polygons, list) or not polygons:
+        raise InputError(
+            f"{name}: coordinates: got {repr(polygons)[:40]}, expected a list of polygons "
+            "[[[[x, y], ...], ...], ...]"
+        )
+    count = 0
+    for p, rings in enumerate(polygons):
+        _check_coordinates(rings, f"{name}: polygon {p + 1}")
+        count += sum(len(ring) for ring in rings)
+        if count > MAX_VERTICES:
+            raise InputError(
+                f"{name}: coordinates: got more than {MAX_VERTICES:,} vertices, expected at most "
+                f"{MAX_VERTICES:,}"
+            )
 
 
 def _check_coordinates(rings: Any, name: str) -> None:
@@ -162,25 +217,86 @@ def _check_position(position: Any, where: str) -> None:
         )
 
 
-def _checked(polygon: Polygon, name: str) -> Polygon:
-    coords = np.asarray(polygon.exterior.coords)
+def _checked(region: Region, name: str) -> Region:
+    """``region`` normalised, or an InputError naming what is wrong with it."""
+    if isinstance(region, MultiPolygon):
+        return _checked_fields(region, name)
+    return _checked_polygon(region, name)
+
+
+def _checked_fields(region: MultiPolygon, name: str) -> Region:
+    """Each field checked on its own; fields must be apart (an overlap would be flown twice)."""
+    parts = [_checked_polygon(p, f"{name}: field {k + 1}") for k, p in enumerate(region.geoms)]
+    for a, b in itertools.combinations(range(len(parts)), 2):
+        if parts[a].intersects(parts[b]):
+            raise InputError(
+                f"{name}: got fields {a + 1} and {b + 1} overlapping or touching, expected "
+                "separate fields (merge touching fields into one polygon)"
+            )
+    if len(parts) == 1:
+        return parts[0]
+    return MultiPolygon(parts)
+
+
+def _checked_polygon(polygon: Polygon, name: str) -> Polygon:
+    coords = shapely.get_coordinates(polygon)
     if not np.all(np.isfinite(coords)) or (coords.size and np.abs(coords).max() > MAX_COORDINATE_M):
         raise InputError(
             f"{name}: got non-finite or huge coordinates, expected finite metres within "
             f"±{MAX_COORDINATE_M:g}"
         )
-    if polygon.interiors:
-        raise InputError(
-            f"{name}: got a polygon with {len(polygon.interiors)} hole(s), expected none "
-            "(holes are not supported yet)"
-        )
+    _check_rings(polygon, name)
     if not polygon.is_valid:
         reason = shapely.is_valid_reason(polygon)
         raise InputError(f"{name}: got an invalid polygon ({reason}), expected a simple one")
     if polygon.area <= 0.0:
         raise InputError(f"{name}: got a polygon of zero area, expected a region")
-    _check_spikes(coords[:-1, :2], name)
+    for ring in (polygon.exterior, *polygon.interiors):
+        _check_spikes(np.asarray(ring.coords)[:-1, :2], name)
     return shapely.normalize(polygon)
+
+
+def _check_rings(polygon: Polygon, name: str) -> None:
+    """Name the ring at fault: a crossing shell, a hole outside it, holes that meet.
+
+    GEOS's own reason ("Self-intersection at ...") does not say which ring;
+    holes are numbered from 1 in input order.
+    """
+    shell = Polygon(polygon.exterior)
+    if not shell.is_valid:
+        reason = shapely.is_valid_reason(shell)
+        raise InputError(
+            f"{name}: got a self-intersecting or degenerate shell ({reason}), expected a "
+            "simple boundary"
+        )
+    inner = [Polygon(ring) for ring in polygon.interiors]
+    for k, hole in enumerate(inner, start=1):
+        if not hole.is_valid or hole.area <= 0.0:
+            reason = shapely.is_valid_reason(hole)
+            raise InputError(
+                f"{name}: got a self-intersecting or empty hole (hole {k}: {reason}), expected "
+                "a simple ring"
+            )
+        if not shell.contains(hole):
+            where = (
+                "touching"
+                if shell.covers(hole)
+                else ("outside" if shell.disjoint(hole) else "crossing")
+            )
+            raise InputError(
+                f"{name}: got a hole {where} the shell (hole {k}), expected holes inside it"
+            )
+        if hole.boundary.intersects(shell.boundary):
+            raise InputError(
+                f"{name}: got a hole touching the shell (hole {k}), expected holes strictly "
+                "inside it (merge the hole into the boundary)"
+            )
+    for a, b in itertools.combinations(range(len(inner)), 2):
+        if inner[a].intersects(inner[b]):
+            raise InputError(
+                f"{name}: got holes {a + 1} and {b + 1} overlapping or touching, expected "
+                "separate holes (merge them into one)"
+            )
 
 
 #: Smallest interior angle accepted, rad: below it a vertex is a zero-width spike.
@@ -218,17 +334,18 @@ def _check_spikes(ring: FloatArray, name: str) -> None:
 MAX_PATH_LENGTH_M = 25_000.0
 
 
-def estimate_path_length(region: Polygon, spacing: float) -> float:
+def estimate_path_length(region: Region, spacing: float) -> float:
     """About how long a path with lines ``spacing`` m apart covering ``region`` is, m.
 
     Area over spacing (the sweeps or rings) plus the perimeter (turns, laps):
     an over-estimate of the planned spiral and zigzag lengths (by ~9 % on a
     100 m square at a 2 m swath, ~2x on a 10 m one, where the perimeter term dominates).
+    The perimeter counts every ring: holes are flown around.
     """
-    return float(region.area / spacing + region.exterior.length)
+    return float(region.area / spacing + region.length)
 
 
-def check_width(region: Polygon, width: float, epsilon: float = 1.0) -> float:
+def check_width(region: Region, width: float, epsilon: float = 1.0) -> float:
     """The coverage diameter ``width`` (m), > 0, small enough to need a path at all
     and large enough for a path of at most :data:`MAX_PATH_LENGTH_M` at a spacing
     of ``epsilon * width`` (checked first, from the area: nothing is built)."""
@@ -241,18 +358,20 @@ def check_width(region: Polygon, width: float, epsilon: float = 1.0) -> float:
             f"{length / 1e3:.4g} km, expected at most {MAX_PATH_LENGTH_M / 1e3:g} km "
             f"({what_fits(region, epsilon)})"
         )
-    if region.buffer(-0.5 * w).is_empty:
-        minx, miny, maxx, maxy = region.bounds
-        raise InputError(
-            f"width: got {w:g} m, expected less than the region's inner width (bounds "
-            f"{maxx - minx:.3g} x {maxy - miny:.3g} m): one disc would already cover it"
-        )
+    for k, field in enumerate(fields(region)):
+        if field.buffer(-0.5 * w).is_empty:
+            minx, miny, maxx, maxy = field.bounds
+            which = "region" if isinstance(region, Polygon) else f"field {k + 1}"
+            raise InputError(
+                f"width: got {w:g} m, expected less than the {which}'s inner width (bounds "
+                f"{maxx - minx:.3g} x {maxy - miny:.3g} m): one disc would already cover it"
+            )
     return w
 
 
-def what_fits(region: Polygon, epsilon: float, budget_m: float = MAX_PATH_LENGTH_M) -> str:
+def what_fits(region: Region, epsilon: float, budget_m: float = MAX_PATH_LENGTH_M) -> str:
     """Which swath would fit a path of ``budget_m`` metres, or that the region must be split."""
-    room = budget_m - region.exterior.length
+    room = budget_m - region.length
     if room <= 0.0:
         return "the perimeter alone is too long: split the region into several missions"
     least = region.area / (epsilon * room)
@@ -263,7 +382,7 @@ def what_fits(region: Polygon, epsilon: float, budget_m: float = MAX_PATH_LENGTH
 SIMPLIFY_FRACTION = 1e-4
 
 
-def coverage_fraction(region: Polygon, path: FloatArray, width: float) -> float:
+def coverage_fraction(region: Region, path: FloatArray, width: float) -> float:
     """Area of (region ∩ swept discs of diameter ``width`` along ``path`` (N, >=2)) / area."""
     return float(region.intersection(swept(path, width)).area / region.area)
 

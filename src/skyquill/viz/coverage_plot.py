@@ -9,6 +9,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
+import shapely
 from matplotlib.axes import Axes
 from shapely.geometry import LineString, MultiPolygon, Polygon
 
@@ -43,10 +44,12 @@ def plot_coverage(plan: CoveragePlan, path: str | Path) -> None:
     fig = plt.figure(figsize=(13, 6.5), layout="constrained")
     grid = fig.add_gridspec(3, 2, width_ratios=(1.1, 1.0))
     top = fig.add_subplot(grid[:, 0])
-    swept = LineString(plan.path).buffer(0.5 * opts.width)
+    sprayed = None if plan.mission is None else plan.mission.swept  # spray off on transits
+    swept = LineString(plan.path).buffer(0.5 * opts.width) if sprayed is None else sprayed
     _fill(top, plan.region.intersection(swept), color="#cfe3f7")
     _fill(top, plan.region.difference(swept), color="#e4572e", alpha=0.8)
-    top.plot(*plan.region.exterior.xy, color="0.3", lw=1.2)
+    for ring in shapely.get_parts(plan.region.boundary):  # shells and holes of every field
+        top.plot(*ring.xy, color="0.3", lw=1.2)
     speed = np.linalg.norm(sp.v, axis=1)
     dots = top.scatter(sp.p[:, 0], sp.p[:, 1], c=speed, s=2, cmap="viridis", vmin=0.0)
     top.plot(plan.waypoints[:, 0], plan.waypoints[:, 1], ".", ms=3, color="0.5")

@@ -1,0 +1,321 @@
+"""Regions with holes or several fields, step 2: one mission over hole-free pieces.
+
+The region is cut around its holes (:func:`~skyquill.coverage.holes.hole_free_pieces`),
+each piece is planned as a region of its own (any planner: the plain one or
+the tuned one), the pieces are ordered for the shortest transits (Held-Karp
+over the routed transit lengths, :mod:`skyquill.coverage.part_order`'s
+search) and joined by rest-to-rest straight legs routed around the holes
+(:func:`~skyquill.coverage.transit.transit_route`) with the spray off.
+
+The spray is on while a piece is flown and the swath's footprint is clear
+of every hole (a piece's path can pass closer than half a swath where its
+spline is pulled into a corner next to a hole; the nozzle closes there).
+The flight is then checked independently (:func:`~skyquill.coverage.keepout.check_keepout`)
+on a dense sampling: a plan that fails is refused, never returned.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import shapely
+from numpy.typing import NDArray
+from shapely.geometry import LineString, Polygon
+from shapely.geometry.base import BaseGeometry
+
+from skyquill.coverage.deadline import Deadline
+from skyquill.coverage.holes import hole_free_pieces
+from skyquill.coverage.keepout import KeepoutCheck, check_keepout
+from skyquill.coverage.part_order import _EXACT_ORDER, _exact_order, _greedy_order
+from skyquill.coverage.partition import _spine, convex_parts
+from skyquill.coverage.regions import Region, fields, holes, swept
+from skyquill.coverage.transit import transit_route
+from skyquill.errors import InfeasibleError
+from skyquill.optimize.legs import LegLimits, stop_and_go
+from skyquill.trajectory import Trajectory, concatenate
+from skyquill.validation import FloatArray
+
+#: Spacing of the flight's dense sampling (spray gating, keep-out check, coverage), m.
+SAMPLE_SPACING_M = 0.01
+#: Clearance of transit corners from the holes' hulls, in swaths.
+TRANSIT_CLEARANCE = 0.5
+#: The spray opens only this much (fraction of the margin) beyond the margin, for round-off.
+SPRAY_GUARD = 1e-3
+
+
+@dataclass(frozen=True)
+class _Piece:
+    """One piece as flown: its trajectory (rest to rest, 3-D) and waypoints (K, 2)."""
+
+    trajectory: Trajectory
+    waypoints: FloatArray
+
+    def at(self, end: bool) -> FloatArray:
+        t = np.array([self.trajectory.duration if end else 0.0])
+        out: FloatArray = self.trajectory.evaluate(t)[0, :2]
+        return out
+
+
+@dataclass(frozen=True)
+class Mission:
+    """A region's pieces flown in one trajectory.
+
+    Attributes
+    ----------
+    trajectory : Trajectory
+        Pieces and transits back to back, rest to rest, 3-D (m).
+    waypoints : ndarray, shape (K, 2)
+        The pieces' waypoints and the transit routes, in flight order (m).
+    path : ndarray, shape (M, 2)
+        The flight sampled every :data:`SAMPLE_SPACING_M` or closer (m).
+    spraying : ndarray of bool, shape (M,)
+        Where the spray is on along ``path``.
+    pen_windows_s : tuple of (float, float)
+        When the spray is on, s from the start.
+    keepout : KeepoutCheck
+        The independent check of ``path`` and ``spraying`` (passed).
+    coverage : float
+        Sprayed fraction of the region's area (holes excluded).
+    swept : shapely geometry
+        The area the spray reached (m).
+    pieces : int
+        Pieces flown.
+    fields : int
+        Fields of the region.
+    transit_length_m : float
+        Length of the transits, m.
+    """
+
+    trajectory: Trajectory
+    waypoints: FloatArray
+    path: FloatArray
+    spraying: NDArray[np.bool_]
+    pen_windows_s: tuple[tuple[float, float], ...]
+    keepout: KeepoutCheck
+    coverage: float
+    swept: BaseGeometry
+    pieces: int
+    fields: int
+    transit_length_m: float
+
+    def summary(self) -> dict[str, Any]:
+        """JSON-ready: the keep-out check, pieces, fields and the transits' length."""
+        return {
+            "keepout": self.keepout.summary(),
+            "fields": self.fields,
+            "pieces": self.pieces,
+            "transit_length_m": self.transit_length_m,
+        }
+
+
+#: A planner of one hole-free piece: (piece, deadline) -> (trajectory, waypoints (K, 2)).
+PiecePlanner = Callable[[Polygon, Deadline], tuple[Trajectory, FloatArray]]
+
+
+def fly_mission(
+    region: Region,
+    width: float,
+    *,
+    legs: LegLimits,
+    altitude: float,
+    deadline: Deadline,
+    plan_piece: PiecePlanner,
+    convex: bool = False,
+) -> Mission:
+    """Plan every piece of ``region``, order and join them, gate the spray, check the holes.
+
+    Parameters
+    ----------
+    region
+        A checked region with holes or several fields (m).
+    width
+        Coverage diameter (m).
+    legs
+        Limits of the transits (and of pieces narrower than the swath, flown
+        along their spine).
+    altitude
+        Flight height, m.
+    deadline
+        The plan's budget; checked between pieces.
+    plan_piece
+        Plans one hole-free piece.
+    convex
+        Split the pieces further into convex parts
+        (:func:`~skyquill.coverage.partition.convex_parts`), each planned on
+        its own: for spirals, whose joined multi-spiral over a concave piece
+        is often too tight to time and then flown part by part anyway, after
+        a long search (a notched half-square: 19 s against 2 s).
+
+    Raises
+    ------
+    InfeasibleError
+        The flight comes closer to a hole than allowed (family ``"keepout"``),
+        a piece cannot be timed, or the deadline is spent.
+    """
+    keepouts = holes(region)
+    flown = []
+    pieces = hole_free_pieces(region, width)
+    if convex:
+        pieces = [part for piece in pieces for part in _convex(piece, width)]
+    for k, piece in enumerate(pieces):
+        deadline.check(f"piece {k + 1} of the region")
+        one = _fly_piece(
+            piece, width, legs=legs, altitude=altitude, deadline=deadline, plan_piece=plan_piece
+        )
+        if one is not None:
+            flown.append(one)
+    if not flown:
+        raise InfeasibleError(
+            "region: got no piece wide enough to fly between the holes, expected a field "
+            "with room for the swath",
+            ("coverage",),
+        )
+    clearance = TRANSIT_CLEARANCE * width
+    order = _order(flown, keepouts, clearance)
+    deadline.check("the transits between pieces")
+    parts, windows, routes = _joined([flown[k] for k in order], keepouts, clearance, legs, altitude)
+    trajectory = concatenate(parts)
+    deadline.check("the keep-out check")
+    path, spraying, pen = _gated(trajectory, windows, keepouts, width, legs.vmax)
+    keepout = check_keepout(path, spraying, keepouts, 0.5 * width)
+    if not keepout.passed:
+        worst = min(keepout.holes, key=lambda h: h.closest_spraying_m or h.closest_m)
+        raise InfeasibleError(
+            f"keepout: got a flight {worst.closest_m:.3g} m (spraying: "
+            f"{worst.closest_spraying_m}) from hole {worst.hole}, expected the vehicle off it "
+            f"and the spray at least {0.5 * width:g} m away",
+            ("keepout",),
+        )
+    area = _sprayed_area(path, spraying, width)
+    covered = float(region.intersection(area).area / region.area)
+    waypoints = np.vstack([flown[k].waypoints for k in order])
+    return Mission(
+        trajectory=trajectory,
+        waypoints=np.vstack([waypoints, *routes]) if routes else waypoints,
+        path=path,
+        spraying=spraying,
+        pen_windows_s=pen,
+        keepout=keepout,
+        coverage=covered,
+        swept=area,
+        pieces=len(flown),
+        fields=len(fields(region)),
+        transit_length_m=float(sum(_length(r) for r in routes)),
+    )
+
+
+def _fly_piece(
+    piece: Polygon,
+    width: float,
+    *,
+    legs: LegLimits,
+    altitude: float,
+    deadline: Deadline,
+    plan_piece: PiecePlanner,
+) -> _Piece | None:
+    """The piece planned; a piece narrower than the swath along its spine; a point: None."""
+    if not piece.buffer(-0.5 * width).is_empty:
+        trajectory, waypoints = plan_piece(piece, deadline)
+        return _Piece(trajectory, waypoints)
+    spine = _spine(piece, width)
+    if len(spine) < 2 or _length(spine) <= 1e-6 * width:
+        return None  # no room to fly: its area is reported as missed
+    if not piece.buffer(1e-9 * width).covers(LineString(spine)):
+        return None  # a thin bent piece (round a hole): its chord would cut across the hole
+    lifted = np.column_stack([spine, np.full(len(spine), altitude)])
+    return _Piece(stop_and_go(lifted, legs).trajectory, spine)
+
+
+def _convex(piece: Polygon, width: float) -> list[Polygon]:
+    """``piece``'s convex parts; itself when the swath does not fit (flown along its spine)."""
+    if piece.buffer(-0.5 * width).is_empty:
+        return [piece]
+    return convex_parts(piece, width)
+
+
+def _order(flown: list[_Piece], keepouts: list[Polygon], clearance: float) -> list[int]:
+    """Visiting order with the shortest routed transits (exact up to 9 pieces)."""
+    n = len(flown)
+    cost = np.zeros((n, n))
+    for a in range(n):
+        for b in range(n):
+            if a != b:
+                route = transit_route(flown[a].at(True), flown[b].at(False), keepouts, clearance)
+                cost[a, b] = _length(route)
+    return _exact_order(cost, None) if n <= _EXACT_ORDER else _greedy_order(cost, None)
+
+
+def _joined(
+    flown: list[_Piece],
+    keepouts: list[Polygon],
+    clearance: float,
+    legs: LegLimits,
+    altitude: float,
+) -> tuple[list[Trajectory], list[tuple[float, float]], list[FloatArray]]:
+    """Pieces and transits back to back, the pieces' time windows and the transit routes."""
+    parts: list[Trajectory] = []
+    windows: list[tuple[float, float]] = []
+    routes: list[FloatArray] = []
+    clock = 0.0
+    for k, piece in enumerate(flown):
+        if k > 0:
+            route = transit_route(flown[k - 1].at(True), piece.at(False), keepouts, clearance)
+            if _length(route) > 1e-9:
+                lifted = np.column_stack([route, np.full(len(route), altitude)])
+                transit = stop_and_go(lifted, legs).trajectory
+                parts.append(transit)
+                routes.append(route)
+                clock += transit.duration
+        parts.append(piece.trajectory)
+        windows.append((clock, clock + piece.trajectory.duration))
+        clock += piece.trajectory.duration
+    return parts, windows, routes
+
+
+def _gated(
+    trajectory: Trajectory,
+    windows: list[tuple[float, float]],
+    keepouts: list[Polygon],
+    width: float,
+    vmax: float,
+) -> tuple[FloatArray, NDArray[np.bool_], tuple[tuple[float, float], ...]]:
+    """The dense flight ``(M, 2)``, where the spray is on, and its time windows.
+
+    On inside a piece's window where the footprint clears every hole by
+    :data:`SPRAY_GUARD` of the margin.
+    """
+    n = max(2, math.ceil(trajectory.duration * vmax / SAMPLE_SPACING_M) + 1)
+    t = np.linspace(0.0, trajectory.duration, n)
+    path: FloatArray = trajectory.evaluate(t)[:, :2]
+    in_piece = np.zeros(n, dtype=bool)
+    for start, end in windows:
+        in_piece |= (t >= start) & (t <= end)
+    clear = np.ones(n, dtype=bool)
+    points = shapely.points(path)
+    margin = 0.5 * width * (1.0 + SPRAY_GUARD)
+    for hole in keepouts:
+        clear &= shapely.distance(points, hole) >= margin
+    on = in_piece & clear
+    edges = np.diff(np.concatenate([[0], on.astype(np.int8), [0]]))
+    starts, stops = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1) - 1
+    pen = tuple((float(t[a]), float(t[b])) for a, b in zip(starts, stops, strict=True))
+    return path, on, pen
+
+
+def _sprayed_area(path: FloatArray, spraying: NDArray[np.bool_], width: float) -> BaseGeometry:
+    """The union of the swath along each sprayed run of ``path`` (m)."""
+    edges = np.diff(np.concatenate([[0], spraying.astype(np.int8), [0]]))
+    runs = zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1), strict=True)
+    areas = [
+        swept(path[a:b], width) if b - a > 1 else shapely.Point(path[a]).buffer(0.5 * width)
+        for a, b in runs
+    ]
+    return shapely.union_all(areas)
+
+
+def _length(path: FloatArray) -> float:
+    return float(np.linalg.norm(np.diff(path, axis=0), axis=1).sum())
