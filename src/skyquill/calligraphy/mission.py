@@ -121,9 +121,11 @@ MAX_ALTITUDE_M = 120.0
 #: (bang-bang jerk); a minimum-jerk (quintic) one peaks at 60 d / T^3.
 LIFT_JERK_FACTOR = 32.0
 #: Fraction of the acceleration limit the route is timed with when the tip is
-#: fitted (0.5 for the path). Measured on 語永中国: writing 1.09-1.15x the
-#: path's time with 1-2 conic solves per plan; 0.75 gives 1.02-1.09x but 7-11.
-TIP_TIMING_ACC = 0.6
+#: fitted (0.5 for the path). Measured (bench/calligraphy.py, 87 characters):
+#: at 0.6 the writing took at most 1.148x the path's on the bundled characters
+#: but up to 1.169x on many-stroke KanjiVG ones (語 読 橋 ...); 0.65 brings those
+#: to 1.13x at 2-5 conic solves a plan (0.75: 1.02-1.09x, 7-11 solves).
+TIP_TIMING_ACC = 0.65
 #: Fraction of the speed limit the legs from and to home are timed at.
 HOME_LEG_SPEED = 0.9
 #: Pause above the first stroke after the approach from home, s. The approach
