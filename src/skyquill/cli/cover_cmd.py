@@ -24,10 +24,11 @@ from skyquill.errors import InputError
 from skyquill.limits import VehicleLimits
 
 if TYPE_CHECKING:
+    from rich.progress import Progress, TaskID
+
     from skyquill.coverage.geo import GeoFrame
     from skyquill.coverage.plan import CoveragePlan
     from skyquill.io.trajectory_json import PlannedTrajectory
-    from rich.progress import Progress, TaskID
 
 #: The bar is drawn only for planning that takes longer than this, s.
 BAR_AFTER_S = 1.0
@@ -109,13 +110,13 @@ def cover(
     summary.json records its origin and CRS, and path.geojson holds the flown
     path and the covered area in lon/lat.
     """
+    from skyquill.coverage.geo import load_geo_region
     from skyquill.coverage.plan import (
         CoverageOptions,
         coverage_limits,
         plan_coverage,
         plan_tuned,
     )
-    from skyquill.coverage.geo import load_geo_region
     from skyquill.io.outputs import staged_output
     from skyquill.io.plan_dir import write_plan
     from skyquill.io.trajectory_json import PlannedTrajectory

@@ -31,7 +31,7 @@ from shapely.geometry import Polygon
 
 from skyquill.coverage.regions import load_region
 from skyquill.errors import InputError
-from skyquill.io.json_read import check_depth
+from skyquill.io.json_read import check_depth, parse_json
 from skyquill.validation import FloatArray, as_float
 
 #: The ``crs`` values that mean "the positions are local metres already".
@@ -237,7 +237,7 @@ def _parse_crs(text: str, name: str = "crs") -> _Chosen:
 
 
 def _file_crs(data: Any, name: str) -> _Chosen:
-    """The legacy ``"crs"`` member (``{"type": "name", "properties": {"name": ...}}``), else WGS84."""
+    """The legacy ``"crs"`` member (``{"type": "name", "properties": {"name": ...}}``) or WGS84."""
     member = data.get("crs") if isinstance(data, dict) else None
     if member is None:
         return pyproj.CRS.from_epsg(4326)
@@ -352,3 +352,19 @@ def _mapped(data: Any, fn: Callable[[list[Any]], list[Any]]) -> Any:
     for _, owner, coords in _walk(data, ""):
         owner["coordinates"] = mapped(coords)
     return data
+
+
+def plan_frame(plan: Path) -> GeoFrame | None:
+    """The geographic frame a plan directory's ``summary.json`` records (``geo``), or None.
+
+    None for a plan in local metres, a single trajectory file, or a directory
+    without a summary: the exports that need an origin then say so.
+    """
+    summary = plan / "summary.json" if plan.is_dir() else None
+    if summary is None or not summary.is_file():
+        return None
+    data = parse_json(summary.read_bytes(), str(summary), "skyquill's summary.json")
+    geo = data.get("geo") if isinstance(data, dict) else None
+    if not isinstance(geo, dict) or geo.get("origin") is None:
+        return None
+    return GeoFrame.from_dict(geo, f"{summary.name}: geo")

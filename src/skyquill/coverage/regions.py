@@ -41,9 +41,7 @@ def region_from_vertices(vertices: Any, name: str = "vertices") -> Polygon:
     return _checked(Polygon(pts), name)
 
 
-def load_region(
-    source: str | Path, project: Callable[[Any, str], Any] | None = None
-) -> Polygon:
+def load_region(source: str | Path, project: Callable[[Any, str], Any] | None = None) -> Polygon:
     """Read a region: a ``.geojson``/``.json`` file (Polygon, Feature or one-feature
     FeatureCollection), a ``.wkt`` file, or a WKT string.
 

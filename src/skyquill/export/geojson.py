@@ -165,9 +165,7 @@ def _dense(planned: PlannedTrajectory) -> tuple[FloatArray, FloatArray, FloatArr
     """Dense times (s), horizontal positions (N, 2) (m) and pen states (N,) of the plan."""
     traj = planned.trajectory
     t = dense_times(traj.breakpoints)
-    pen = (
-        planned.pen(t).astype(bool) if planned.pen_windows_s else np.zeros(t.size, dtype=bool)
-    )
+    pen = planned.pen(t).astype(bool) if planned.pen_windows_s else np.zeros(t.size, dtype=bool)
     return t, traj.evaluate(t)[:, :2], pen
 
 
@@ -202,7 +200,7 @@ def _to_geo(frame: GeoFrame, geometry: BaseGeometry) -> BaseGeometry:
 
     def fn(xy: FloatArray) -> FloatArray:
         lon, lat = frame.to_geo(xy[:, 0], xy[:, 1])
-        return np.round(np.column_stack([lon, lat]), DEGREE_DIGITS)
+        return np.asarray(np.round(np.column_stack([lon, lat]), DEGREE_DIGITS), dtype=float)
 
     return shapely.transform(geometry, fn)
 
@@ -212,4 +210,3 @@ def _to_local(frame: GeoFrame, geometry: BaseGeometry) -> BaseGeometry:
         return np.column_stack(frame.to_local(lonlat[:, 0], lonlat[:, 1]))
 
     return shapely.transform(geometry, fn)
-
