@@ -247,7 +247,7 @@ BOUND_CASES = [
     Case("write at 1000 m/s cannot stay on the strokes",
          _write_cmd("--vmax", "1000", "--amax", "1e4", "--jmax", "1e6"), "lower speed limit"),
     Case("cover --altitude -5", _cover("--altitude", "-5"), "altitude"),
-    Case("cover a km square at 2 m", ["cover", "{tmp}/km.geojson", "--out", "{out}"], "km",
+    Case("cover a km square at 2 m", ["cover", "{tmp}/km.geojson", "--out", "{out}", "--crs", "local"], "km",
          setup=_write("km.geojson", KM_SQUARE)),
     Case("cover --width 0.001", _cover("--width", "0.001"), "km"),
     Case("fly --rate 1e6", _fly("--rate", "1e6"), "rate", setup=WITH_TRAJ),

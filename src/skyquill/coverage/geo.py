@@ -10,8 +10,9 @@ it (PX4 global setpoints, Skybrush's show origin, ``path.geojson``) map back.
 The CRS of a GeoJSON file is, in order: the ``crs`` argument (``"local"``: the
 positions are already local metres, as before; ``"wgs84"``; any CRS pyproj knows,
 e.g. ``"EPSG:32633"``), the legacy ``"crs"`` member of the file (GeoJSON 2008,
-still written by QGIS and GDAL for projected data), else WGS84. WKT carries no
-CRS and stays local metres.
+still written by QGIS and GDAL for projected data; ``{"type": "name",
+"properties": {"name": "local"}}`` marks a file in local metres, as skyquill's
+examples are), else WGS84. WKT carries no CRS and stays local metres.
 """
 
 from __future__ import annotations
@@ -29,7 +30,7 @@ import pyproj
 from pyproj.exceptions import CRSError
 from shapely.geometry import Polygon
 
-from skyquill.coverage.regions import load_region
+from skyquill.coverage.regions import MAX_COORDINATE_M, load_region
 from skyquill.errors import InputError
 from skyquill.io.json_read import check_depth, parse_json
 from skyquill.validation import FloatArray, as_float
@@ -271,7 +272,8 @@ class _Projector:
         if isinstance(crs, str):  # LOCAL
             return data
         positions = list(_positions(data, ""))
-        if not positions:  # nothing to project: load_region names what is missing
+        if not positions or any(len(p) != 2 for _, p in positions):
+            # nothing to project, or a z: load_region names what is wrong
             return data
         xy = np.array([p[:2] for _, p in positions], dtype=float)
         if crs.is_geographic:
@@ -279,11 +281,26 @@ class _Projector:
                 check_lon_lat(p[0], p[1], f"{name}: coordinates{where}")
         self.frame = _frame(crs, xy, self.alt_m)
         x, y = self.frame.transformer_from(crs).transform(xy[:, 0], xy[:, 1], errcheck=True)
+        _check_extent(np.hypot(x, y).max(), crs, name)
         local = iter(np.column_stack([x, y]).tolist())
         out = _mapped(copy.deepcopy(data), lambda p: [*next(local), *p[2:]])
         if isinstance(out, dict):
             out.pop("crs", None)
         return out
+
+
+def _check_extent(reach_m: float, crs: pyproj.CRS, name: str) -> None:
+    """Refuse a field reaching beyond :data:`MAX_COORDINATE_M` from its centre.
+
+    Most often a file in local metres read as longitude/latitude degrees (a
+    10 m square becomes a 1,100 km one): the message says how to read it as metres.
+    """
+    if not reach_m <= MAX_COORDINATE_M:
+        raise InputError(
+            f"{name}: got a field reaching {reach_m / 1e3:,.0f} km from its centre in "
+            f"{crs.name}, expected at most {MAX_COORDINATE_M / 1e3:g} km; coordinates in "
+            "local metres need --crs local (RFC 7946 GeoJSON is longitude/latitude)"
+        )
 
 
 def _frame(crs: pyproj.CRS, xy: FloatArray, alt_m: float | None) -> GeoFrame:
