@@ -68,7 +68,9 @@ def test_a_lonlat_field_plans_as_the_same_field_in_metres(tmp_path: Path) -> Non
     geo_plan, local_plan = plan_coverage(geo.region, options), plan_coverage(local, options)
     assert geo_plan.duration == pytest.approx(local_plan.duration, abs=1e-3)
     t = np.linspace(0.0, min(geo_plan.duration, local_plan.duration), 2000)
-    gap = np.linalg.norm(geo_plan.trajectory.evaluate(t) - local_plan.trajectory.evaluate(t), axis=1)
+    gap = np.linalg.norm(
+        geo_plan.trajectory.evaluate(t) - local_plan.trajectory.evaluate(t), axis=1
+    )
     assert gap.max() < 1e-3
     assert geo_plan.coverage == pytest.approx(local_plan.coverage, abs=1e-6)
 
@@ -103,7 +105,7 @@ def test_coordinates_out_of_range_are_refused(
 def test_metres_read_as_degrees_say_how_to_read_metres(tmp_path: Path) -> None:
     ring = [[0, 0], [10, 0], [10, 10], [0, 10], [0, 0]]
     path = _write(tmp_path / "m.geojson", ring)
-    with pytest.raises(InputError, match="m.geojson: got a field reaching .* --crs local"):
+    with pytest.raises(InputError, match=r"m\.geojson: got a field reaching .* --crs local"):
         load_geo_region(path)
     for geo in (load_geo_region(path, crs="local"), load_geo_region(_write(path, ring, "local"))):
         assert geo.frame is None and geo.region.area == pytest.approx(100.0)
@@ -128,7 +130,7 @@ def test_the_frame_is_recorded_and_read_back(tmp_path: Path) -> None:
     back = plan_frame(tmp_path)
     assert back is not None and back.as_dict() == geo.frame.as_dict()
     assert plan_frame(tmp_path / "summary.json") is None  # a file, not a plan directory
-    with pytest.raises(InputError, match="origin: got latitude 95.0, expected -90..90"):
+    with pytest.raises(InputError, match=r"origin: got latitude 95\.0, expected -90\.\.90"):
         GeoFrame(8.0, 95.0)
 
 

@@ -164,7 +164,8 @@ def check_path_geojson(
 def _dense(planned: PlannedTrajectory) -> tuple[FloatArray, FloatArray, FloatArray]:
     """Dense times (s), horizontal positions (N, 2) (m) and pen states (N,) of the plan."""
     traj = planned.trajectory
-    t = dense_times(traj.breakpoints)
+    # the last breakpoint may pass the duration by a rounding, and leave the last pen window
+    t = np.minimum(dense_times(traj.breakpoints), traj.duration)
     pen = planned.pen(t).astype(bool) if planned.pen_windows_s else np.zeros(t.size, dtype=bool)
     return t, traj.evaluate(t)[:, :2], pen
 
