@@ -118,7 +118,7 @@ def test_unknown_crs_and_wkt_with_a_crs_are_refused(tmp_path: Path) -> None:
     with pytest.raises(InputError, match=r"crs.properties.name: got 'nowhere'"):
         load_geo_region(_write(tmp_path / "n.geojson", [[0, 0], [1, 0], [0, 1], [0, 0]], "nowhere"))
     wkt = "POLYGON ((0 0, 10 0, 10 10, 0 10, 0 0))"
-    assert load_geo_region(wkt).frame is None
+    assert load_geo_region(wkt).frame is None and load_geo_region(wkt, "local").frame is None
     with pytest.raises(InputError, match="crs: got 'wgs84' for a WKT region"):
         load_geo_region(wkt, crs="wgs84")
 

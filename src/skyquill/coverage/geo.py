@@ -201,7 +201,7 @@ def load_geo_region(
     chosen = None if crs is None else _parse_crs(crs)
     projector = _Projector(chosen, alt_m)
     region = load_region(source, project=projector)
-    if not projector.called and chosen is not None:
+    if not projector.called and isinstance(chosen, pyproj.CRS):
         raise InputError(
             f"crs: got {crs!r} for a WKT region, expected none or 'local' (WKT carries no CRS "
             "and is read as local metres; convert the field to GeoJSON to give one)"
