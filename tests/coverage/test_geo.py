@@ -100,6 +100,13 @@ def test_coordinates_out_of_range_are_refused(
     ring = [[8.54, 47.37], corner, [8.55, 47.38], [8.54, 47.37]]
     with pytest.raises(InputError, match=message):
         load_geo_region(_write(tmp_path / "bad.geojson", ring))
+    geometry = {"type": "Polygon", "coordinates": [ring]}
+    feature = {"type": "Feature", "properties": {}, "geometry": geometry}
+    (tmp_path / "f.geojson").write_text(
+        json.dumps({"type": "FeatureCollection", "features": [feature]})
+    )
+    with pytest.raises(InputError, match=r"features\[0\]\.geometry\." + message):
+        load_geo_region(tmp_path / "f.geojson")
 
 
 def test_metres_read_as_degrees_say_how_to_read_metres(tmp_path: Path) -> None:

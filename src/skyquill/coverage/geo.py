@@ -278,7 +278,7 @@ class _Projector:
         xy = np.array([p[:2] for _, p in positions], dtype=float)
         if crs.is_geographic:
             for where, p in positions:
-                check_lon_lat(p[0], p[1], f"{name}: coordinates{where}")
+                check_lon_lat(p[0], p[1], f"{name}: {where}")
         self.frame = _frame(crs, xy, self.alt_m)
         x, y = self.frame.transformer_from(crs).transform(xy[:, 0], xy[:, 1], errcheck=True)
         _check_extent(np.hypot(x, y).max(), crs, name)
@@ -339,7 +339,7 @@ def _walk(node: Any, where: str) -> Iterator[tuple[str, Any, list[Any]]]:
 
 
 def _positions(data: Any, where: str) -> Iterator[tuple[str, list[Any]]]:
-    """Every position (a list of >= 2 JSON numbers), with its index path, in document order."""
+    """Every position (a list of >= 2 JSON numbers), with its path, in document order."""
 
     def leaves(node: Any, path: str) -> Iterator[tuple[str, list[Any]]]:
         if _is_position(node):
@@ -348,8 +348,9 @@ def _positions(data: Any, where: str) -> Iterator[tuple[str, list[Any]]]:
             for i, item in enumerate(node):
                 yield from leaves(item, f"{path}[{i}]")
 
-    for _, _, coords in _walk(data, where):
-        yield from leaves(coords, "")
+    for owner, _, coords in _walk(data, where):
+        # e.g. "features[0].geometry.coordinates[0][3]": where a vertex is in the file
+        yield from leaves(coords, f"{owner.lstrip('.')}.coordinates".lstrip("."))
 
 
 def _mapped(data: Any, fn: Callable[[list[Any]], list[Any]]) -> Any:
