@@ -26,7 +26,8 @@ def plan_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
     field.write_text(json.dumps({"type": "Polygon", "coordinates": [[*ring, ring[0]]]}))
     out = root / "plan"
     args = ["cover", str(field), "--out", str(out), "--width", "4", "--pattern", "zigzag"]
-    result = CliRunner().invoke(app, [*args, "--origin-alt", "408"])
+    # a generous budget: the suite runs on a shared, loaded machine
+    result = CliRunner().invoke(app, [*args, "--origin-alt", "408", "--time-limit", "600"])
     assert result.exit_code == 0, result.output
     return out
 
