@@ -163,6 +163,9 @@ def test_plan_flies_exports_and_reads_back(
             # A plan made without --target crazyflie that does not fit the uploads is refused.
             assert "plan it with target 'crazyflie'" in " ".join(done.output.split())
             continue
+        if name == "px4-global":  # needs a geographic origin: tests/cli/test_cover_geo.py
+            assert done.exit_code == 2 and "origin: got none" in done.output
+            continue
         assert done.exit_code == 0, done.output
         report = json.loads(out.with_name(f"{out.stem}.summary.json").read_text())
         files = [Path(f) for f in report["files"]]

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 from scipy.interpolate import make_interp_spline
 
+from skyquill.coverage.geo import GeoFrame
 from skyquill.errors import InputError
 from skyquill.export import EXPORTERS, ExportOptions, exporter
 from skyquill.io.trajectory_json import PlannedTrajectory
@@ -22,6 +23,7 @@ TOLERANCE_M = {
     "skyc": 2e-3,
     "skybrush-csv": 1e-3,
     "px4": 1e-3,
+    "px4-global": 1e-2,  # MAVLink's 1e-7 degree integers: up to 6.7 mm at 47 N
     "csv": 1e-3,
     "json": 1e-3,
 }
@@ -53,7 +55,9 @@ def test_every_format_reads_back_within_its_tolerance(tmp_path: Path, name: str,
         with pytest.raises(InputError, match="plan it with target 'crazyflie'"):
             chosen(plans, tmp_path / "out.csv", ExportOptions(100.0))
         return
-    report = chosen(plans, tmp_path / f"out{chosen.suffix}", ExportOptions(100.0))
+    # every format takes an origin; px4-global needs one
+    options = ExportOptions(100.0, origin=GeoFrame(8.54, 47.37))
+    report = chosen(plans, tmp_path / f"out{chosen.suffix}", options)
     assert report.format == name and report.files and all(f.is_file() for f in report.files)
     assert report.max_error_m <= TOLERANCE_M[name]
     assert report.as_dict()["max_error_m"] == report.max_error_m

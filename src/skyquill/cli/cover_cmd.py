@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 from types import TracebackType
-from typing import TYPE_CHECKING, Annotated
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
@@ -26,6 +26,10 @@ from skyquill.limits import VehicleLimits
 if TYPE_CHECKING:
     from rich.progress import Progress, TaskID
 
+    from skyquill.coverage.geo import GeoFrame
+    from skyquill.coverage.plan import CoveragePlan
+    from skyquill.io.trajectory_json import PlannedTrajectory
+
 #: The bar is drawn only for planning that takes longer than this, s.
 BAR_AFTER_S = 1.0
 
@@ -35,8 +39,8 @@ def cover(
     region: Annotated[
         Path,
         typer.Argument(
-            help="Region: GeoJSON (Multi)Polygon/Feature, or a .wkt file; metres; "
-            "holes are keep-out zones."
+            help="Region: GeoJSON (Multi)Polygon/Feature (WGS84 lon/lat by RFC 7946, or the "
+            "CRS its crs member names), or a .wkt file (local metres); holes are keep-out zones."
         ),
     ],
     out: OutDir,
@@ -79,6 +83,21 @@ def cover(
             "the step it was at; a budget below the estimate is refused at once."
         ),
     ] = 60.0,
+    crs: Annotated[
+        str | None,
+        typer.Option(
+            help="The region's CRS: wgs84, local (metres, x east, y north) or one pyproj knows "
+            "(e.g. EPSG:32633). Default: what the file says (GeoJSON: WGS84 unless it has a "
+            "crs member; WKT: local)."
+        ),
+    ] = None,
+    origin_alt: Annotated[
+        float | None,
+        typer.Option(
+            help="Ground altitude at the field's centre above mean sea level, m: recorded "
+            "with the origin (Skybrush's show origin carries it)."
+        ),
+    ] = None,
     target: Target = None,
     force: Force = False,
 ) -> None:
@@ -86,14 +105,18 @@ def cover(
 
     With --target the planned path is re-fitted into the vehicle's uploads (degree-7
     pieces, within 5 % of the swath of the path, hovering between uploads).
+
+    A geographic region is planned in a local metric frame centred on it;
+    summary.json records its origin and CRS, and path.geojson holds the flown
+    path and the covered area in lon/lat.
     """
+    from skyquill.coverage.geo import load_geo_region
     from skyquill.coverage.plan import (
         CoverageOptions,
         coverage_limits,
         plan_coverage,
         plan_tuned,
     )
-    from skyquill.coverage.regions import load_region
     from skyquill.io.outputs import staged_output
     from skyquill.io.plan_dir import write_plan
     from skyquill.io.trajectory_json import PlannedTrajectory
@@ -101,7 +124,8 @@ def cover(
 
     with user_errors():
         check_out(out)
-        shape = load_region(region)
+        geo = load_geo_region(region, crs, origin_alt)
+        shape = geo.region
         options = CoverageOptions(
             width=width,
             limits=_limits(vmax, amax, jmax, amax_axis, jmax_axis),
@@ -130,13 +154,16 @@ def cover(
             console.status("writing and checking the plan"),
             staged_output(out, "cover", force=force, inputs=[region]) as stage,
         ):
+            fields = plan.summary() | {"region": str(region)} | geo.summary()
+            if geo.frame is not None:
+                fields["path_geojson"] = _write_geojson(stage, geo.frame, plan, planned)
             summary = write_plan(
                 stage,
                 [planned],
                 rate=rate,
                 # The refit for a target holds the limits through the hull; the LP does not.
                 guaranteed=plan.delivered is not None,
-                summary=plan.summary() | {"region": str(region)},
+                summary=fields,
                 plot=lambda path: plot_coverage(plan, path),
             )
     uploads = "" if plan.delivered is None else f", {len(plan.delivered.budget.uploads)} upload(s)"
@@ -145,6 +172,18 @@ def cover(
         f"coverage {plan.coverage:.4f}, max excess {summary['plan']['max_excess']:.4f}, "
         f"planned in {plan.planning_time:.2f} s -> {out}"
     )
+
+
+def _write_geojson(
+    stage: Path, frame: GeoFrame, plan: CoveragePlan, planned: PlannedTrajectory
+) -> dict[str, Any]:
+    """``path.geojson`` (flown path and covered area in lon/lat), read back and checked."""
+    from skyquill.coverage.regions import swept
+    from skyquill.export.geojson import write_path_geojson
+
+    covered = plan.region.intersection(swept(plan.path, plan.options.width))
+    check = write_path_geojson(stage / "path.geojson", frame, planned, covered, plan.region)
+    return {"file": "path.geojson"} | check.as_dict()
 
 
 def _limits(

@@ -8,6 +8,7 @@ from typing import Annotated
 import typer
 
 from skyquill.cli.main import Force, app, console, positive_rate, say_done, user_errors
+from skyquill.coverage.geo import plan_frame
 from skyquill.errors import InputError
 from skyquill.export import EXPORTERS, ExportOptions
 from skyquill.io.atomic import write_json
@@ -60,7 +61,9 @@ def export(
                 f"--out: got {str(out)!r}, expected a file ending in {chosen.suffix} for "
                 f"--format {format}"
             )
-        options = ExportOptions(rate_hz=positive_rate(rate), light_rgb=_rgb(light))
+        options = ExportOptions(
+            rate_hz=positive_rate(rate), light_rgb=_rgb(light), origin=plan_frame(plan)
+        )
         plans = read_plan(plan)
         folder = out.parent
         with (

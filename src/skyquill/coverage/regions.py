@@ -11,7 +11,7 @@ a disc of the coverage diameter (issue 5's metric).
 from __future__ import annotations
 
 import itertools
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any, TypeAlias
 
@@ -74,9 +74,13 @@ def has_keepouts(region: Region) -> bool:
     return isinstance(region, Polygon) and bool(region.interiors)
 
 
-def load_region(source: str | Path) -> Region:
+def load_region(source: str | Path, project: Callable[[Any, str], Any] | None = None) -> Region:
     """Read a region: a ``.geojson``/``.json`` file (Polygon, Feature or one-feature
     FeatureCollection), a ``.wkt`` file, or a WKT string.
+
+    ``project(data, file_name)`` maps a parsed GeoJSON document to one in local
+    metres (:func:`skyquill.coverage.geo.load_geo_region` passes it); WKT is
+    always local metres.
 
     Coordinates are 2-D local metres: JSON numbers (a string such as ``"1"`` is
     refused, not converted), ``[x, y]`` positions (a third value, a z, is refused,
@@ -109,7 +113,8 @@ def load_region(source: str | Path) -> Region:
     raw = path.read_bytes()
     if path.suffix.lower() == ".wkt":
         return _from_wkt(decode_utf8(raw, path.name, "a WKT POLYGON"), path.name)
-    return _from_geojson(parse_json(raw, path.name, _WHAT), path.name)
+    data = parse_json(raw, path.name, _WHAT)
+    return _from_geojson(data if project is None else project(data, path.name), path.name)
 
 
 def _from_wkt(text: str, name: str) -> Region:

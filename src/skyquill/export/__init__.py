@@ -9,12 +9,13 @@ from __future__ import annotations
 from skyquill.errors import InputError
 from skyquill.export.base import Exporter, ExportOptions, ExportReport, NamedPlan
 from skyquill.export.crazyswarm import EXPORTER as CRAZYSWARM
+from skyquill.export.px4_global import EXPORTER as PX4_GLOBAL
 from skyquill.export.samples import CSV, JSON, PX4
 from skyquill.export.skybrush_csv import EXPORTER as SKYBRUSH_CSV
 from skyquill.export.skyc import EXPORTER as SKYC
 
 EXPORTERS: dict[str, Exporter] = {
-    e.name: e for e in (CRAZYSWARM, SKYC, SKYBRUSH_CSV, PX4, CSV, JSON)
+    e.name: e for e in (CRAZYSWARM, SKYC, SKYBRUSH_CSV, PX4, PX4_GLOBAL, CSV, JSON)
 }
 
 

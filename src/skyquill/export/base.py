@@ -15,6 +15,8 @@ from typing import Any, Protocol
 
 import numpy as np
 
+from skyquill.coverage.geo import GeoFrame
+from skyquill.errors import InputError
 from skyquill.io.skybrush_lights import check_rgb
 from skyquill.io.trajectory_json import PlannedTrajectory, pen_down
 from skyquill.trajectory import Trajectory, dense_times
@@ -36,14 +38,22 @@ class ExportOptions:
     light_rgb
         The light colour while the pen is down (Skybrush formats), three integers 0..255;
         the light is off while the pen is up.
+    origin
+        The plan's geographic frame (``summary.json``'s ``geo``), or None for a plan in
+        local metres: px4-global needs it, skyc records it as the show's location.
     """
 
     rate_hz: float = 100.0
     light_rgb: tuple[int, int, int] = (255, 255, 255)
+    origin: GeoFrame | None = None
 
     def __post_init__(self) -> None:
         as_float("rate_hz", self.rate_hz, positive=True)
         object.__setattr__(self, "light_rgb", check_rgb("light_rgb", self.light_rgb))
+        if self.origin is not None and not isinstance(self.origin, GeoFrame):
+            raise InputError(
+                f"origin: got {type(self.origin).__name__}, expected a GeoFrame or None"
+            )
 
 
 @dataclass(frozen=True)

@@ -18,6 +18,8 @@ from typing import Any
 
 import numpy as np
 
+from skyquill.coverage.geo import GeoFrame
+from skyquill.errors import InputError
 from skyquill.export.base import (
     DeliveredCheck,
     ExportOptions,
@@ -35,11 +37,19 @@ from skyquill.io.skybrush_lights import (
     program_bytes,
 )
 from skyquill.io.skybrush_playback import played_show, played_trajectory
-from skyquill.io.skyc import SkycDrone, read_show_json, write_skyc
+from skyquill.io.skyc import (
+    SkycDrone,
+    read_show_json,
+    read_show_location,
+    show_location,
+    write_skyc,
+)
 from skyquill.io.trajectory_json import pen_down
 
 #: A limit excess below this counts as none (float rounding of the read-back), relative.
 EXCESS_TOLERANCE = 1e-9
+#: Heading of the show's X+ axis, degrees clockwise from north: skyquill's x is east.
+SHOW_X_HEADING_DEG = 90.0
 
 
 @dataclass(frozen=True)
@@ -69,7 +79,16 @@ class SkycExporter:
             played_trajectory(d.name, {"points": d.keyframes.points()}).trajectory() for d in drones
         ]
         validation = validation_settings([p.limits for _, p in plans], flown)
-        path = write_skyc(drones, out.with_suffix(self.suffix), validation=validation)
+        frame = options.origin
+        location = (
+            None
+            if frame is None
+            # skyquill's x is east: the show's X+ axis heads 90 degrees from north
+            else show_location(frame.lat_deg, frame.lon_deg, frame.alt_m, SHOW_X_HEADING_DEG)
+        )
+        path = write_skyc(
+            drones, out.with_suffix(self.suffix), validation=validation, location=location
+        )
         show = read_show_json(path)
         played = [p.trajectory() for p in played_show(show)]
         delivered = tuple(
@@ -81,15 +100,33 @@ class SkycExporter:
             for i, ((_, plan), back) in enumerate(zip(plans, played, strict=True))
         ]
         details = _details(drones, delivered, lights, validation)
+        shift = 0.0 if frame is None else _location_shift(show, frame)
+        if frame is not None:
+            details["location"] = show["environment"]["location"] | {"shift_m": shift}
         return ExportReport(
             self.name,
             (path,),
             exact=False,
-            max_error_m=max(d.max_error_m for d in delivered),
+            # the whole show is flown around the stored (rounded) origin
+            max_error_m=max(d.max_error_m for d in delivered) + shift,
             message=_message(path, details),
             details=details,
             delivered=delivered,
         )
+
+
+def _location_shift(show: dict[str, Any], frame: GeoFrame) -> float:
+    """How far the origin read back from the show lies from the plan's, m (1e-7 deg rounding).
+
+    A heading other than :data:`SHOW_X_HEADING_DEG` would turn the show: refused.
+    """
+    stored = read_show_location(show)
+    assert stored is not None  # written with one
+    lat, lon, _, heading = stored
+    if heading != SHOW_X_HEADING_DEG:  # pragma: no cover - written here
+        raise InputError(f"orientation: got {heading:g}, expected {SHOW_X_HEADING_DEG:g}")
+    x, y = frame.to_local(lon, lat)
+    return float(np.hypot(x, y))
 
 
 def _light_mismatch(

@@ -25,6 +25,13 @@ at most two (cubic). What a drone plays from it is :mod:`skyquill.io.skybrush_pl
 :mod:`skyquill.io.skybrush_keyframes` builds keyframes on its ms and mm grid and
 :mod:`skyquill.io.skybrush_lights` the light programs.
 
+An outdoor show may propose where it is flown: ``"environment": {"type": "outdoor",
+"location": {"origin": [lat_e7, lon_e7, amsl_mm], "orientation": deg}}`` (skybrush.js
+``types.ts``, ``Location``; the integers as Skybrush Studio for Blender writes them,
+skybrush-io/studio-blender ``src/modules/sbstudio/model/location.py``: latitude and
+longitude in 1e-7 degrees, the optional altitude above mean sea level in mm, the
+orientation of the show's X+ axis in degrees from north towards east).
+
 ``yawControl`` is read by Skybrush's "show pro" extension (skybrush-server
 ``src/flockwave/server/ext/mavlink/driver.py``, ``upload_show``); without it the server
 warns and leaves the yaw to the drone. Frames and units: Skybrush's show frame is x, y
@@ -117,6 +124,7 @@ def write_skyc(
     *,
     validation: Mapping[str, float] | None = None,
     title: str = "skyquill",
+    location: Mapping[str, Any] | None = None,
 ) -> Path:
     """Write a Skybrush ``.skyc`` show (atomically) and return its path.
 
@@ -130,6 +138,9 @@ def write_skyc(
         ``settings.validation`` (keys of :data:`VALIDATION_KEYS`), or ``None``.
     title
         Show title written to ``meta.title``.
+    location
+        ``environment.location`` (:func:`show_location`), or ``None``: an outdoor
+        show with a location, else an indoor one.
 
     Raises
     ------
@@ -142,7 +153,9 @@ def write_skyc(
         raise InputError(f"title: got {type(title).__name__}, expected a string")
     show: dict[str, Any] = {
         "version": 1,
-        "environment": {"type": "indoor"},
+        "environment": {"type": "indoor"}
+        if location is None
+        else {"type": "outdoor", "location": dict(location)},
         "meta": {"title": title},
         "swarm": {"drones": [_drone_json(d) for d in drones]},
     }
@@ -153,6 +166,59 @@ def write_skyc(
     with atomic_path(file) as tmp, zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as archive:
         archive.writestr("show.json", json.dumps(show, allow_nan=False))
     return file
+
+
+def show_location(
+    lat_deg: float, lon_deg: float, amsl_m: float | None, orientation_deg: float
+) -> dict[str, Any]:
+    """``environment.location``: the show origin (WGS84) and the X+ axis' heading.
+
+    Parameters
+    ----------
+    lat_deg, lon_deg
+        The origin, degrees (stored as integers of 1e-7 degrees, about 1.1 cm).
+    amsl_m
+        Its altitude above mean sea level, m (stored in mm), or None (left out).
+    orientation_deg
+        Heading of the show's X+ axis, degrees clockwise from north (90: x east).
+    """
+    origin = [round(lat_deg * 1e7), round(lon_deg * 1e7)]
+    if amsl_m is not None:
+        origin.append(round(amsl_m * 1e3))
+    return {"origin": origin, "orientation": round(float(orientation_deg), 3)}
+
+
+def read_show_location(show: Mapping[str, Any]) -> tuple[float, float, float | None, float] | None:
+    """``(lat_deg, lon_deg, amsl_m or None, orientation_deg)`` of a validated show, or None."""
+    location = show["environment"].get("location")
+    if location is None:
+        return None
+    origin = location["origin"]
+    amsl = None if len(origin) < 3 else origin[2] / 1e3
+    return origin[0] / 1e7, origin[1] / 1e7, amsl, float(location["orientation"])
+
+
+def _check_location(location: Any) -> None:
+    where = "show.json: environment.location"
+    location = _obj(where, location)
+    origin = location.get("origin")
+    if not (
+        isinstance(origin, list)
+        and len(origin) in (2, 3)
+        and all(isinstance(c, int) and not isinstance(c, bool) for c in origin)
+        and abs(origin[0]) <= 900_000_000
+        and abs(origin[1]) <= 1_800_000_000
+    ):
+        raise InputError(
+            f"{where}.origin: got {origin!r:.60}, expected [lat_e7, lon_e7(, amsl_mm)]: "
+            "integers of 1e-7 degrees within ±90/±180 (and mm)"
+        )
+    orientation = location.get("orientation")
+    if not _is_number(orientation):
+        raise InputError(
+            f"{where}.orientation: got {orientation!r:.40}, expected the X+ axis' heading in "
+            "degrees from north"
+        )
 
 
 def read_show_json(path: str | Path) -> dict[str, Any]:
@@ -308,6 +374,8 @@ def validate_show(show: Any) -> None:
         raise InputError(
             f"show.json: environment.type: got {env.get('type')!r}, expected one of {ENVIRONMENTS}"
         )
+    if "location" in env:
+        _check_location(env["location"])
     _check_validation(show.get("settings"))
     swarm = _obj("show.json: swarm", show.get("swarm"))
     drones = swarm.get("drones")
