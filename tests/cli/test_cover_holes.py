@@ -37,7 +37,8 @@ def test_a_field_with_a_hole_is_flown_around_it(tmp_path: Path) -> None:
     region = tmp_path / "holed.geojson"
     region.write_text(json.dumps({"type": "Polygon", "coordinates": [SHELL, HOLE]}))
     out = tmp_path / "out"
-    args = ["cover", str(region), "--out", str(out), "--pattern", "zigzag", "--width", "2"]
+    args = ["cover", str(region), "--crs", "local", "--out", str(out), "--pattern", "zigzag"]
+    args += ["--width", "2"]
     result = CliRunner().invoke(app, args)
     assert result.exit_code == 0, result.output
     xy, pen = _read(out)
@@ -66,7 +67,7 @@ def test_two_fields_in_one_wkt_are_one_flight(tmp_path: Path) -> None:
     )
     out = tmp_path / "out"
     result = CliRunner().invoke(
-        app, ["cover", str(region), "--out", str(out), "--pattern", "zigzag"]
+        app, ["cover", str(region), "--crs", "local", "--out", str(out), "--pattern", "zigzag"]
     )
     assert result.exit_code == 0, result.output
     xy, pen = _read(out)
@@ -91,7 +92,8 @@ def test_bad_holes_exit_2_naming_the_problem(
 ) -> None:
     region = tmp_path / "bad.geojson"
     region.write_text(json.dumps({"type": "Polygon", "coordinates": rings}))
-    result = CliRunner().invoke(app, ["cover", str(region), "--out", str(tmp_path / "o")])
+    args = ["cover", str(region), "--crs", "local", "--out", str(tmp_path / "o")]
+    result = CliRunner().invoke(app, args)
     assert result.exit_code == 2
     assert message in " ".join(result.output.split())
     assert "Traceback" not in result.output
