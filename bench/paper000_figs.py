@@ -71,7 +71,12 @@ def main() -> None:
         for name, strokes in inputs().items():
             results[name] = {}
             for mode in MODES:
-                options = WritingOptions(resegment=mode, resegment_iterations=30)  # type: ignore[arg-type]
+                # Paper 000 fits the vehicle's path (offset by the brush): its figures.
+                options = WritingOptions(
+                    resegment=mode,  # type: ignore[arg-type]
+                    resegment_iterations=30,
+                    follow="path",
+                )
                 missions[(name, mode)] = plan_writing(strokes, options=options)
                 results[name][mode] = measure(missions[(name, mode)])
     RESULTS.mkdir(parents=True, exist_ok=True)
