@@ -104,3 +104,32 @@ def export_base(rev: str, into: Path) -> Path:
     with tarfile.open(archive) as tar:
         tar.extractall(into / "base", filter="data")
     return into / "base" / "src"
+
+
+def toppra_path(curve: Any) -> Any:
+    """toppra's geometric path around a 2-D scipy ``BSpline`` on ``[0, 1]``; None without toppra.
+
+    The peer of the coverage speed LP (``bench/coverage_lp.py``, ``bench/coverage_scale.py``).
+    """
+    try:
+        import toppra as ta
+        from toppra.interpolator import AbstractGeometricPath
+    except ImportError:
+        return None
+    ta.setup_logging("WARNING")
+
+    class BSplinePath(AbstractGeometricPath):  # type: ignore[misc]
+        """toppra geometric-path adapter around the scipy ``BSpline``."""
+
+        def __call__(self, s: Any, order: int = 0) -> Any:
+            return np.asarray(curve(np.clip(np.asarray(s, dtype=float), 0.0, 1.0), order))
+
+        @property
+        def dof(self) -> int:
+            return 2
+
+        @property
+        def path_interval(self) -> Any:
+            return np.array([0.0, 1.0])
+
+    return BSplinePath()

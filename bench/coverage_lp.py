@@ -54,7 +54,7 @@ from typing import Any
 import numpy as np
 from threadpoolctl import threadpool_info, threadpool_limits
 
-from common import jsonable, machine_info, time_calls, time_stats
+from common import jsonable, machine_info, time_calls, time_stats, toppra_path
 from skyquill.coverage.paths import contours, spiral_control_points, spiral_curve
 from skyquill.coverage.regions import region_from_vertices
 from skyquill.coverage.speed import SpeedPlan, plan_speed
@@ -224,30 +224,12 @@ def plan_case(curve: Any, delta: float, runs: int) -> list[dict[str, Any]]:
 
 def toppra_case(curve: Any, runs: int) -> dict[str, Any] | None:
     """Case 4: jerk-off plan vs toppra on the same path and grid."""
-    try:
-        import toppra as ta
-        import toppra.algorithm as algo
-        from toppra import constraint
-        from toppra.interpolator import AbstractGeometricPath
-    except ImportError:
+    path = toppra_path(curve)
+    if path is None:
         return None
-    ta.setup_logging("WARNING")
+    import toppra.algorithm as algo
+    from toppra import constraint
 
-    class BSplinePath(AbstractGeometricPath):  # type: ignore[misc]
-        """toppra geometric-path adapter around the scipy ``BSpline``."""
-
-        def __call__(self, s: Any, order: int = 0) -> Any:
-            return np.asarray(curve(np.clip(np.asarray(s, dtype=float), 0.0, 1.0), order))
-
-        @property
-        def dof(self) -> int:
-            return 2
-
-        @property
-        def path_interval(self) -> Any:
-            return np.array([0.0, 1.0])
-
-    path = BSplinePath()
     vlim = np.array([[-100.0, 100.0]] * 2)
     alim = np.array([[-AMAX, AMAX]] * 2)
 

@@ -40,7 +40,7 @@ import numpy as np
 from shapely.geometry import box
 from threadpoolctl import threadpool_info, threadpool_limits
 
-from common import jsonable, machine_info, time_calls, time_stats
+from common import jsonable, machine_info, time_calls, time_stats, toppra_path
 from coverage_lp import spiral
 from skyquill.coverage.plan import CoverageOptions, CoveragePlan, plan_coverage
 from skyquill.coverage.speed import plan_speed
@@ -98,28 +98,11 @@ def growth(cases: list[dict[str, Any]]) -> dict[str, Any]:
 
 def _toppra(curve: Any, n: int) -> float | None:
     """Seconds toppra takes on ``curve`` at ``n`` grid points (jerk off), or None without it."""
-    try:
-        import toppra as ta
-        import toppra.algorithm as algo
-        from toppra import constraint
-        from toppra.interpolator import AbstractGeometricPath
-    except ImportError:
+    path = toppra_path(curve)
+    if path is None:
         return None
-    ta.setup_logging("WARNING")
-
-    class BSplinePath(AbstractGeometricPath):  # type: ignore[misc]
-        """toppra geometric-path adapter around the scipy ``BSpline``."""
-
-        def __call__(self, s: Any, order: int = 0) -> Any:
-            return np.asarray(curve(np.clip(np.asarray(s, dtype=float), 0.0, 1.0), order))
-
-        @property
-        def dof(self) -> int:
-            return 2
-
-        @property
-        def path_interval(self) -> Any:
-            return np.array([0.0, 1.0])
+    import toppra.algorithm as algo
+    from toppra import constraint
 
     limits = [
         constraint.JointVelocityConstraint(np.array([[-100.0, 100.0]] * 2)),
@@ -128,7 +111,7 @@ def _toppra(curve: Any, n: int) -> float | None:
     grid = np.linspace(0.0, 1.0, n)
     start = time.perf_counter()
     algo.TOPPRA(
-        limits, BSplinePath(), gridpoints=grid, parametrizer="ParametrizeConstAccel"
+        limits, path, gridpoints=grid, parametrizer="ParametrizeConstAccel"
     ).compute_trajectory(0, 0)
     return time.perf_counter() - start
 
