@@ -838,6 +838,7 @@ def resegmented(
             max_iter=opts.resegment_iterations,
             initial_result=plan.fit,  # the plan just made at these times: not solved again
             workspace=samples.workspace,
+            interior=True,  # each conic solve costs 10-50 closed forms
         )
     except InfeasibleError:
         return plan

@@ -201,7 +201,36 @@ def solve(
         (C, y), z, used, margin = _closed_form(asm), np.zeros(0), "sparse-lu", 0.0
         cone_z = None
         method = "closed_form"
-    elapsed = time.perf_counter() - start
+    solved = (C, (y, z, cone_z), used, margin, asm)
+    return _fit_result(problem, solved, method, time.perf_counter() - start, workspace)
+
+
+def solve_inside(problem: SmoothingProblem, workspace: Workspace) -> FitResult | None:
+    """``solve(problem)`` when no inequality binds at its optimum, else ``None`` (no QP).
+
+    The closed form subject to the equalities alone, kept only if it meets every
+    limit, corridor and cone exactly (:func:`solve`'s first route with a
+    workspace): a descent that only wants to stay where nothing binds
+    (:func:`~skyquill.optimize.resegment.resegment` with ``interior=True``)
+    asks this, and skips the conic solve of a point it would reject.
+    """
+    if not problem.has_inequalities:
+        return solve(problem, workspace=workspace)  # the closed form is the solve
+    start = time.perf_counter()
+    inside = _inside_optimum(problem, workspace)
+    if inside is None:
+        return None
+    return _fit_result(problem, inside, "closed_form", time.perf_counter() - start, workspace)
+
+
+def _fit_result(
+    problem: SmoothingProblem,
+    solved: _Solved,
+    method: Literal["closed_form", "qp"],
+    elapsed: float,
+    workspace: Workspace | None,
+) -> FitResult:
+    C, (y, z, cone_z), used, margin, asm = solved
     traj = SplineTrajectory(C, problem.degree, problem.duration)
     terms = problem_cost(problem, C, workspace.assembly if workspace is not None else None)
     return FitResult(

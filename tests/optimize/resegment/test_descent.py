@@ -133,3 +133,34 @@ def test_a_callers_workspace_carries_its_setup_into_the_run() -> None:
     assert workspace.assembly.hits >= shared.n_solves  # every solve re-used the blocks
     a, b = own.result.trajectory.control_points, shared.result.trajectory.control_points
     assert np.abs(a - b).max() <= 1e-8 * np.abs(a).max()
+
+
+def test_interior_descent_never_solves_a_conic_program(monkeypatch: pytest.MonkeyPatch) -> None:
+    """With ``interior=True`` and nothing binding at the start, every trial is the closed
+    form (a trial where a limit would bind is rejected unsolved): no conic program is
+    solved, the cost still falls, and the result meets the limits."""
+    import importlib
+
+    from skyquill.limits import vehicle_limits
+
+    solve_module = importlib.import_module("skyquill.optimize.solve")
+    pts, times = spiral(24)
+    free = solve(point_fit_factory(pts, 18)(times)).trajectory.sample(500.0)
+    peaks = (float(np.abs(x).max()) for x in (free.v, free.a, free.j))
+    limits = vehicle_limits(2, *(10.0 * p for p in peaks), None)  # the hull is looser
+    make = point_fit_factory(pts, 18, limits=limits)
+    first = solve(make(times), workspace=Workspace())
+    assert first.method == "closed_form"
+    calls: list[int] = []
+    original = solve_module._solve_qp
+
+    def counting(*args: object, **kwargs: object) -> object:
+        calls.append(1)
+        return original(*args, **kwargs)
+
+    monkeypatch.setattr(solve_module, "_solve_qp", counting)
+    out = resegment(pts, times, make, interior=True, max_iter=10)
+    assert calls == []
+    assert out.result.method == "closed_form"
+    assert out.cost <= first.cost
+    assert out.result.verification.max_excess <= 1e-9

@@ -55,7 +55,7 @@ from skyquill.optimize.resegment.problems import (
     zero_based,
 )
 from skyquill.optimize.resegment.results import Mode, ResegmentResult, Status
-from skyquill.optimize.solve import FitResult, solve
+from skyquill.optimize.solve import FitResult, solve, solve_inside
 from skyquill.optimize.workspace import Workspace
 from skyquill.solvers import DEFAULT_BACKEND
 from skyquill.validation import FloatArray, as_array, as_float, as_int
@@ -74,6 +74,7 @@ class _Search:
     solver: str
     total: float
     n_ctrl: int
+    interior: bool = False
     n_solves: int = 0
     grad_time: float = 0.0
     #: Every solve of the run shares it: the problems differ only in the times.
@@ -87,6 +88,9 @@ class _Search:
         problem = self.make_problem(tt)
         check_problem(problem, tt, self.n_ctrl)
         self.n_solves += 1
+        if self.interior:  # a point where a limit would bind is rejected unsolved
+            inside = solve_inside(problem, self.workspace)
+            return None if inside is None else (tt, inside)
         try:
             return tt, solve(problem, self.solver, workspace=self.workspace)
         except InfeasibleError:
@@ -173,6 +177,7 @@ def resegment(
     solver: str = DEFAULT_BACKEND,
     initial_result: FitResult | None = None,
     workspace: Workspace | None = None,
+    interior: bool = False,
 ) -> ResegmentResult:
     """Re-segment the point times by gradient descent (paper 000 §5.4).
 
@@ -223,6 +228,14 @@ def resegment(
         (:class:`~skyquill.optimize.workspace.Workspace`); a fresh one if
         ``None``. A caller that solved the first problem with a workspace
         passes it on, so that the run starts from its assembly and PIQP setup.
+    interior
+        Stay where no limit binds: when nothing binds at the initial times,
+        a trial whose optimum would touch a limit, a corridor or a cone is
+        rejected like an infeasible one (the step shrinks) without its conic
+        solve (:func:`~skyquill.optimize.solve.solve_inside`), so every solve
+        of the run is the closed form. The descent may stop earlier than it
+        would across the limits; a writing plan re-segmented from the home
+        (its long legs at the speed limit) spent 80 % of its time there.
 
     Returns
     -------
@@ -262,6 +275,7 @@ def resegment(
         t,
         initial_result,
     )
+    search.interior = interior and res.method == "closed_form"
     T = np.diff(t)
     F = search.objective(t, res)
     g = search.gradient(t, res)
