@@ -185,8 +185,8 @@ class WritingOptions:
         default) the swung brush tip, which leaves the ink (module
         docstring); ``"path"`` the untilted tip, i.e. the vehicle's path
         offset by the brush (paper 000), which is faster to plan and leaves
-        the ink up to a few centimetres off at these limits. Walls and a
-        zero-length brush are always ``"path"``.
+        the ink up to a few centimetres off at these limits. A wall is
+        always written by the path (the brush is not hanging there).
     resegment
         Time re-segmentation after the first feasible, faithful plan (paper
         000 §5.4): ``"fixed"`` keeps the total time, ``"free"`` lets it move
