@@ -378,6 +378,8 @@ def demo(out: OutDir = Path("out/demo"), force: Force = False) -> None:
         f"wrote 永 in {summary['duration_s']:.1f} s of flight "
         f"(planned in {summary['planning_time_s']:.2f} s, pen-down deviation "
         f"{1e3 * summary['deviation']['max_m']:.2f} mm, max excess {summary['max_excess']:.1e}); "
-        f"flown with RPT: RMSE {1e3 * flight['rmse_m']:.2f} mm.\n"
-        f"  {out / 'plot.png'}\n  {out / 'summary.json'}\n  {out / 'trajectory.csv'}"
+        f"flown with RPT: RMSE {1e3 * flight['rmse_m']:.2f} mm, the ink within "
+        f"{1e3 * flight['ink_max_deviation_m']:.2f} mm, IoU {flight['ink_iou']:.2f}.\n"
+        f"  {out / 'plot.png'}\n  {out / 'ink.png'}\n  {out / 'summary.json'}\n"
+        f"  {out / 'trajectory.csv'}"
     )
