@@ -19,14 +19,15 @@ the latitude/longitude, not to the local numbers.)
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
 
 from skyquill.coverage.geo import GeoFrame
 from skyquill.errors import InputError
-from skyquill.export.base import ExportOptions, ExportReport, NamedPlan, check_delivered, target
+from skyquill.export.base import ExportOptions, ExportReport, NamedPlan
+from skyquill.export.samples import SampledExporter
 from skyquill.io.points import trajectory_table
 from skyquill.io.px4 import check_stream_rate, enu_to_ned, yaw_enu_to_ned_deg
 from skyquill.io.table import read_table
@@ -107,23 +108,20 @@ class Px4GlobalExporter:
                 "origin: got none, expected a plan with a geographic origin (a cover plan of "
                 "a GeoJSON field in longitude/latitude or a projected CRS) for px4-global"
             )
-        files, checks = [], []
-        for name, planned in plans:
-            path = target(out, name, len(plans) > 1, self.suffix)
-            write_px4_global(planned.trajectory, path, options.rate_hz, options.origin)
-            checks.append(check_delivered(name, planned, read_px4_global(path, options.origin)))
-            files.append(path)
         origin = options.origin
-        return ExportReport(
-            self.name,
-            tuple(files),
-            exact=False,
-            max_error_m=max(c.max_error_m for c in checks),
-            message=f"wrote {len(files)} PX4 global setpoint file(s) at {options.rate_hz:g} Hz "
-            f"around lat {origin.lat_deg:.7f}, lon {origin.lon_deg:.7f}: "
-            + ", ".join(f.name for f in files),
-            details={"rate_hz": options.rate_hz, "origin": origin.as_dict()},
-            delivered=tuple(checks),
+
+        def write(traj: Trajectory, path: Path, rate_hz: float) -> SampledTrajectory:
+            write_px4_global(traj, path, rate_hz, origin)
+            return read_px4_global(path, origin)
+
+        # The sampled formats' loop: one file a drone, read back, checked against the plan.
+        report = SampledExporter(self.name, self.suffix, self.help, write)(plans, out, options)
+        return replace(
+            report,
+            message=f"wrote {len(report.files)} PX4 global setpoint file(s) at "
+            f"{options.rate_hz:g} Hz around lat {origin.lat_deg:.7f}, "
+            f"lon {origin.lon_deg:.7f}: " + ", ".join(f.name for f in report.files),
+            details=report.details | {"origin": origin.as_dict()},
         )
 
 
