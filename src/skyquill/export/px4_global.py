@@ -29,24 +29,13 @@ from skyquill.errors import InputError
 from skyquill.export.base import ExportOptions, ExportReport, NamedPlan
 from skyquill.export.samples import SampledExporter
 from skyquill.io.points import trajectory_table
-from skyquill.io.px4 import check_stream_rate, enu_to_ned, yaw_enu_to_ned_deg
+from skyquill.io.px4 import PX4_COLUMNS, check_stream_rate, enu_to_ned, yaw_enu_to_ned_deg
 from skyquill.io.table import read_table
 from skyquill.trajectory import SampledTrajectory, Trajectory
 
-#: Header of the global setpoint CSV (MAVLink ``SET_POSITION_TARGET_GLOBAL_INT`` fields).
-PX4_GLOBAL_COLUMNS = (
-    "t",
-    "lat_int",
-    "lon_int",
-    "alt_rel_m",
-    "v_north",
-    "v_east",
-    "v_down",
-    "a_north",
-    "a_east",
-    "a_down",
-    "yaw_deg",
-)
+#: Header of the global setpoint CSV (MAVLink ``SET_POSITION_TARGET_GLOBAL_INT`` fields):
+#: the position as the link carries it, then velocity, acceleration and yaw as the NED CSV.
+PX4_GLOBAL_COLUMNS = ("t", "lat_int", "lon_int", "alt_rel_m", *PX4_COLUMNS[4:])
 #: MAVLink's integer latitude/longitude unit, degrees.
 DEG_E7 = 1e-7
 
