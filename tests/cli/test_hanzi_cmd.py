@@ -35,3 +35,9 @@ def test_write_names_a_missing_character_and_the_alternatives(tmp_path: Path) ->
     text = " ".join(result.output.split())
     assert "'𠀀' (U+20000) not found" in text and "--hanzi FILE|DIR" in text
     assert "Traceback" not in result.output
+
+
+def test_an_empty_text_is_refused_in_one_line() -> None:
+    result = runner.invoke(app, ["hanzi", "  "])
+    assert result.exit_code == 2
+    assert "text: got '  ', expected characters to look up" in " ".join(result.output.split())

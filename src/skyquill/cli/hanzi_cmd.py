@@ -8,6 +8,7 @@ from typing import Annotated
 import typer
 
 from skyquill.cli.main import app, user_errors
+from skyquill.errors import InputError
 
 #: Characters per line of the listing.
 LINE = 40
@@ -33,6 +34,10 @@ def hanzi(
             typer.echo(f"{source}, by code point:")
             typer.echo("\n".join(textwrap.wrap(chars, LINE)))
             return
+        if not text.strip():
+            raise InputError(
+                f"text: got {text!r}, expected characters to look up (or none, to list them all)"
+            )
         missing = missing_hanzi(text)
         if not missing:
             typer.echo(f"all of {text.strip()!r} are among the {source}")
