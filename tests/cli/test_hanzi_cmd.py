@@ -40,4 +40,4 @@ def test_write_names_a_missing_character_and_the_alternatives(tmp_path: Path) ->
 def test_an_empty_text_is_refused_in_one_line() -> None:
     result = runner.invoke(app, ["hanzi", "  "])
     assert result.exit_code == 2
-    assert "text: got '  ', expected characters to look up" in " ".join(result.output.split())
+    assert "text: got '  ', expected characters to look up" in result.output
