@@ -12,7 +12,7 @@ import time
 from typing import Any
 
 
-def slow_planner(request: Any, *, progress: Any, file_url: Any) -> Any:
+def slow_planner(request: Any, *, progress: Any, file_url: Any, plan_id: str) -> Any:
     """Reports progress forever (until the studio kills it)."""
     for i in range(10_000):
         progress(min(0.99, i / 1000), f"step {i}")
@@ -20,14 +20,14 @@ def slow_planner(request: Any, *, progress: Any, file_url: Any) -> Any:
     raise AssertionError("the studio should have stopped this plan")
 
 
-def crashing_planner(request: Any, *, progress: Any, file_url: Any) -> Any:
+def crashing_planner(request: Any, *, progress: Any, file_url: Any, plan_id: str) -> Any:
     """Dies of a segmentation fault after reporting a little progress."""
     progress(0.1, "about to crash")
     os.kill(os.getpid(), signal.SIGSEGV)
     time.sleep(10.0)  # never reached: the signal kills the process
 
 
-def refusing_planner(request: Any, *, progress: Any, file_url: Any) -> Any:
+def refusing_planner(request: Any, *, progress: Any, file_url: Any, plan_id: str) -> Any:
     """Refuses every request the way skyquill refuses bad input."""
     from skyquill.errors import InfeasibleError
 

@@ -65,7 +65,7 @@ def _wait(client: TestClient, url: str, timeout: float = 30.0) -> list[dict[str,
     seen, deadline = [], time.monotonic() + timeout
     while time.monotonic() < deadline:
         seen.append(client.get(url).json())
-        if seen[-1]["state"] in ("done", "error"):
+        if seen[-1]["state"] in ("done", "error", "cancelled"):
             return seen
         time.sleep(0.05)
     raise AssertionError(f"job {url} did not end in {timeout} s: {seen[-1]}")
@@ -94,7 +94,7 @@ def test_a_plan_of_two_strokes(planned: dict[str, Any]) -> None:
     assert down[:, 2].min() >= -0.02 and down[:, 2].max() < 2e-3
     assert drone["deviation_max_m"] <= 0.005 + 1e-9
     assert drone["flight_rmse_m"] < 0.02
-    names = [f["name"] for f in result["files"]]
+    names = [f["kind"] for f in result["files"]]
     assert names[0] == "setpoints.csv" and "show.skyc" in names and "summary.json" in names
     # A plan that does not fit a Crazyflie's uploads lists its Crazyswarm download as unavailable.
     if not any(n.startswith("crazyswarm") for n in names):
@@ -113,7 +113,7 @@ def test_the_flight_measures_its_ink(planned: dict[str, Any]) -> None:
 
 def test_the_files_read_back(client: TestClient, planned: dict[str, Any], tmp_path: Path) -> None:
     """Setpoints, Crazyswarm uploads and the .skyc show agree with each other."""
-    files = {f["name"]: client.get(f["url"]) for f in planned["result"]["files"]}
+    files = {f["kind"]: client.get(f["url"]) for f in planned["result"]["files"]}
     assert all(r.status_code == 200 for r in files.values())
     assert "attachment" in files["setpoints.csv"].headers["content-disposition"]
     rows = list(csv.reader(io.StringIO(files["setpoints.csv"].text)))
@@ -154,7 +154,7 @@ def test_typed_text_for_two_drones(client: TestClient) -> None:
     assert result["source"] == "text" and len(result["drones"]) == 2
     assert result["drones"][1]["board_u0"] > result["size_m"]
     assert result["min_separation_m"] >= 1.0
-    files = {f["name"]: f for f in result["files"]}
+    files = {f["kind"]: f for f in result["files"]}
     archive = zipfile.ZipFile(io.BytesIO(client.get(files["setpoints.zip"]["url"]).content))
     assert sorted(archive.namelist()) == ["setpoints_1.csv", "setpoints_2.csv"]
 
@@ -246,7 +246,9 @@ def test_an_infeasible_request_is_a_clear_message_not_a_500(client: TestClient) 
 def test_unknown_jobs_and_files_are_404(client: TestClient, planned: dict[str, Any]) -> None:
     job = planned["job_id"]
     assert client.get(f"/api/jobs/{'0' * 32}").status_code == 404
-    assert client.get(f"/api/jobs/{job}/files/flight.csv").status_code == 404
+    plan_id = planned["result"]["plan_id"]
+    assert client.get(f"/api/jobs/{job}/files/skyquill-{plan_id}-flight.csv").status_code == 404
+    assert client.get(f"/api/jobs/{job}/files/setpoints.csv").status_code in (404, 422)
     # Anything that is not a job id or a file name is refused before any lookup.
     assert client.get("/api/jobs/..%2F..%2Fetc").status_code in (404, 422)
     assert client.get(f"/api/jobs/{job}/files/..%2Fsetpoints.csv").status_code in (404, 422)
@@ -315,3 +317,116 @@ def test_a_refused_job_says_why_and_old_jobs_are_forgotten() -> None:
             assert end["message"] == "limits: nothing can be planned here (a test planner)"
         assert client.get(urls[0]).status_code == 404  # the oldest, forgotten
         assert [client.get(u).status_code for u in urls[1:]] == [200, 200]
+
+
+def test_every_download_carries_the_plan_id(client: TestClient, planned: dict[str, Any]) -> None:
+    """One id per plan: in each file's name, its Content-Disposition and summary.json."""
+    result = planned["result"]
+    plan_id = result["plan_id"]
+    assert len(plan_id) == 12 and planned["job_id"].startswith(plan_id)
+    for file in result["files"]:
+        assert file["name"] == f"skyquill-{plan_id}-{file['kind']}"
+        answer = client.get(file["url"])
+        assert (
+            f'filename="skyquill-{plan_id}-{file["kind"]}"' in answer.headers["content-disposition"]
+        )
+    summary_url = next(f["url"] for f in result["files"] if f["kind"] == "summary.json")
+    assert client.get(summary_url).json()["plan_id"] == plan_id
+
+
+def test_the_summary_records_the_request_and_the_simulated_flight(
+    client: TestClient, planned: dict[str, Any]
+) -> None:
+    """summary.json says what was asked (limits, board, size, drones, options) and what flew."""
+    result = planned["result"]
+    summary_url = next(f["url"] for f in result["files"] if f["kind"] == "summary.json")
+    summary = client.get(summary_url).json()
+    assert summary["request"] == {
+        "board": "horizontal",
+        "size_m": 0.5,
+        "vmax": 1.0,
+        "amax": 2.0,
+        "jmax": 10.0,
+        "drones": 1,
+        "fly": True,
+        "strokes": 2,
+        "points": 8,
+        "timestamps": True,
+    }
+    (flown,) = summary["simulated_flight"]
+    (drone,) = result["drones"]
+    assert flown["duration_s"] == drone["duration_s"]
+    assert flown["path_rmse_m"] == drone["flight_rmse_m"]
+    assert flown["ink_max_deviation_m"] == drone["ink_max_deviation_m"]
+    assert flown["ink_iou"] == drone["ink_iou"]
+    assert flown["limit_excess"] <= 1e-9
+    # The ink is drawn as wide as the brush's footprint at its press (Brush defaults).
+    assert flown["ink_width_m"] == pytest.approx(0.002 + 2.0 * 0.005)
+
+
+def test_an_estimate_is_cheap_and_warns_of_a_slow_flight(client: TestClient) -> None:
+    """/api/estimate plans nothing; at 1 cm/s it warns of the flight and the uploads."""
+    start = time.perf_counter()
+    usual = client.post("/api/estimate", json=TWO_STROKES)
+    slow = client.post("/api/estimate", json=TWO_STROKES | {"vmax": 0.01})
+    assert time.perf_counter() - start < 2.0
+    assert usual.status_code == slow.status_code == 200
+    assert usual.json()["warnings"] == []
+    guess = slow.json()
+    assert guess["flight_time_s"] > 50 * usual.json()["flight_time_s"]  # mostly length / vmax
+    assert guess["path_length_m"] == usual.json()["path_length_m"]
+    assert guess["crazyflie_uploads"] > 20 and guess["setpoint_bytes"] > 1_000_000
+    assert [w.split(" ")[:3] for w in guess["warnings"]] == [
+        ["a", "flight", "of"],
+        ["about", f"{guess['crazyflie_uploads']:,}", "Crazyflie"],
+    ]
+
+
+def test_the_estimate_is_a_lower_bound_of_the_flight(
+    client: TestClient, planned: dict[str, Any]
+) -> None:
+    guess = client.post("/api/estimate", json=TWO_STROKES).json()
+    assert 0.3 * planned["result"]["duration_s"] < guess["flight_time_s"]
+    assert guess["flight_time_s"] <= planned["result"]["duration_s"]
+
+
+def test_a_running_plan_is_cancelled() -> None:
+    """DELETE kills the planning process; the job ends "cancelled" at once."""
+    with _client(planner=slow_planner, time_limit_s=30.0) as client:
+        accepted = client.post("/api/plan", json=TWO_STROKES).json()
+        while client.get(accepted["url"]).json()["progress"] == 0.0:
+            time.sleep(0.02)
+        start = time.monotonic()
+        assert client.delete(accepted["url"]).status_code == 200
+        end = _wait(client, accepted["url"], timeout=5.0)[-1]
+        assert end["state"] == "cancelled" and time.monotonic() - start < 2.0
+        assert end["result"] is None
+        # The studio is free again: a new plan is accepted.
+        assert client.post("/api/plan", json=TWO_STROKES).status_code == 202
+        assert client.delete(f"/api/jobs/{'0' * 32}").status_code == 404
+
+
+def test_a_time_out_says_what_made_the_plan_long() -> None:
+    """At 1 cm/s the flight is the cause, and the message says so (not the drawing's size)."""
+    with _client(time_limit_s=1.0, planner=slow_planner) as client:
+        answer = client.post("/api/plan?wait=true", json=TWO_STROKES | {"vmax": 0.01})
+        detail = answer.json()["detail"]
+        assert "a flight of at least" in detail and "at 0.01 m/s" in detail
+        assert "raise the speed limit" in detail
+
+
+@pytest.mark.parametrize(
+    ("body", "field"),
+    [
+        (TWO_STROKES | {"vmax": -1}, "vmax"),
+        (TWO_STROKES | {"size_m": 9.0}, "size_m"),
+        ({"text": "é"}, "text"),
+        ({"text": "Hi", "drones": 3}, "drones"),
+        ({"strokes": [[[0, 0], [0, 0]]]}, "strokes"),
+    ],
+)
+def test_an_error_names_its_field(client: TestClient, body: Any, field: str) -> None:
+    """The page highlights the field an error is about: the JSON says which."""
+    answer = client.post("/api/plan", json=body)
+    assert answer.status_code == 422
+    assert answer.json()["field"] == field

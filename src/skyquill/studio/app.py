@@ -4,18 +4,26 @@ Routes
 ------
 ``GET /``
     The page (``static/index.html``; its script and style under ``/static``).
+``POST /api/estimate``
+    A :class:`~skyquill.studio.models.PlanRequest`; answers its
+    :class:`~skyquill.studio.models.Estimate` (route length, flight time,
+    uploads, warnings) without planning.
 ``POST /api/plan``
     A :class:`~skyquill.studio.models.PlanRequest`; answers 202 with a job id
     (or, with ``?wait=true``, the finished job, or 422 if it cannot be planned).
 ``GET /api/jobs/{job_id}``
     State, progress and, once done, the result.
+``DELETE /api/jobs/{job_id}``
+    Cancel the job (its planning process is killed); answers its status.
 ``GET /api/jobs/{job_id}/files/{name}``
-    A generated download (``setpoints.csv``, ``crazyswarm.csv``, ``show.skyc``, ...).
+    A generated download, ``skyquill-<plan id>-<kind>`` (kinds ``setpoints.csv``,
+    ``crazyswarm.zip``, ``show.skyc``, ``summary.json``, ...).
 ``GET /docs``, ``GET /openapi.json``
     FastAPI's OpenAPI description (``/docs`` loads Swagger UI's assets from
     its CDN; ``/openapi.json`` works offline).
 
-Errors are JSON ``{"detail": "<one readable line>"}``: 422 for anything the
+Errors are JSON ``{"detail": "<one readable line>", "field": <name or null>}``
+(``field``: the request field it is about, for the page to point at): 422 for anything the
 person sent that cannot be planned, 413 for a body over the size limit, 429
 when busy, 404 for an unknown job or file. No route takes a file-system path.
 """
@@ -38,9 +46,9 @@ from starlette.middleware.trustedhost import TrustedHostMiddleware
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 from skyquill.errors import SkyquillError
+from skyquill.studio.estimate import estimate
 from skyquill.studio.jobs import BusyError, Job, JobManager
-from skyquill.studio.models import JobAccepted, JobStatus, PlanRequest
-from skyquill.studio.planner import parts_of
+from skyquill.studio.models import Estimate, JobAccepted, JobStatus, PlanRequest, field_of
 
 #: Largest request body, bytes: 20,000 points of two 20-character numbers, with room.
 MAX_BODY_BYTES = 1_000_000
@@ -54,7 +62,11 @@ MAX_LISTED_ERRORS = 4
 
 JOB_ID = Annotated[str, Path(pattern=r"^[0-9a-f]{32}$", description="A job id from /api/plan.")]
 FILE_NAME = Annotated[
-    str, Path(pattern=r"^[a-z_]{1,32}\.(csv|zip|skyc|json)$", description="A file of the job.")
+    str,
+    Path(
+        pattern=r"^skyquill-[0-9a-f]{12}-[a-z_]{1,32}\.(csv|zip|skyc|json)$",
+        description="A file of the job.",
+    ),
 ]
 
 
@@ -167,6 +179,14 @@ def _add_routes(app: FastAPI, manager: JobManager) -> None:
         return HTMLResponse(html.read_text(encoding="utf-8"))
 
     @app.post(
+        "/api/estimate",
+        responses={422: {"description": "Malformed request; `detail` says why."}},
+    )
+    async def estimate_plan(request: PlanRequest) -> Estimate:
+        """How long the flight would be, its uploads and files: no planning, milliseconds."""
+        return await run_in_threadpool(estimate, request)
+
+    @app.post(
         "/api/plan",
         status_code=status.HTTP_202_ACCEPTED,
         response_model=JobAccepted,
@@ -182,8 +202,9 @@ def _add_routes(app: FastAPI, manager: JobManager) -> None:
         wait: Annotated[bool, Query(description="Answer when planned (200) or 422.")] = False,
     ) -> JobAccepted | JSONResponse:
         """Start planning a drawing or text; poll the job (or ``?wait=true``)."""
-        await run_in_threadpool(parts_of, request)  # malformed strokes: 422 now, not later
-        job = manager.submit(request)
+        # Malformed strokes: 422 now, not later; the estimate explains a time-out.
+        guess = await run_in_threadpool(estimate, request)
+        job = manager.submit(request, guess)
         if not wait:
             return JobAccepted(job_id=job.id, url=f"/api/jobs/{job.id}")
         await manager.wait(job)
@@ -197,6 +218,13 @@ def _add_routes(app: FastAPI, manager: JobManager) -> None:
         """A job's state, progress, message and (once done) result."""
         return _job(manager, job_id).status()
 
+    @app.delete("/api/jobs/{job_id}", responses={404: {"description": "Unknown job."}})
+    def cancel_job(job_id: JOB_ID) -> JobStatus:
+        """Cancel a queued or running job (its process is killed); a finished one stays."""
+        job = _job(manager, job_id)
+        manager.cancel(job)
+        return job.status()
+
     @app.get(
         "/api/jobs/{job_id}/files/{name}",
         response_class=Response,
@@ -208,7 +236,7 @@ def _add_routes(app: FastAPI, manager: JobManager) -> None:
         file = job.output.files.get(name) if job.output is not None else None
         if file is None:
             raise HTTPException(404, f"file: got {name!r}, not a file of job {job_id}")
-        disposition = f'attachment; filename="{file.name}"'
+        disposition = f'attachment; filename="{name}"'
         return Response(
             file.data, media_type=file.media_type, headers={"Content-Disposition": disposition}
         )
@@ -228,10 +256,11 @@ class _UnplannableError(Exception):
 def _add_error_handlers(app: FastAPI) -> None:
     async def validation(_: Request, exc: Exception) -> JSONResponse:
         errors = exc.errors() if isinstance(exc, RequestValidationError) else []
-        return _detail(422, describe_errors(errors), errors=_plain(errors))
+        message = describe_errors(errors)
+        return _detail(422, message, field=_field(errors, message), errors=_plain(errors))
 
     async def user_error(_: Request, exc: Exception) -> JSONResponse:
-        return _detail(422, str(exc))
+        return _detail(422, str(exc), field=field_of(str(exc)))
 
     async def busy(_: Request, exc: Exception) -> JSONResponse:
         return _detail(429, str(exc), headers={"Retry-After": "5"})
@@ -321,6 +350,14 @@ def _describe(error: Any) -> str:
     expected = message.removeprefix("Input should be ")
     expected = expected[0].lower() + expected[1:] if expected else "something else"
     return f"{where}: got {_short.repr(error.get('input'))}, expected {expected}"
+
+
+def _field(errors: Sequence[Any], message: str) -> str | None:
+    """The request field the first error is about: its location, else its message's name."""
+    loc = list(errors[0].get("loc", ())) if errors else []
+    if len(loc) > 1 and loc[0] == "body" and isinstance(loc[1], str):
+        return field_of(loc[1])
+    return field_of(message)
 
 
 def _plain(errors: Sequence[Any]) -> list[dict[str, Any]]:

@@ -35,12 +35,13 @@ from multiprocessing.connection import Connection
 from typing import Any
 
 from skyquill.errors import SkyquillError
-from skyquill.studio.models import JobState, JobStatus, PlanRequest
+from skyquill.studio.estimate import WARN_FLIGHT_S
+from skyquill.studio.models import Estimate, JobState, JobStatus, PlanRequest, field_of
 from skyquill.studio.planner import PlanOutput, run_plan
 
 logger = logging.getLogger(__name__)
 
-#: A planner: the request, a progress callback and the URL of a file by its name.
+#: A planner: the request, a progress callback, the URL of a file by its name, the plan id.
 Planner = Callable[..., PlanOutput]
 
 
@@ -52,6 +53,9 @@ class BusyError(Exception):
 PRELOAD = ("skyquill.studio.planner", "skyquill.cli.main", "skyquill.sim", "skyquill.io.skyc")
 #: How often a supervisor checks its child's messages, liveness and time, s.
 POLL_S = 0.05
+#: Hex digits of the job id that make the plan id (in file names): 48 bits, so two
+#: plans of one studio share one with a chance of 1 in 10^14.
+PLAN_ID_DIGITS = 12
 
 
 @dataclass
@@ -69,11 +73,18 @@ class Job:
     output: PlanOutput | None = None
     finished: float | None = None
     future: Future[None] | None = None
+    estimate: Estimate | None = None
+    cancel_requested: bool = False
 
     @property
     def active(self) -> bool:
         """Queued or running."""
         return self.state in ("queued", "running")
+
+    @property
+    def plan_id(self) -> str:
+        """The plan's identifier, in its files' names."""
+        return self.id[:PLAN_ID_DIGITS]
 
     def status(self) -> JobStatus:
         """The JSON the page polls."""
@@ -84,6 +95,7 @@ class Job:
             progress=self.progress,
             stage=self.stage,
             message=self.message,
+            field=field_of(self.message) if self.state == "error" else None,
             elapsed_s=round(end - self.created, 3),
             result=self.output.result if self.output is not None else None,
         )
@@ -127,8 +139,11 @@ class JobManager:
         self._context = multiprocessing.get_context("forkserver")
         self._context.set_forkserver_preload(list(PRELOAD))
 
-    def submit(self, request: PlanRequest) -> Job:
-        """Queue a plan of ``request``; raise :class:`BusyError` when too many are active."""
+    def submit(self, request: PlanRequest, estimate: Estimate | None = None) -> Job:
+        """Queue a plan of ``request``; raise :class:`BusyError` when too many are active.
+
+        ``estimate`` (of the request) explains a time-out: what made the plan long.
+        """
         with self._lock:
             self._expire()
             if sum(job.active for job in self._jobs.values()) >= self._max_active:
@@ -136,10 +151,22 @@ class JobManager:
                     f"the studio is busy with {self._max_active} plans; try again in a moment"
                 )
             job = Job(uuid.uuid4().hex, request, time.monotonic() + self.time_limit_s)
+            job.estimate = estimate
             self._jobs[job.id] = job
             self._forget_old()
         job.future = self._executor.submit(self._run, job)
         return job
+
+    def cancel(self, job: Job) -> None:
+        """Stop ``job``: a queued one at once, a running one by killing its process.
+
+        The job ends ``"cancelled"`` (a finished one is left as it is); its
+        supervisor sees the request within :data:`POLL_S` and kills the child.
+        """
+        with self._lock:
+            job.cancel_requested = True
+            if job.state == "queued":
+                self._finish(job, "cancelled", "cancelled before it started")
 
     def get(self, job_id: str) -> Job | None:
         """The job ``job_id``, or ``None`` if unknown or forgotten."""
@@ -176,7 +203,7 @@ class JobManager:
         receiver, sender = self._context.Pipe(duplex=False)
         child = self._context.Process(
             target=_child_main,
-            args=(self._planner, job.request, job.id, sender),
+            args=(self._planner, job.request, job.id, job.plan_id, sender),
             name=f"skyquill-plan-{job.id[:8]}",
             daemon=True,
         )
@@ -199,8 +226,11 @@ class JobManager:
     def _supervise(self, job: Job, child: Any, receiver: Connection) -> None:
         """Relay the child's messages until it reports an end, dies or runs out of time."""
         while True:
+            if job.cancel_requested:
+                self._end(job, "cancelled", "cancelled")
+                return
             if self._closed or time.monotonic() > job.deadline:
-                self._end(job, "error", self._timeout_message())
+                self._end(job, "error", self._timeout_message(job))
                 return
             try:
                 ready = receiver.poll(POLL_S)
@@ -231,17 +261,36 @@ class JobManager:
         with self._lock:
             if not job.active:
                 return  # already failed by its time limit: drop the late result
-            job.state, job.message, job.output = state, message, output
-            job.finished = time.monotonic()
-            if state == "done":
-                job.progress, job.stage = 1.0, "done"
+            self._finish(job, state, message, output)
 
-    def _timeout_message(self) -> str:
+    @staticmethod
+    def _finish(job: Job, state: JobState, message: str, output: PlanOutput | None = None) -> None:
+        """Record the end of ``job`` (caller holds the lock)."""
+        job.state, job.message, job.output = state, message, output
+        job.finished = time.monotonic()
+        if state == "done":
+            job.progress, job.stage = 1.0, "done"
+        elif state == "cancelled":
+            job.stage = "cancelled"
+
+    def _timeout_message(self, job: Job) -> str:
+        """Why the plan stopped, with what made it long when the estimate says."""
         if self._closed:
             return "the studio was shut down before the plan finished"
+        limit = f"planning took longer than the studio's limit of {self.time_limit_s:g} s"
+        guess, request = job.estimate, job.request
+        if guess is None:
+            return f"{limit}; draw or type less, use fewer drones or raise the limits"
+        flight = (
+            f"a flight of at least {guess.flight_time_s:,.0f} s "
+            f"({guess.path_length_m:.1f} m of route at {request.vmax:g} m/s)"
+        )
+        if guess.flight_time_s > WARN_FLIGHT_S:  # long because slow: the speed is the cause
+            return f"{limit}: {flight} is long to plan; raise the speed limit or draw less"
+        what = f"{len(request.strokes)} strokes" if request.strokes else f"{request.text!r}"
         return (
-            f"planning took longer than the studio's limit of {self.time_limit_s:g} s; "
-            "draw or type less, or use fewer drones"
+            f"{limit} for {what} on {request.drones} drone(s), {flight}; "
+            "draw or type less, or use more drones"
         )
 
     def _expire(self) -> None:
@@ -249,7 +298,7 @@ class JobManager:
         now = time.monotonic()
         for job in self._jobs.values():
             if job.active and now > job.deadline:
-                job.state, job.message, job.finished = "error", self._timeout_message(), now
+                job.state, job.message, job.finished = "error", self._timeout_message(job), now
 
     def _forget_old(self) -> None:
         """Drop the oldest finished jobs beyond ``max_kept`` (caller holds the lock)."""
@@ -263,14 +312,16 @@ def _file_url(job_id: str) -> Callable[[str], str]:
     return lambda name: f"/api/jobs/{job_id}/files/{name}"
 
 
-def _child_main(planner: Planner, request: PlanRequest, job_id: str, sender: Connection) -> None:
+def _child_main(
+    planner: Planner, request: PlanRequest, job_id: str, plan_id: str, sender: Connection
+) -> None:
     """The child process: plan, sending progress and then one end message."""
 
     def progress(fraction: float, stage: str) -> None:
         sender.send(("progress", fraction, stage))
 
     try:
-        output = planner(request, progress=progress, file_url=_file_url(job_id))
+        output = planner(request, progress=progress, file_url=_file_url(job_id), plan_id=plan_id)
     except SkyquillError as exc:  # the person's input: say why, in their terms
         sender.send(("error", str(exc)))
     except Exception as exc:  # a bug: traceback to the server's log, a short line to the page

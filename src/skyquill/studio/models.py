@@ -8,6 +8,7 @@ for a bounded amount of planning.
 
 from __future__ import annotations
 
+import re
 from typing import Annotated, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator
@@ -118,7 +119,51 @@ class PlanRequest(BaseModel):
         return self
 
 
-JobState = Literal["queued", "running", "done", "error"]
+JobState = Literal["queued", "running", "done", "error", "cancelled"]
+
+#: The page's label of each request field, for messages a person reads (the API's
+#: errors name the field as the JSON does; the page shows these and highlights the field).
+FIELD_LABELS = {
+    "strokes": "Drawing",
+    "t": "Drawing",
+    "text": "Text",
+    "board": "Surface",
+    "size_m": "Size of the writing, m",
+    "drones": "Drones",
+    "vmax": "Speed, m/s",
+    "amax": "Acceleration, m/s²",
+    "jmax": "Jerk, m/s³",
+    "fly": "Fly it in simulation",
+}
+
+#: Words a message may start with that are about one field without being its name.
+FIELD_ALIASES = {"stroke": "strokes", "times": "t"}
+_LEADING_NAME = re.compile(r"([a-z_]+)")
+
+
+def field_of(message: str) -> str | None:
+    """The request field a ``"name: got X, expected Y"`` message is about, if it is one."""
+    found = _LEADING_NAME.match(message)
+    if found is None:
+        return None
+    name = FIELD_ALIASES.get(found.group(1), found.group(1))
+    return name if name in FIELD_LABELS else None
+
+
+class Estimate(BaseModel):
+    """What a request would plan, from its route alone (no solve): seconds to compute.
+
+    The flight time is a lower bound (the route's length at the speed limit,
+    plus a stop at the acceleration limit per stroke); the planner may stretch
+    it. ``warnings`` are the thresholds it crosses
+    (:data:`~skyquill.studio.planner.WARN_FLIGHT_S`, ...), for a person.
+    """
+
+    path_length_m: float = Field(description="Longest drone's route (strokes, lifts, legs), m.")
+    flight_time_s: float = Field(description="Longest drone's flight at the limits, at least, s.")
+    crazyflie_uploads: int = Field(description="Crazyflie uploads of the longest drone, about.")
+    setpoint_bytes: int = Field(description="Size of the setpoint CSV(s), about, bytes.")
+    warnings: list[str]
 
 
 class Limits(BaseModel):
@@ -167,6 +212,9 @@ class DronePlan(BaseModel):
     deviation_max_m: float
     checks: list[LimitReport]
     flight_rmse_m: float | None = None
+    ink_width_m: float = Field(
+        description="Width of the planned strokes' ink (the brush's footprint at its press), m."
+    )
     ink_max_deviation_m: float | None = Field(
         default=None,
         description="Two-sided distance between the simulated ink and the input strokes in "
@@ -182,7 +230,8 @@ class DronePlan(BaseModel):
 class DownloadFile(BaseModel):
     """A file the page offers for download."""
 
-    name: str
+    name: str = Field(description="``skyquill-<plan id>-<kind>``: the name it downloads as.")
+    kind: str = Field(description="What it is, the same in every plan (``setpoints.csv``).")
     url: str
     description: str
     size_bytes: int
@@ -191,6 +240,7 @@ class DownloadFile(BaseModel):
 class PlanResult(BaseModel):
     """Everything the page shows after a plan."""
 
+    plan_id: str = Field(description="In every download's name and in summary.json.")
     source: Literal["strokes", "text"]
     board: Literal["horizontal", "wall"]
     size_m: float
@@ -218,5 +268,8 @@ class JobStatus(BaseModel):
     progress: float = Field(ge=0.0, le=1.0)
     stage: str
     message: str = ""
+    field: str | None = Field(
+        default=None, description="The request field an error is about (None: no one field)."
+    )
     elapsed_s: float
     result: PlanResult | None = None

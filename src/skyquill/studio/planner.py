@@ -62,6 +62,12 @@ DECIMALS = 4
 #: ``progress(fraction, stage)``; it may raise to stop the plan (time limit).
 Progress = Callable[[float, str], None]
 
+#: Share of the progress bar for planning one drone against flying it: the solves
+#: (stretches, re-segmentation) take about three times the closed-loop flight.
+PLAN_WEIGHT, FLY_WEIGHT = 3.0, 1.0
+#: The bar's span for :func:`plan_show` (the rest: reading the input, writing files).
+SHOW_START, SHOW_END = 0.05, 0.9
+
 
 @dataclass(frozen=True)
 class StudioFile:
@@ -112,7 +118,7 @@ def split_strokes(drawing: Strokes, parts: int) -> list[Strokes]:
 
 
 def run_plan(
-    request: PlanRequest, *, progress: Progress, file_url: Callable[[str], str]
+    request: PlanRequest, *, progress: Progress, file_url: Callable[[str], str], plan_id: str
 ) -> PlanOutput:
     """Plan, fly and export what ``request`` asks; report progress between the stages.
 
@@ -124,6 +130,8 @@ def run_plan(
         Called with the fraction done (0 to 1) and a stage name; may raise to stop.
     file_url
         The URL at which the page will find a generated file, from its name.
+    plan_id
+        The plan's identifier: in every file's name and in ``summary.json``.
 
     Raises
     ------
@@ -142,9 +150,12 @@ def run_plan(
         _drone_plan(mission, part, first_board, flight)
         for mission, part, flight in zip(show.missions, parts, flights, strict=True)
     ]
-    progress(0.92, "writing the files")
-    files, notes = _exports(show.missions)
+    flown = [_flight_record(d, request) for d in drones if d.flight]
+    record = {"plan_id": plan_id, "request": request_record(request), "simulated_flight": flown}
+    files, notes = _exports(show.missions, record, progress)
+    named = {f"skyquill-{plan_id}-{kind}": (kind, f) for kind, f in files.items()}
     result = PlanResultModel(
+        plan_id=plan_id,
         source="text" if request.text is not None else "strokes",
         board=request.board,
         size_m=request.size_m,
@@ -155,25 +166,62 @@ def run_plan(
         drones=drones,
         files=[
             DownloadFile(
-                name=f.name, url=file_url(f.name), description=f.description, size_bytes=len(f.data)
+                name=name,
+                kind=kind,
+                url=file_url(name),
+                description=f.description,
+                size_bytes=len(f.data),
             )
-            for f in files.values()
+            for name, (kind, f) in named.items()
         ],
         notes=notes,
     )
-    return PlanOutput(result, files)
+    return PlanOutput(result, {name: f for name, (_, f) in named.items()})
+
+
+def request_record(request: PlanRequest) -> dict[str, Any]:
+    """What was asked, for ``summary.json``: the input's size, the board, the limits, options."""
+    record: dict[str, Any] = request.model_dump(exclude={"strokes", "t", "text"})
+    if request.text is not None:
+        record["text"] = request.text
+    else:
+        assert request.strokes is not None
+        record["strokes"] = len(request.strokes)
+        record["points"] = sum(len(s) for s in request.strokes)
+        record["timestamps"] = request.t is not None
+    return record
+
+
+def _flight_record(drone: DronePlan, request: PlanRequest) -> dict[str, Any]:
+    """One drone's simulated flight as ``summary.json`` records it (SI units)."""
+    excess = max((c.relative_excess for c in drone.checks), default=0.0)
+    return {
+        "duration_s": drone.duration_s,
+        "path_rmse_m": drone.flight_rmse_m,
+        "ink_max_deviation_m": drone.ink_max_deviation_m,
+        "ink_iou": drone.ink_iou,
+        "ink_width_m": drone.ink_width_m,
+        "limit_excess": excess,
+    }
 
 
 def _plan_show(
     parts: list[Strokes], options: WritingOptions, request: PlanRequest, progress: Progress
 ) -> Show:
-    """:func:`plan_show` in this process, its steps mapped to 5 % .. 90 % of the job."""
-    planned = 0
+    """:func:`plan_show` in this process, its steps mapped to 5 % .. 90 % of the job.
+
+    A drone's planning weighs :data:`PLAN_WEIGHT`, its flight :data:`FLY_WEIGHT`;
+    the stage named is the one that starts (what the person waits for).
+    """
+    planned, n = 0, len(parts)
 
     def report(done: int, total: int, stage: str) -> None:
         nonlocal planned
-        planned = min(done, len(parts))
-        progress(0.05 + 0.85 * done / total, stage)
+        planned = min(done, n)
+        flown = max(0, done - n)
+        weight = PLAN_WEIGHT * planned + FLY_WEIGHT * flown
+        whole = PLAN_WEIGHT * n + (FLY_WEIGHT * n if request.fly else 0.0)
+        progress(SHOW_START + (SHOW_END - SHOW_START) * weight / whole, _next_stage(done, n))
 
     try:
         return plan_show(
@@ -194,6 +242,15 @@ def _plan_show(
             f"{request.vmax:g} m/s, acceleration {request.amax:g} m/s^2 and jerk "
             f"{request.jmax:g} m/s^3 ({exc}); expected looser limits or a smaller drawing"
         ) from exc
+
+
+def _next_stage(done: int, n: int) -> str:
+    """What :func:`plan_show` does after ``done`` of its steps, for a person."""
+    if done < n:
+        return f"planning drone {done + 1} of {n} (solving the spline: the longest step)"
+    if done < 2 * n:
+        return f"flying drone {done - n + 1} of {n} in simulation"
+    return "checking the drones' separation"
 
 
 def _round(a: FloatArray) -> Any:
@@ -231,6 +288,7 @@ def _drone_plan(
         "duration_s": traj.duration,
         "planning_time_s": mission.planning_time_s,
         "deviation_max_m": mission.deviation.max_m,
+        "ink_width_m": mission.options.brush.stroke_width_m,
         "checks": [LimitReport.model_validate(c) for c in check.limits_report()],
     }
     if flight is not None:
@@ -262,12 +320,16 @@ def _decimate(points: FloatArray) -> FloatArray:
     return np.vstack([points[::step], points[-1:]])
 
 
-def _exports(missions: Sequence[Mission]) -> tuple[dict[str, StudioFile], list[str]]:
+def _exports(
+    missions: Sequence[Mission], record: dict[str, Any], progress: Progress
+) -> tuple[dict[str, StudioFile], list[str]]:
     """The plan's setpoint CSV(s) and summary, and the studio's formats from the registry.
 
     Everything is written through the same writer and exporters as the command
     line (a plan directory in a temporary folder, then
     :data:`~skyquill.export.EXPORTERS`), kept in memory, and checked as written.
+    ``record`` (the plan id, the request, the simulated flights) heads ``summary.json``.
+    Files are keyed by their kind (``setpoints.csv``).
     """
     planned = [
         (
@@ -276,14 +338,16 @@ def _exports(missions: Sequence[Mission]) -> tuple[dict[str, StudioFile], list[s
         )
         for i, m in enumerate(missions, start=1)
     ]
+    steps = 1 + len(STUDIO_FORMATS)
     with tempfile.TemporaryDirectory(prefix="skyquill-studio-") as tmp:
         out = Path(tmp)
+        progress(SHOW_END, f"writing the setpoints (file 1 of {steps})")
         summary = write_plan(
             out / "plan",
             [p for _, p in planned],
             rate=CSV_RATE_HZ,
             guaranteed=True,
-            summary={"drones": [m.summary() for m in missions]},
+            summary=record | {"drones": [m.summary() for m in missions]},
         )
         setpoints = [
             (f"setpoints_{i}.csv", (out / "plan" / d["csv"]).read_bytes())
@@ -298,7 +362,8 @@ def _exports(missions: Sequence[Mission]) -> tuple[dict[str, StudioFile], list[s
             )
         ]
         notes = []
-        for name, stem in STUDIO_FORMATS.items():
+        for k, (name, stem) in enumerate(STUDIO_FORMATS.items(), start=2):
+            progress(SHOW_END + 0.09 * (k - 1) / steps, f"writing the {stem} (file {k} of {steps})")
             exporter = EXPORTERS[name]
             try:
                 report = exporter(
