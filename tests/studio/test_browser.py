@@ -1,15 +1,22 @@
 """The studio end to end in a real headless browser (Debian's chromium, driven by Playwright).
 
-The server runs in a thread on a free loopback port; the test draws two strokes
-with mouse events, plans them, waits for the preview, checks that the path is
-painted, downloads the setpoint CSV and parses it, and saves a screenshot under
-the test's output directory (and at ``$SKYQUILL_STUDIO_SCREENSHOT`` when set:
-that is how ``docs/studio.png`` is made).
+The server runs in a thread on a free loopback port; the tests draw strokes
+with mouse events (or type), plan, and check what a person sees: the path and
+the ink painted, downloads named by the plan, a result marked out of date as
+soon as an input changes, the drawing locked while planning, Cancel, the
+estimate's warning, errors at their field, a phone's screen. Screenshots go
+under each test's output directory, and to ``$SKYQUILL_STUDIO_SCREENSHOTS``
+(a directory) when set: that is how ``docs/images/studio-desktop.png`` and
+``studio-phone.png`` are made::
+
+    SKYQUILL_STUDIO_SCREENSHOTS=docs/images .venv/bin/python -m pytest tests/studio/test_browser.py
 """
 
 from __future__ import annotations
 
+import contextlib
 import csv
+import json
 import os
 import shutil
 import socket
@@ -21,6 +28,7 @@ from typing import Any
 from urllib.parse import urlparse
 
 import pytest
+from studio_fakes import slow_planner
 
 from skyquill.io.points import TRAJECTORY_COLUMNS
 from skyquill.studio import JobManager, create_app
@@ -51,8 +59,21 @@ def _free_port() -> int:
 @pytest.fixture(scope="module")
 def studio_url() -> Iterator[str]:
     """The studio served by uvicorn in a thread, on a free loopback port."""
+    with _serve(JobManager(time_limit_s=60.0)) as url:
+        yield url
+
+
+@pytest.fixture(scope="module")
+def slow_studio_url() -> Iterator[str]:
+    """A studio whose plans never end (until cancelled or timed out)."""
+    with _serve(JobManager(time_limit_s=30.0, planner=slow_planner)) as url:
+        yield url
+
+
+@contextlib.contextmanager
+def _serve(jobs: JobManager) -> Iterator[str]:
     port = _free_port()
-    app = create_app(jobs=JobManager(time_limit_s=60.0), allowed_hosts=["127.0.0.1"])
+    app = create_app(jobs=jobs, allowed_hosts=["127.0.0.1"])
     server = uvicorn.Server(uvicorn.Config(app, host="127.0.0.1", port=port, log_level="warning"))
     thread = threading.Thread(target=server.run, daemon=True)
     thread.start()
@@ -65,26 +86,69 @@ def studio_url() -> Iterator[str]:
     thread.join(timeout=10.0)
 
 
-@pytest.fixture
-def page(studio_url: str) -> Iterator[Any]:
-    """A fresh page of the studio in headless chromium; no page errors allowed."""
+#: A desktop's window and a phone's (an iPhone 12-15's CSS pixels).
+DESKTOP = {"width": 1480, "height": 980}
+PHONE = {"width": 390, "height": 844}
+
+
+@pytest.fixture(scope="module")
+def browser() -> Iterator[Any]:
+    """One headless chromium for the module (a launch costs ~1 s)."""
     with playwright_api.sync_playwright() as pw:
-        browser = pw.chromium.launch(
+        chromium = pw.chromium.launch(
             executable_path=str(CHROMIUM), args=CHROMIUM_ARGS, headless=True
         )
-        context = browser.new_context(
-            viewport={"width": 1480, "height": 980}, accept_downloads=True
-        )
-        tab = context.new_page()
-        tab.problems = []
-        tab.hosts = set()
-        tab.on("pageerror", lambda exc: tab.problems.append(str(exc)))
-        tab.on("request", lambda request: tab.hosts.add(urlparse(request.url).hostname))
-        tab.goto(studio_url)
-        tab.wait_for_selector("#studio[data-ready='true']", timeout=10_000)
+        yield chromium
+        chromium.close()
+
+
+@contextlib.contextmanager
+def _open(browser: Any, url: str, viewport: dict[str, int] = DESKTOP) -> Iterator[Any]:
+    """A fresh page of the studio; it records page errors, hosts and API calls."""
+    context = browser.new_context(viewport=viewport, accept_downloads=True)
+    tab = context.new_page()
+    tab.problems = []
+    tab.hosts = set()
+    tab.calls = []
+    tab.on("pageerror", lambda exc: tab.problems.append(str(exc)))
+    tab.on("request", lambda request: tab.hosts.add(urlparse(request.url).hostname))
+    tab.on(
+        "request", lambda request: tab.calls.append((request.method, urlparse(request.url).path))
+    )
+    tab.goto(url)
+    tab.wait_for_selector("#studio[data-ready='true']", timeout=10_000)
+    try:
         yield tab
+    finally:
         context.close()
-        browser.close()
+
+
+@pytest.fixture
+def page(browser: Any, studio_url: str) -> Iterator[Any]:
+    """A fresh page of the studio in headless chromium; no page errors allowed."""
+    with _open(browser, studio_url) as tab:
+        yield tab
+        assert tab.problems == []
+
+
+def _screenshot(page: Any, tmp_path: Path, name: str) -> None:
+    """Save a screenshot under the test's directory (and the docs' when asked)."""
+    shot = tmp_path / name
+    page.screenshot(path=str(shot))
+    assert shot.stat().st_size > 10_000
+    if target := os.environ.get("SKYQUILL_STUDIO_SCREENSHOTS"):
+        shutil.copyfile(shot, Path(target) / name)
+
+
+def _wait_planned(page: Any, timeout_ms: int = 45_000) -> None:
+    page.wait_for_selector("#studio[data-state='planned']", timeout=timeout_ms)
+
+
+def _download(page: Any, kind: str) -> tuple[str, str]:
+    """Click the download of ``kind``: its suggested name and its text."""
+    with page.expect_download() as info:
+        page.click(f"a[data-file='{kind}']")
+    return info.value.suggested_filename, Path(info.value.path()).read_text()
 
 
 def _draw(page: Any, stroke: list[tuple[float, float]]) -> None:
@@ -111,7 +175,7 @@ def _painted(page: Any, canvas: str) -> int:
 
 
 def test_draw_plan_preview_download(page: Any, tmp_path: Path) -> None:
-    """Two strokes -> Plan -> path, plots, simulated flight, a CSV that parses, a screenshot."""
+    """Two strokes -> Plan -> path, ink, plots, files named by the plan, a screenshot."""
     for stroke in STROKES:
         _draw(page, list(stroke))
     assert page.text_content("#stroke-count") == "2 strokes"
@@ -119,26 +183,37 @@ def test_draw_plan_preview_download(page: Any, tmp_path: Path) -> None:
 
     start = time.perf_counter()
     page.click("#plan")
-    page.wait_for_selector("#studio[data-state='planned']", timeout=45_000)
+    _wait_planned(page)
     shown = time.perf_counter() - start
-    print(f"plan shown after {shown:.2f} s: {page.text_content('#summary')}")
+    summary = page.text_content("#summary")
+    print(f"plan shown after {shown:.2f} s: {summary}")
 
     assert int(page.get_attribute("#overlay", "data-path-points")) > 100
-    assert _painted(page, "overlay") > 2_000  # path, trace, flight and drone drawn
+    assert _painted(page, "overlay") > 2_000  # path, ink, trace, flight and drone drawn
     assert _painted(page, "plots") > 2_000
-    assert "every limit met" in page.text_content("#summary")
-    assert "simulated RMSE" in page.text_content("#summary")
-    assert page.is_hidden("#error")
+    assert "every limit met" in summary and "simulated path RMSE" in summary
+    # The ink is explained: in the legend, and its distance and overlap in the summary.
+    assert page.is_visible(".legend .key.sim-ink")
+    assert page.text_content(".legend .key.sim-ink") == "simulated ink"
+    assert "ink deviation" in summary and "ink IoU 0." in summary
+    # "Planned in" is the wait, click to result (the server's solve time is less).
+    waited = float(summary.split("planned in ")[1].split(" s")[0])
+    assert 0.0 < waited <= shown + 0.2
+    assert page.is_hidden("#error") and page.is_visible("#estimate")
 
-    with page.expect_download() as info:
-        page.click("a[data-file='setpoints.csv']")
-    download = info.value
-    assert download.suggested_filename == "setpoints.csv"
-    rows = list(csv.reader(Path(download.path()).read_text().splitlines()))
+    plan_id = page.get_attribute("#studio", "data-plan-id")
+    name, text = _download(page, "setpoints.csv")
+    assert name == f"skyquill-{plan_id}-setpoints.csv"
+    rows = list(csv.reader(text.splitlines()))
     assert rows[0] == [*TRAJECTORY_COLUMNS, "yaw", "pen"]
     table = [[float(v) for v in row] for row in rows[1:]]
     assert len(table) > 100 and all(len(r) == len(rows[0]) for r in table)
     assert {r[-1] for r in table} == {0.0, 1.0}  # pen up and pen down
+    name, text = _download(page, "summary.json")
+    assert name == f"skyquill-{plan_id}-summary.json" and json.loads(text)["plan_id"] == plan_id
+    name, text = _download(page, "drawing.json")
+    assert name == f"skyquill-{plan_id}-drawing.json"
+    assert len(json.loads(text)["strokes"]) == 2
 
     # Pause the animation mid-flight, so the screenshot shows the drone writing.
     page.eval_on_selector(
@@ -146,13 +221,125 @@ def test_draw_plan_preview_download(page: Any, tmp_path: Path) -> None:
         "(el) => { el.value = String(0.55 * Number(el.max));"
         " el.dispatchEvent(new Event('input')); }",
     )
-    shot = tmp_path / "studio.png"
-    page.screenshot(path=str(shot), full_page=True)
-    assert shot.stat().st_size > 10_000
-    if target := os.environ.get("SKYQUILL_STUDIO_SCREENSHOT"):
-        shutil.copyfile(shot, target)
-    assert page.problems == []
+    _screenshot(page, tmp_path, "studio-desktop.png")
     assert page.hosts - {None} == {"127.0.0.1"}  # offline: nothing fetched from elsewhere
+
+
+def test_the_default_form_is_valid_enter_plans_and_a_change_makes_it_stale(page: Any) -> None:
+    """Defaults pass the browser's checks; Enter plans; any change: out of date, no downloads."""
+    assert page.evaluate("document.getElementById('form').checkValidity()") is True
+    page.uncheck("#fly")
+    page.fill("#text", "L")
+    page.press("#text", "Enter")
+    _wait_planned(page)
+    assert page.get_attribute("a[data-file='setpoints.csv']", "href")
+    assert page.is_hidden("#stale")
+
+    page.fill("#vmax", "0.8")  # a limit the result was not planned with
+    assert page.get_attribute("#studio", "data-state") == "stale"
+    assert page.is_visible("#stale") and "Out of date" in page.text_content("#stale")
+    for link in page.query_selector_all("#files a"):
+        assert link.get_attribute("href") is None
+        assert link.get_attribute("aria-disabled") == "true"
+
+    # A failed plan removes the result: nothing left to download.
+    page.fill("#text", "é")
+    page.press("#text", "Enter")
+    page.wait_for_selector("#error:not([hidden])", timeout=10_000)
+    assert page.get_attribute("#studio", "data-state") == "error"
+    assert page.query_selector_all("#files a") == []
+    assert page.is_hidden("#stale") and page.text_content("#summary") == ""
+
+
+def test_errors_name_the_field_as_labelled_and_point_at_it(page: Any) -> None:
+    """The server's message in the page's words, its field highlighted and focused."""
+    page.fill("#text", "Hi")
+    page.fill("#drones", "3")
+    page.click("#plan")
+    page.wait_for_selector("#error:not([hidden])", timeout=10_000)
+    error = page.text_content("#error")
+    assert error.startswith("Drones: got 3 drones for 1 character(s)/word(s)")
+    assert page.is_visible("label.invalid #drones")
+    assert page.get_attribute("#drones", "aria-invalid") == "true"
+    assert page.evaluate("document.activeElement.id") == "drones"
+    assert "one drone per" in page.text_content("#drones-rule").lower()
+
+
+def test_the_drawing_is_locked_while_planning(page: Any) -> None:
+    """A stroke drawn while a plan runs is not taken; the result and drawing.json agree."""
+    _draw(page, list(STROKES[0]))
+    page.uncheck("#fly")
+    page.click("#plan")
+    _draw(page, list(STROKES[1]))  # while planning: refused
+    page.fill("#amax", "1.5")  # a setting changed while planning: the result comes out of date
+    assert page.text_content("#stroke-count") == "1 stroke"
+    page.wait_for_selector("#studio[data-state='stale']", timeout=45_000)
+    assert page.text_content("#stroke-count") == "1 stroke"
+    assert page.is_visible("#stale")
+    page.fill("#amax", "2")
+    page.click("#plan")
+    _wait_planned(page)
+    drawn = page.evaluate("document.querySelectorAll('#files a').length")
+    assert drawn >= 3
+    _, text = _download(page, "drawing.json")
+    assert len(json.loads(text)["strokes"]) == 1
+
+
+def test_cancel_stops_the_plan(browser: Any, slow_studio_url: str) -> None:
+    """Cancel kills the job; the page is back to idle with nothing planned."""
+    with _open(browser, slow_studio_url) as page:
+        _draw(page, list(STROKES[0]))
+        page.click("#plan")
+        # The fake planner's stages ("step N"): the job runs (the page's CSP forbids eval).
+        page.wait_for_selector("#stage:has-text('step')", timeout=10_000)
+        assert page.is_visible("#cancel")
+        page.click("#cancel")
+        page.wait_for_selector("#studio[data-state='drawn']", timeout=5_000)
+        assert page.is_hidden("#progress-box") and page.is_hidden("#cancel")
+        assert page.is_enabled("#plan") and page.is_hidden("#error")
+        assert ("DELETE", next(p for m, p in page.calls if p.startswith("/api/jobs/"))) in (
+            page.calls
+        )
+        assert page.problems == []
+
+
+def test_a_slow_speed_is_warned_of_before_planning(page: Any) -> None:
+    """At 1 cm/s the estimate warns (flight minutes, uploads) and nothing is planned yet."""
+    _draw(page, list(STROKES[0]))
+    page.fill("#vmax", "0.01")
+    page.click("#plan")
+    page.wait_for_selector("#warning:not([hidden])", timeout=5_000)
+    warning = page.text_content("#warning")
+    assert "min" in warning and "Crazyflie uploads" in warning
+    assert ("POST", "/api/estimate") in page.calls and ("POST", "/api/plan") not in page.calls
+    assert page.is_enabled("#plan") and page.is_hidden("#progress-box")
+    page.click("#dismiss")
+    assert page.is_hidden("#warning")
+
+
+def test_on_a_phone_plan_is_near_the_canvas_and_the_result_in_view(
+    browser: Any, studio_url: str, tmp_path: Path
+) -> None:
+    """390 x 844: Plan within a screen of the canvas's bottom; the result scrolled into view."""
+    with _open(browser, studio_url, PHONE) as page:
+        canvas = page.locator("#ink").bounding_box()
+        plan = page.locator("#plan").bounding_box()
+        assert 0 <= plan["y"] - (canvas["y"] + canvas["height"]) < PHONE["height"]
+        assert plan["y"] + plan["height"] <= PHONE["height"]  # on the first screen
+        _draw(page, list(STROKES[0]))
+        _draw(page, list(STROKES[1]))
+        page.evaluate("window.scrollTo(0, document.body.scrollHeight)")
+        page.click("#plan")
+        _wait_planned(page)
+        box = page.locator("#overlay").bounding_box()
+        assert box["y"] >= -1 and box["y"] + box["height"] <= PHONE["height"] + 1
+        page.eval_on_selector(
+            "#time",
+            "(el) => { el.value = String(0.55 * Number(el.max));"
+            " el.dispatchEvent(new Event('input')); }",
+        )
+        _screenshot(page, tmp_path, "studio-phone.png")
+        assert page.problems == []
 
 
 def test_the_page_shows_the_servers_message(page: Any) -> None:
@@ -162,4 +349,3 @@ def test_the_page_shows_the_servers_message(page: Any) -> None:
     page.wait_for_selector("#error:not([hidden])", timeout=10_000)
     assert "not in Hershey font" in page.text_content("#error")
     assert page.get_attribute("#studio", "data-state") == "error"
-    assert page.problems == []
