@@ -200,6 +200,7 @@ def test_draw_plan_preview_download(page: Any, tmp_path: Path) -> None:
     waited = float(summary.split("planned in ")[1].split(" s")[0])
     assert 0.0 < waited <= shown + 0.2
     assert page.is_hidden("#error") and page.is_visible("#estimate")
+    assert page.is_hidden("#drone-legend")  # one drone: nothing to tell apart
 
     plan_id = page.get_attribute("#studio", "data-plan-id")
     name, text = _download(page, "setpoints.csv")
@@ -216,6 +217,7 @@ def test_draw_plan_preview_download(page: Any, tmp_path: Path) -> None:
     assert len(json.loads(text)["strokes"]) == 2
 
     # Pause the animation mid-flight, so the screenshot shows the drone writing.
+    page.evaluate("window.scrollTo(0, 0)")
     page.eval_on_selector(
         "#time",
         "(el) => { el.value = String(0.55 * Number(el.max));"
@@ -229,11 +231,20 @@ def test_the_default_form_is_valid_enter_plans_and_a_change_makes_it_stale(page:
     """Defaults pass the browser's checks; Enter plans; any change: out of date, no downloads."""
     assert page.evaluate("document.getElementById('form').checkValidity()") is True
     page.uncheck("#fly")
-    page.fill("#text", "L")
+    page.fill("#drones", "2")
+    page.fill("#text", "L T")
     page.press("#text", "Enter")
     _wait_planned(page)
-    assert page.get_attribute("a[data-file='setpoints.csv']", "href")
+    assert page.get_attribute("a[data-file='setpoints.zip']", "href")
     assert page.is_hidden("#stale")
+    # Each drone in its own colour, on the canvas and in the plots, with a legend.
+    for legend in ("#drone-legend", "#plot-legend"):
+        keys = page.locator(f"{legend} .key")
+        assert keys.all_text_contents() == ["drone 1", "drone 2"]
+        colours = {
+            k.evaluate("(el) => el.style.getPropertyValue('--key-color')") for k in keys.all()
+        }
+        assert len(colours) == 2
 
     page.fill("#vmax", "0.8")  # a limit the result was not planned with
     assert page.get_attribute("#studio", "data-state") == "stale"
