@@ -48,6 +48,7 @@ wall.
 from __future__ import annotations
 
 import itertools
+import logging
 import math
 import time
 from dataclasses import dataclass, field
@@ -87,6 +88,9 @@ from skyquill.verify import Verification, verify
 if TYPE_CHECKING:  # the simulator is imported only to fly
     from skyquill.calligraphy.budget import TargetPlan
     from skyquill.sim import ContactBoard
+
+#: One DEBUG record per solve of a route (a progress display listens: the studio).
+logger = logging.getLogger(__name__)
 
 #: Spacing of the samples that hold lifts and transits near their straight lines, m.
 TRANSIT_SPACING_M = 0.01
@@ -753,6 +757,7 @@ def plan_route(
     scale, stretches = 1.0, 0
     while True:
         last = stretches >= opts.max_stretches
+        logger.debug("solving at %.3gx the first timing (stretch %d)", scale, stretches)
         try:
             plan = _plan_at(samples, times * scale, board, opts, scale)
         except InfeasibleError:
@@ -828,6 +833,7 @@ def resegmented(
         # makes the current total time stationary, so the descent trades time
         # between segments and moves the total only where that pays.
         penalty = 5.0 * plan.fit.cost_terms["smoothness"] / float(plan.times[-1])
+    logger.debug("re-segmenting the times (up to %d steps)", opts.resegment_iterations)
     try:
         result = resegment(
             samples.points,

@@ -12,13 +12,15 @@ at a path that came from a request.
 
 from __future__ import annotations
 
+import contextlib
 import io
 import itertools
 import json
+import logging
 import math
 import tempfile
 import zipfile
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -67,6 +69,10 @@ Progress = Callable[[float, str], None]
 PLAN_WEIGHT, FLY_WEIGHT = 3.0, 1.0
 #: The bar's span for :func:`plan_show` (the rest: reading the input, writing files).
 SHOW_START, SHOW_END = 0.05, 0.9
+#: Each solve of a drone's route (mission.py logs one per stretch or re-segmentation)
+#: moves the bar this fraction of the way to the end of the drone's share: how many
+#: solves a drone takes is not known in advance, so the bar slows, never stops or jumps back.
+SOLVE_STEP = 0.35
 
 
 @dataclass(frozen=True)
@@ -213,26 +219,35 @@ def _plan_show(
     A drone's planning weighs :data:`PLAN_WEIGHT`, its flight :data:`FLY_WEIGHT`;
     the stage named is the one that starts (what the person waits for).
     """
-    planned, n = 0, len(parts)
+    planned, n, solves = 0, len(parts), 0
+    whole = PLAN_WEIGHT * n + (FLY_WEIGHT * n if request.fly else 0.0)
+
+    def at(weight: float) -> float:
+        return SHOW_START + (SHOW_END - SHOW_START) * weight / whole
 
     def report(done: int, total: int, stage: str) -> None:
-        nonlocal planned
-        planned = min(done, n)
+        nonlocal planned, solves
+        planned, solves = min(done, n), 0
         flown = max(0, done - n)
-        weight = PLAN_WEIGHT * planned + FLY_WEIGHT * flown
-        whole = PLAN_WEIGHT * n + (FLY_WEIGHT * n if request.fly else 0.0)
-        progress(SHOW_START + (SHOW_END - SHOW_START) * weight / whole, _next_stage(done, n))
+        progress(at(PLAN_WEIGHT * planned + FLY_WEIGHT * flown), _next_stage(done, n))
+
+    def solving(step: str) -> None:
+        nonlocal solves
+        solves += 1
+        share = PLAN_WEIGHT * (1.0 - (1.0 - SOLVE_STEP) ** solves)
+        progress(at(PLAN_WEIGHT * planned + share), f"drone {planned + 1} of {n}: {step}")
 
     try:
-        return plan_show(
-            parts,
-            options,
-            SEPARATION_M,
-            workers=1,
-            board_kind=request.board,
-            fly=request.fly,
-            progress=report,
-        )
+        with _solves_reported(solving):
+            return plan_show(
+                parts,
+                options,
+                SEPARATION_M,
+                workers=1,
+                board_kind=request.board,
+                fly=request.fly,
+                progress=report,
+            )
     except SolverError as exc:
         # Seen with tiny jerk limits: the QP backends hit their iteration limit
         # instead of proving infeasibility. To the person it is the same answer.
@@ -244,13 +259,46 @@ def _plan_show(
         ) from exc
 
 
+class _SolveHandler(logging.Handler):
+    """Passes each of mission.py's per-solve DEBUG records to a callback, as its message."""
+
+    def __init__(self, callback: Callable[[str], None]) -> None:
+        super().__init__(logging.DEBUG)
+        self.callback = callback
+
+    def emit(self, record: logging.LogRecord) -> None:
+        """Report the solve (a progress callback that raises stops the plan)."""
+        # Not caught here (nor by logging): a callback that raises stops the plan.
+        self.callback(record.getMessage())
+
+
+@contextlib.contextmanager
+def _solves_reported(callback: Callable[[str], None]) -> Iterator[None]:
+    """While inside, each solve of a route (its stretches, its re-segmentation) calls ``callback``.
+
+    The plan runs in the job's own process (one plan per process), so turning the
+    mission logger's DEBUG records on there touches nothing else.
+    """
+    from skyquill.calligraphy import mission
+
+    handler = _SolveHandler(callback)
+    level = mission.logger.level
+    mission.logger.addHandler(handler)
+    mission.logger.setLevel(logging.DEBUG)
+    try:
+        yield
+    finally:
+        mission.logger.removeHandler(handler)
+        mission.logger.setLevel(level)
+
+
 def _next_stage(done: int, n: int) -> str:
     """What :func:`plan_show` does after ``done`` of its steps, for a person."""
     if done < n:
         return f"planning drone {done + 1} of {n} (solving the spline: the longest step)"
     if done < 2 * n:
         return f"flying drone {done - n + 1} of {n} in simulation"
-    return "checking the drones' separation"
+    return "collecting the results"
 
 
 def _round(a: FloatArray) -> Any:
