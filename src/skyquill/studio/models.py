@@ -134,6 +134,7 @@ FIELD_LABELS = {
     "amax": "Acceleration, m/s²",
     "jmax": "Jerk, m/s³",
     "fly": "Fly it in simulation",
+    "limits": "Limits",  # not a field: the three limits together (an infeasible plan)
 }
 
 #: Words a message may start with that are about one field without being its name.

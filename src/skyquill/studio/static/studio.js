@@ -10,6 +10,7 @@ const COLORS = ["#e8590c", "#2b8a3e", "#5f3dc4", "#0b7285", "#d6336c", "#795548"
 const LABELS = {
   strokes: "Drawing", t: "Drawing", text: "Text", board: "Surface", size_m: "Size of the writing",
   drones: "Drones", vmax: "Speed", amax: "Acceleration", jmax: "Jerk", fly: "Fly it in simulation",
+  limits: "Limits",
 };
 const css = getComputedStyle(document.documentElement);
 const color = (name) => css.getPropertyValue(name).trim();
@@ -323,7 +324,7 @@ function showError(message, field = null) {
 function labelled(message, field) {
   // "vmax: got -1, ..." -> "Speed: got -1, ..." (the page's words, not the API's).
   const label = LABELS[field];
-  const name = message.match(/^[a-z_]+/);
+  const name = message.match(/^(strokes from studio drawing|[a-z_]+)(?=[:[.])/);
   return label && name ? label + message.slice(name[0].length) : message;
 }
 
@@ -347,6 +348,7 @@ function inputsChanged() {
   // Any change of the drawing, the text or a setting: the result shown is no longer of these inputs.
   state.version += 1;
   hideWarning();
+  ui.estimate.hidden = true; // it was of the inputs before the change
   if (!state.busy) showError("");
   markStale();
   if (!state.result && !state.busy) ui.studio.dataset.state = state.strokes.length ? "drawn" : "empty";
