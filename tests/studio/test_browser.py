@@ -31,6 +31,7 @@ import pytest
 from studio_fakes import slow_planner
 
 from skyquill.io.points import TRAJECTORY_COLUMNS
+from skyquill.strokes import load_stroke_json
 from skyquill.studio import JobManager, create_app
 
 CHROMIUM = Path("/usr/bin/chromium")
@@ -214,7 +215,8 @@ def test_draw_plan_preview_download(page: Any, tmp_path: Path) -> None:
     assert name == f"skyquill-{plan_id}-summary.json" and json.loads(text)["plan_id"] == plan_id
     name, text = _download(page, "drawing.json")
     assert name == f"skyquill-{plan_id}-drawing.json"
-    assert len(json.loads(text)["strokes"]) == 2
+    (tmp_path / name).write_text(text)
+    assert load_stroke_json(tmp_path / name).n_strokes == 2  # as `skyquill write --strokes` reads
 
     # Pause the animation mid-flight, so the screenshot shows the drone writing.
     page.evaluate("window.scrollTo(0, 0)")

@@ -632,7 +632,7 @@ function showFiles(result) {
 function drawingLink(planId) {
   // The recording the plan was made of (not the canvas now), as `skyquill write --strokes` reads it.
   const body = state.planned;
-  const json = JSON.stringify({ plan_id: planId, strokes: body.strokes, t: body.t });
+  const json = JSON.stringify({ strokes: body.strokes, t: body.t }); // the id is in its name
   const li = document.createElement("li");
   const a = document.createElement("a");
   a.href = URL.createObjectURL(new Blob([json], { type: "application/json" }));
