@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
+import skyquill.solvers.lp as lp_module
 from skyquill.errors import InputError
 from skyquill.solvers.lp import LinearProgram, highspy_available, resolve_backend
 
@@ -85,3 +86,25 @@ def test_bad_arguments_are_named() -> None:
     lp = LinearProgram(a, [1.0, 1.0])
     with pytest.raises(InputError, match=r"^col_upper: got shape"):
         lp.update_bounds(col_upper=np.ones(3))
+
+
+def test_a_stalled_hot_start_is_told_by_iterations_and_solved_cold(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """No wall-time guess: the same problem takes the same path on a busy machine."""
+    if not highspy_available():
+        pytest.skip("highspy not installed")
+    monkeypatch.setattr(lp_module, "HOT_SOLVE_ITERATIONS_PER_COLUMN", 0)
+    lp = _box_lp("highspy")
+    sol = lp.solve()
+    assert sol.status == "optimal" and sol.solver == "linprog"
+    assert lp.backend == "linprog"  # for good
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_a_spent_time_limit_is_a_status(backend: str) -> None:
+    rng = np.random.default_rng(5)
+    a = sp.random_array((3000, 1500), density=0.01, rng=rng, format="csr")
+    lp = LinearProgram(a, -rng.uniform(0.5, 1.5, 1500), backend=backend, time_limit_s=1e-6)
+    lp.update_bounds(row_lower=-np.ones(3000), row_upper=np.ones(3000))
+    assert lp.solve().status == "time_limit"

@@ -20,6 +20,7 @@ from skyquill.cli.main import (
     upload_target,
     user_errors,
 )
+from skyquill.coverage import DEFAULT_MIN_COVERAGE
 from skyquill.errors import InputError
 from skyquill.limits import VehicleLimits
 
@@ -62,7 +63,13 @@ def cover(
         float | None,
         typer.Option(help="Per-axis jerk limit instead of the norm (paper 001), m/s^3."),
     ] = None,
-    pattern: Annotated[str, typer.Option(help="spiral, zigzag or zigzag-stop.")] = "spiral",
+    pattern: Annotated[
+        str,
+        typer.Option(
+            help="spiral, zigzag, zigzag-stop or zigzag-jerk (turns time-optimal for the jerk "
+            "limit: the fastest on convex fields)."
+        ),
+    ] = "spiral",
     contours: Annotated[str, typer.Option(help="Spiral rings: offset or homothetic.")] = "offset",
     drift: Annotated[str, typer.Option(help="Spiral laps: step or lap (paper eq. 4).")] = "step",
     delta: Annotated[float, typer.Option(help="Corner control-point distance, m.")] = 0.5,
@@ -71,9 +78,13 @@ def cover(
         bool, typer.Option(help="Zigzags: a lap around the region first.")
     ] = False,
     min_coverage: Annotated[
-        float | None,
-        typer.Option(help="Pick epsilon and delta for this coverage fraction (e.g. 0.97)."),
-    ] = None,
+        float,
+        typer.Option(
+            help="Cover at least this fraction of the region: epsilon and delta are picked for "
+            "the fastest flight that does (ask for less to fly faster); 0 flies --epsilon and "
+            "--delta as given."
+        ),
+    ] = DEFAULT_MIN_COVERAGE,
     rate: Annotated[float, typer.Option(help="Setpoint rate, Hz.")] = 50.0,
     altitude: Annotated[float, typer.Option(help="Flight height, m.")] = 2.0,
     time_limit: Annotated[
@@ -141,7 +152,7 @@ def cover(
             time_limit=time_limit,
         )
         with _BudgetBar() as bar:
-            if min_coverage is None:
+            if min_coverage == 0.0:
                 plan = plan_coverage(shape, options, progress=bar.update)
             else:
                 plan = plan_tuned(shape, options, min_coverage, progress=bar.update)
@@ -154,7 +165,11 @@ def cover(
             console.status("writing and checking the plan"),
             staged_output(out, "cover", force=force, inputs=[region]) as stage,
         ):
-            fields = plan.summary() | {"region": str(region)} | geo.summary()
+            fields = (
+                plan.summary()
+                | {"region": str(region), "min_coverage": min_coverage or None}
+                | geo.summary()
+            )
             if geo.frame is not None:
                 fields["path_geojson"] = _write_geojson(stage, geo.frame, plan, planned)
             summary = write_plan(

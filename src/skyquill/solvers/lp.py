@@ -6,9 +6,12 @@ linearisation, a local tightening) keeps one :class:`LinearProgram`:
 
 * ``"highspy"`` passes the model to HiGHS once; every later solve hands it
   only the bounds that changed, so the dual simplex restarts from the previous
-  optimal basis (tens of pivots instead of a cold solve).  Each solve gets a
-  wall-time limit; a solve that ends neither optimal nor infeasible (a stalled
-  hot start) switches the instance to ``"linprog"`` for good.
+  optimal basis (tens of pivots instead of a cold solve).  A solve that ends
+  neither optimal nor infeasible (a stalled hot start: more simplex
+  iterations than :data:`HOT_SOLVE_ITERATIONS_PER_COLUMN` per column) switches
+  the instance to ``"linprog"`` for good. The stall is told by iterations,
+  not wall time, so that the same problem takes the same path on a busy
+  machine (a 0.5 s limit sent plans to the slow cold solves under load).
 * ``"linprog"`` rebuilds the rows for :func:`scipy.optimize.linprog` (HiGHS,
   presolve on) and solves from scratch every time: the reference, and the
   fallback when highspy is not installed.
@@ -20,6 +23,7 @@ which problem failed) is the caller's job.
 from __future__ import annotations
 
 import logging
+import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -43,14 +47,15 @@ _linprog: Callable[..., Any] = linprog
 logger = logging.getLogger(__name__)
 
 LPBackend = Literal["highspy", "linprog"]
-LPStatus = Literal["optimal", "infeasible", "failed"]
+LPStatus = Literal["optimal", "infeasible", "time_limit", "failed"]
 #: Backend names :func:`resolve_backend` accepts.
 LP_BACKENDS = ("auto", "highspy", "linprog")
-#: Wall-time limit of one hot-started highspy solve, s.
-HOT_SOLVE_LIMIT_S = 0.5
+#: Simplex iterations per column after which a hot start counts as stalled (cold
+#: solves of the coverage speed LP took 0.6-1.7 per column, hot ones a few in all).
+HOT_SOLVE_ITERATIONS_PER_COLUMN = 20
 
 __all__ = [
-    "HOT_SOLVE_LIMIT_S",
+    "HOT_SOLVE_ITERATIONS_PER_COLUMN",
     "LP_BACKENDS",
     "LPBackend",
     "LPSolution",
@@ -92,7 +97,8 @@ class LPSolution:
 
     Attributes
     ----------
-    status : {"optimal", "infeasible", "failed"}
+    status : {"optimal", "infeasible", "time_limit", "failed"}
+        ``"time_limit"``: stopped at :attr:`LinearProgram.time_limit_s`;
         ``"failed"``: anything else (see ``message``).
     x : ndarray, shape (n,), or None
         The solution clipped into the column bounds; None unless optimal.
@@ -126,8 +132,9 @@ class LinearProgram:
         Objective ``c`` (minimised).
     backend : {"auto", "highspy", "linprog"}, default "auto"
         See the module docstring.
-    time_limit_s : float, default HOT_SOLVE_LIMIT_S
-        Wall-time limit of one highspy solve, s.
+    time_limit_s : float, default inf
+        Wall-time limit of one solve, s (a caller's remaining budget): a solve
+        stopped by it returns status ``"time_limit"``.
     """
 
     def __init__(
@@ -136,7 +143,7 @@ class LinearProgram:
         cost: Any,
         *,
         backend: str = "auto",
-        time_limit_s: float = HOT_SOLVE_LIMIT_S,
+        time_limit_s: float = math.inf,
     ) -> None:
         self.a = sparse.csr_array(a)
         m, n = self.a.shape
@@ -184,12 +191,12 @@ class LinearProgram:
         """Solve with the current bounds (hot start from the last basis with highspy)."""
         if self._highs is not None:
             sol = self._highs.solve(self, self.time_limit_s)
-            if sol is not None:
+            if sol is not None:  # None: stalled
                 return self._count(sol)
             logger.info("highspy stalled; linprog for the remaining solves")
             self._highs = None
             self.backend = "linprog"
-        return self._count(_solve_linprog(self))
+        return self._count(_solve_linprog(self, self.time_limit_s))
 
     def _count(self, sol: LPSolution) -> LPSolution:
         self.solve_time_s += sol.solve_time_s
@@ -212,8 +219,9 @@ def _normalised_rows(lp: LinearProgram) -> tuple[Any, FloatArray]:
     return sparse.vstack(blocks, format="csr"), np.concatenate(rhs)
 
 
-def _solve_linprog(lp: LinearProgram) -> LPSolution:
-    """One cold solve with :func:`scipy.optimize.linprog` (HiGHS, presolve on)."""
+def _solve_linprog(lp: LinearProgram, limit_s: float) -> LPSolution:
+    """One cold solve with :func:`scipy.optimize.linprog` (HiGHS, presolve on), within
+    ``limit_s`` seconds."""
     a_ub, b_ub = _normalised_rows(lp)
     lower = np.where(np.isfinite(lp.col_lower), lp.col_lower, np.nan)
     upper = np.where(np.isfinite(lp.col_upper), lp.col_upper, np.nan)
@@ -222,10 +230,13 @@ def _solve_linprog(lp: LinearProgram) -> LPSolution:
         for lo, hi in zip(lower.tolist(), upper.tolist(), strict=True)
     ]
     t0 = time.perf_counter()
-    res = _linprog(lp.cost, A_ub=a_ub, b_ub=b_ub, bounds=bounds, method="highs")
+    options = {} if math.isinf(limit_s) else {"time_limit": limit_s}
+    res = _linprog(lp.cost, A_ub=a_ub, b_ub=b_ub, bounds=bounds, method="highs", options=options)
     dt = time.perf_counter() - t0
     if res.status == 2:
         return LPSolution("infeasible", None, "linprog", dt, str(res.message))
+    if res.status == 1 and not math.isinf(limit_s):  # linprog's "iteration or time limit"
+        return LPSolution("time_limit", None, "linprog", dt, str(res.message))
     if res.status != 0 or res.x is None:
         return LPSolution("failed", None, "linprog", dt, str(res.message))
     x = np.clip(np.asarray(res.x, dtype=np.float64), lp.col_lower, lp.col_upper)
@@ -266,13 +277,15 @@ class _HighsModel:
         self.cols = (np.zeros(n), np.full(n, np.inf))
 
     def solve(self, lp: LinearProgram, limit_s: float) -> LPSolution | None:
-        """Pass the changed bounds and re-solve; None when HiGHS stalled."""
+        """Pass the changed bounds and re-solve within ``limit_s`` s; None when HiGHS stalled."""
         assert _highspy is not None
         self._pass_bounds(lp)
         t0 = time.perf_counter()
         status = self._run(limit_s)
         dt = time.perf_counter() - t0
         statuses = _highspy.HighsModelStatus
+        if status == statuses.kTimeLimit:
+            return LPSolution("time_limit", None, "highspy", dt, "time limit reached")
         if status not in (statuses.kOptimal, statuses.kInfeasible):
             # A hot start can stall, or end "Unknown", on some problems where a
             # cold linprog solve (presolve on) does not.
@@ -299,11 +312,15 @@ class _HighsModel:
         self.cols = (lo.copy(), hi.copy())
 
     def _run(self, limit_s: float) -> Any:
-        """Run HiGHS for at most ``limit_s`` more seconds; its model status.
+        """Run HiGHS for at most ``limit_s`` more seconds and the stall's iterations; its
+        model status.
 
         HiGHS's ``time_limit`` counts the instance's run time over all solves,
-        so the limit is set relative to the time already spent.
+        so the limit is set relative to the time already spent; its iteration
+        count starts again at every run.
         """
+        iterations = HOT_SOLVE_ITERATIONS_PER_COLUMN * max(int(self.highs.getNumCol()), 1)
+        self.highs.setOptionValue("simplex_iteration_limit", iterations)
         self.highs.setOptionValue("time_limit", float(self.highs.getRunTime()) + limit_s)
         self.highs.run()
         return self.highs.getModelStatus()

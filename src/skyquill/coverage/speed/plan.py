@@ -173,7 +173,7 @@ def plan_speed(
     jlim = None if jmax_a is None else component_limits(jmax_a, norm)
     if jlim is not None:
         a = sparse.vstack([a, _jerk_matrix((p1, p2, p3), jlim * args.safety, vb)], format="csr")
-    lp = _GridLP(a, backend=backend, time_scale=p1.shape[1] / d, deadline=deadline)
+    lp = _GridLP(a, backend=backend, deadline=deadline)
     bounds = _Bounds(ub, None if jlim is None else vb, p1.shape[1], *_ones(n))
     log: tuple[list[float], list[float]] = ([], [])
     stop = (args.jerk_iterations, args.jerk_tol)

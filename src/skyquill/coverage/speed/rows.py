@@ -8,9 +8,9 @@ from typing import Any
 import numpy as np
 from scipy import sparse
 
-from skyquill.coverage.deadline import Deadline
+from skyquill.coverage.deadline import TIME_LIMIT, Deadline
 from skyquill.errors import InfeasibleError, SolverError
-from skyquill.solvers.lp import HOT_SOLVE_LIMIT_S, LinearProgram
+from skyquill.solvers.lp import LinearProgram
 from skyquill.validation import FloatArray
 
 
@@ -139,10 +139,6 @@ def _end_caps(ub: FloatArray, c1: FloatArray, jmax: FloatArray) -> None:
         ub[node] = min(ub[node], float(np.min(cap)))
 
 
-#: Grid points up to which a hot solve gets the base limit ``HOT_SOLVE_LIMIT_S``.
-_HOT_LIMIT_POINTS = 2000
-
-
 class _GridLP:
     """``max sum(b)`` s.t. ``|A b| <= r`` row-wise, ``0 <= b <= ub``; re-solved as bounds change.
 
@@ -151,24 +147,9 @@ class _GridLP:
     only changes bounds.
     """
 
-    def __init__(
-        self,
-        a: Any,
-        *,
-        backend: str,
-        time_scale: float = 1.0,
-        deadline: Deadline | None = None,
-    ) -> None:
-        # A hot solve's time limit grows with the rows per node: polygon
-        # norm limits have m/2 components where per-axis limits have d (the
-        # first pseudo-jerk LP took 0.24 / 0.5 / 1.15 s at m = 8 / 16 / 32
-        # on the 10 m square spiral, n = 1000), and with the grid, like the
-        # simplex's work (slope ~2: a hot start cut at 0.5 s at 8,000 points
-        # went to a cold linprog for every later solve, 86.5 s against 3.6 s).
-        size = max(1.0, a.shape[1] / _HOT_LIMIT_POINTS) ** 2
-        self.limit = HOT_SOLVE_LIMIT_S * max(1.0, time_scale) * size
+    def __init__(self, a: Any, *, backend: str, deadline: Deadline | None = None) -> None:
         self.deadline = deadline
-        self.lp = LinearProgram(a, -np.ones(a.shape[1]), backend=backend, time_limit_s=self.limit)
+        self.lp = LinearProgram(a, -np.ones(a.shape[1]), backend=backend)
 
     @property
     def time(self) -> float:
@@ -186,11 +167,15 @@ class _GridLP:
         With a deadline, no solve is started once it is spent, nor given more
         than what is left of it.
         """
+        step = f"speed LP solve {self.lp.solves + 1}"
         if self.deadline is not None:
-            self.deadline.check(f"speed LP solve {self.lp.solves + 1}")
-            self.lp.time_limit_s = max(min(self.limit, self.deadline.remaining()), 1e-3)
+            self.deadline.check(step)
+            self.lp.time_limit_s = max(self.deadline.remaining(), 1e-3)
         self.lp.update_bounds(row_lower=-r, row_upper=r, col_upper=ub)
         sol = self.lp.solve()
+        if sol.status == "time_limit" and self.deadline is not None:
+            self.deadline.check(step)  # spent: raises with the step's name
+            raise InfeasibleError(f"time_limit: stopped at {step}", (TIME_LIMIT,))
         if sol.status == "infeasible":
             raise InfeasibleError("speed-planning LP is infeasible", ("speed_lp",))
         if sol.x is None:
