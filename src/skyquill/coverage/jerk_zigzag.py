@@ -158,7 +158,11 @@ def plan_jerk_zigzag(
         )
     planes = _half_planes(inner)
     states = _states(lanes, u, step, (speed, loop), planes)
-    pieces = [_segment(a, b, limits) for a, b in itertools.pairwise(states)]
+    # Even segments run along a lane (start, between turns, end), odd ones are turns.
+    pieces = [
+        _turn_pieces(a, b, limits) if k % 2 else _lane_pieces(a, b, limits)
+        for k, (a, b) in enumerate(itertools.pairwise(states))
+    ]
     trajectory = _joined(pieces, altitude)
     return JerkZigzag(trajectory, np.array([s[0] for s in states]), speed)
 
@@ -195,7 +199,7 @@ def _turn(step: FloatArray, u: FloatArray, limits: AxisLimits) -> tuple[float, F
     while True:
         state_in = (np.zeros(2), speed * u)
         state_out = (step, -speed * u)
-        ruckig = _ruckig(state_in, state_out, limits)
+        ruckig = _ruckig(state_in, state_out, _box(limits))
         t = np.arange(0.0, ruckig.duration, TURN_SAMPLE_S)
         kinematics = [ruckig.at_time(x) for x in t]
         velocity = np.array([k[1] for k in kinematics])
@@ -290,26 +294,62 @@ def _check_order(states: list[State], u: FloatArray) -> None:
             )
 
 
-def _ruckig(start: State, end: State, limits: AxisLimits) -> Trajectory:
-    """Ruckig's time-optimal motion from ``start`` to ``end``, both axes arriving together."""
-    inp = InputParameter(2)
+def _ruckig(
+    start: State, end: State, limits: tuple[list[float], list[float], list[float]]
+) -> Trajectory:
+    """Ruckig's time-optimal motion from ``start`` to ``end`` (any number of axes, arriving
+    together), under per-axis ``(velocity, acceleration, jerk)`` bounds."""
+    dofs = len(start[0])
+    inp = InputParameter(dofs)
     inp.current_position, inp.current_velocity = list(start[0]), list(start[1])
     inp.target_position, inp.target_velocity = list(end[0]), list(end[1])
-    inp.current_acceleration = inp.target_acceleration = [0.0, 0.0]
-    inp.max_velocity = [limits.vmax] * 2
-    inp.max_acceleration = [limits.amax] * 2
-    inp.max_jerk = [limits.jmax] * 2
+    inp.current_acceleration = inp.target_acceleration = [0.0] * dofs
+    inp.max_velocity, inp.max_acceleration, inp.max_jerk = limits
     inp.synchronization = Synchronization.Time
-    out = Trajectory(2)
-    result = Ruckig(2).calculate(inp, out)
+    out = Trajectory(dofs)
+    result = Ruckig(dofs).calculate(inp, out)
     if result != Result.Working:
         raise SolverError(f"Ruckig failed on a coverage turn or lane: {result}")
     return out
 
 
-def _segment(start: State, end: State, limits: AxisLimits) -> tuple[FloatArray, FloatArray]:
-    """One Ruckig motion as cubic pieces: durations (P,) s and coefficients (P, 4, 2)."""
-    motion = _ruckig(start, end, limits)
+def _box(limits: AxisLimits) -> tuple[list[float], list[float], list[float]]:
+    return [limits.vmax] * 2, [limits.amax] * 2, [limits.jmax] * 2
+
+
+def _turn_pieces(start: State, end: State, limits: AxisLimits) -> tuple[FloatArray, FloatArray]:
+    """A turn, both axes at once: durations (P,) s and coefficients (P, 4, 2)."""
+    return _pieces(_ruckig(start, end, _box(limits)))
+
+
+def _lane_pieces(start: State, end: State, limits: AxisLimits) -> tuple[FloatArray, FloatArray]:
+    """A straight stretch along a lane, one axis along it: the speed is then the norm
+    (two axes at their bounds would fly a diagonal lane at sqrt(2) vmax)."""
+    offset = end[0] - start[0]
+    length = float(np.linalg.norm(offset))
+    if length <= 0.0:
+        return np.zeros(0), np.zeros((0, 4, 2))
+    heading = offset / length
+    with np.errstate(divide="ignore"):
+        amax = float(np.min(limits.amax / np.abs(heading)))
+        jmax = float(np.min(limits.jmax / np.abs(heading)))
+    along = _ruckig(
+        (np.zeros(1), np.array([start[1] @ heading])),
+        (np.array([length]), np.array([end[1] @ heading])),
+        ([limits.vmax], [amax], [jmax]),
+    )
+    durations, scalar = _pieces(along)
+    coeffs = scalar * heading[None, None, :]
+    coeffs[:, 0, :] += start[0]
+    return durations, coeffs
+
+
+def _pieces(motion: Trajectory) -> tuple[FloatArray, FloatArray]:
+    """Ruckig's motion as cubic pieces: durations (P,) s and coefficients (P, 4, d).
+
+    Its phases have constant jerk, so each piece is exact: position, velocity
+    and acceleration at the piece's start, jerk from the acceleration's change.
+    """
     switches = {0.0, motion.duration}
     for profile in motion.profiles[0]:
         switches.update(np.cumsum(profile.t).tolist())
@@ -318,8 +358,8 @@ def _segment(start: State, end: State, limits: AxisLimits) -> tuple[FloatArray, 
     times[-1] = motion.duration
     coeffs = []
     for t0, t1 in itertools.pairwise(times):
-        p0, v0, a0 = (np.asarray(x) for x in motion.at_time(t0))
-        a1 = np.asarray(motion.at_time(t1)[2])
+        p0, v0, a0 = (np.atleast_1d(np.asarray(x, dtype=np.float64)) for x in motion.at_time(t0))
+        a1 = np.atleast_1d(np.asarray(motion.at_time(t1)[2], dtype=np.float64))
         coeffs.append(np.stack([p0, v0, a0 / 2.0, (a1 - a0) / (t1 - t0) / 6.0]))
     return np.diff(times), np.array(coeffs)
 
