@@ -6,7 +6,7 @@ import pytest
 from shapely.geometry import box
 
 from skyquill.coverage.paths import contours, zigzag
-from skyquill.coverage.plan import CoverageOptions, plan_coverage, plan_tuned
+from skyquill.coverage.plan import CoverageOptions, _fitting_epsilons, plan_coverage, plan_tuned
 from skyquill.coverage.regions import MAX_PATH_LENGTH_M, check_width, estimate_path_length
 from skyquill.errors import InputError
 
@@ -46,10 +46,16 @@ def test_a_perimeter_longer_than_the_budget_says_split() -> None:
         check_width(strip, 0.5)
 
 
-def test_tuning_is_refused_at_its_densest_spacing() -> None:
+def test_tuning_skips_the_spacings_whose_path_is_too_long() -> None:
     # 4e4 m² / (0.7 * 2.2 m) + 800 m ~ 26.8 km: fits at epsilon 1 (19 km), not at 0.7.
     region = box(0.0, 0.0, 200.0, 200.0)
     assert estimate_path_length(region, 2.2) < MAX_PATH_LENGTH_M
+    fitting = _fitting_epsilons(region, CoverageOptions(width=2.2))
+    assert 1.0 in fitting and 0.7 not in fitting
+
+
+def test_tuning_is_refused_when_even_its_widest_spacing_is_too_long() -> None:
+    region = box(0.0, 0.0, 250.0, 250.0)  # 6.25e4 m² / 2.2 m ~ 28 km at epsilon 1
     with pytest.raises(InputError, match=r"^width: got 2\.2 m .* expected at most 25 km"):
         plan_tuned(region, CoverageOptions(width=2.2), 0.97)
 

@@ -547,9 +547,9 @@ def _tuned_mission(
     the miss ``goal`` allows.
 
     A mission covers less than its pieces do: the spray closes where a
-    piece's path comes within half a swath of a hole, and what the planning
-    obstacles add to the holes is missed (a 40 x 25 m field with two holes,
-    zigzag: 98.9 % with its pieces at 99 %, 99.1 % with them at 99.5 %).
+    piece's path comes within half a swath of a hole (the headland laps
+    round the holes sweep most of that band back), and what the planning
+    obstacles add to the holes is missed.
 
     Raises
     ------
