@@ -186,3 +186,14 @@ def test_a_flight_that_sprays_into_a_hole_is_refused(monkeypatch: pytest.MonkeyP
     with pytest.raises(InfeasibleError, match="keepout: got a flight") as info:
         plan_coverage(region, ZIGZAG)
     assert info.value.families == ("keepout",)
+
+
+def test_every_hole_gets_a_headland_lap_unless_it_would_leave_the_field() -> None:
+    inner = region_from_vertices(SQUARE, holes=[[(6, 6), (9, 6), (9, 10), (6, 10)]])
+    edge = region_from_vertices(SQUARE, holes=[[(0.5, 6), (3, 6), (3, 9), (0.5, 9)]])
+    with_lap, without = plan_coverage(inner, ZIGZAG), plan_coverage(edge, ZIGZAG)
+    assert with_lap.summary()["headlands"] == 1 and without.summary()["headlands"] == 0
+    _assert_safe(with_lap)
+    # The lap sweeps the band round the hole that the gated pieces miss.
+    band = Polygon(inner.interiors[0]).buffer(1.0).difference(Polygon(inner.interiors[0]))
+    assert band.difference(with_lap.mission.swept).area < 0.05 * band.area  # type: ignore[union-attr]

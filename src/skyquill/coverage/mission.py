@@ -86,6 +86,8 @@ class Mission:
         The area the spray reached (m).
     pieces : int
         Pieces flown.
+    headlands : int
+        Laps flown round holes (see :func:`_hole_rings`).
     fields : int
         Fields of the region.
     transit_length_m : float
@@ -101,6 +103,7 @@ class Mission:
     coverage: float
     swept: BaseGeometry
     pieces: int
+    headlands: int
     fields: int
     transit_length_m: float
 
@@ -110,6 +113,7 @@ class Mission:
             "keepout": self.keepout.summary(),
             "fields": self.fields,
             "pieces": self.pieces,
+            "headlands": self.headlands,
             "transit_length_m": self.transit_length_m,
         }
 
@@ -170,6 +174,7 @@ def fly_mission(
         )
         if one is not None:
             flown.append(one)
+    pieces_flown = len(flown)
     flown += _hole_rings(region, width, legs, altitude)
     if not flown:
         raise InfeasibleError(
@@ -205,7 +210,8 @@ def fly_mission(
         keepout=keepout,
         coverage=covered,
         swept=area,
-        pieces=len(flown),
+        pieces=pieces_flown,
+        headlands=len(flown) - pieces_flown,
         fields=len(fields(region)),
         transit_length_m=float(sum(_length(r) for r in routes)),
     )
