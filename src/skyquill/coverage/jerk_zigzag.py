@@ -57,6 +57,9 @@ MIN_PHASE_S = 1e-9
 #: 1.0 and 0.1, 98.7 % in 26.1 s at 0.9 and 0.15).
 SIDE_INSETS = (1.0, 0.95, 0.9, 0.8)
 EDGE_GAPS = (0.05, 0.1, 0.2, 0.3, 0.45)
+#: Turn entry speeds tried, fractions of vmax: slower turns sweep shallower loops and fit
+#: the short lanes of a triangle's apex (none of the full-speed layouts did).
+TURN_SPEEDS = (1.0, 0.6, 0.35)
 #: Lane spacings tried, in swaths.
 SPACINGS = (1.0, 0.9, 0.8)
 #: The default shape (no tuning), in half swaths.
@@ -101,12 +104,15 @@ class JerkZigzagShape:
         Distance of the first and last lanes from the region's sides.
     edge_gap : float
         Closest approach of a turn's loop, the start and the end to the boundary.
+    turn_speed : float
+        The highest turn entry speed tried, a fraction of ``vmax`` in (0, 1].
     """
 
     angle: float
     spacing: float
     side_inset: float
     edge_gap: float
+    turn_speed: float = 1.0
 
 
 @dataclass(frozen=True)
@@ -149,7 +155,7 @@ def plan_jerk_zigzag(
             ("coverage",),
         )
     step = _spacing(lanes, u) * _normal(u)
-    speed, loop = _turn(step, u, limits)
+    speed, loop = _turn(step, u, limits, shape.turn_speed)
     inner = region.buffer(-shape.edge_gap, join_style="mitre")
     if not isinstance(inner, Polygon) or inner.is_empty:
         raise InfeasibleError(
@@ -189,13 +195,15 @@ def _lanes(region: Polygon, shape: JerkZigzagShape, u: FloatArray) -> list[Float
     return chords
 
 
-def _turn(step: FloatArray, u: FloatArray, limits: AxisLimits) -> tuple[float, FloatArray]:
+def _turn(
+    step: FloatArray, u: FloatArray, limits: AxisLimits, fraction: float
+) -> tuple[float, FloatArray]:
     """The fastest entry speed whose turn keeps the speed norm, and the loop (K, 2).
 
     The loop is sampled relative to the entry point, for a turn entered
     along ``+u`` (the other end's is its mirror along ``u``).
     """
-    speed = limits.vmax
+    speed = fraction * limits.vmax
     while True:
         state_in = (np.zeros(2), speed * u)
         state_out = (step, -speed * u)
@@ -394,9 +402,9 @@ def tuning_shapes(region: Polygon, width: float) -> list[JerkZigzagShape]:
     """Every shape of the tuning grid (:data:`SPACINGS`, :data:`SIDE_INSETS`, :data:`EDGE_GAPS`)."""
     half = 0.5 * width
     return [
-        JerkZigzagShape(angle, spacing * width, inset * half, gap * half)
-        for angle, spacing, inset, gap in itertools.product(
-            lane_angles(region), SPACINGS, SIDE_INSETS, EDGE_GAPS
+        JerkZigzagShape(angle, spacing * width, inset * half, gap * half, speed)
+        for angle, spacing, inset, gap, speed in itertools.product(
+            lane_angles(region), SPACINGS, SIDE_INSETS, EDGE_GAPS, TURN_SPEEDS
         )
     ]
 

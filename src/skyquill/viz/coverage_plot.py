@@ -66,9 +66,10 @@ def plot_coverage(plan: CoveragePlan, path: str | Path) -> None:
     top.set_aspect("equal")
     top.set_xlabel("x (m)")
     top.set_ylabel("y (m)")
+    missed = "" if plan.missed is None else f", {plan.missed.area_m2:.3g} m²"
     top.set_title(
         f"{opts.pattern}: {plan.duration:.1f} s, {plan.path_length:.1f} m, "
-        f"coverage {100 * plan.coverage:.1f} % (red: missed)"
+        f"coverage {100 * plan.coverage:.1f} % (red: missed{missed})"
     )
     rows = (
         ("speed (m/s)", speed[:, None], opts.vmax),
