@@ -44,7 +44,6 @@ from skyquill.trajectory import (
 from skyquill.trajectory.horner import horner
 from skyquill.validation import FloatArray
 
-
 #: Largest position jump accepted where pieces meet, m (round-off of exported files).
 JUMP_TOLERANCE_M = 1e-6
 
@@ -165,8 +164,8 @@ class Motion:
         return taylor_bound(derivatives, 0.5 * (b - a))
 
 
-def motion_of(name: str, trajectory: Trajectory, horizon: float) -> Motion:
-    """``trajectory`` as exact polynomial pieces on ``[0, horizon]``, held after its end.
+def motion_of(name: str, trajectory: Trajectory, horizon: float, start_s: float = 0.0) -> Motion:
+    """``trajectory`` as exact polynomial pieces on ``[0, horizon]``, held before and after.
 
     Parameters
     ----------
@@ -175,7 +174,9 @@ def motion_of(name: str, trajectory: Trajectory, horizon: float) -> Motion:
     trajectory
         Any of the kinds in the module docstring, 3 axes, z up, m.
     horizon
-        End of the show, s, at least the trajectory's duration.
+        End of the show, s, at least ``start_s`` plus the trajectory's duration.
+    start_s
+        Show time of the trajectory's 0, s; before it the drone waits at its start.
 
     Raises
     ------
@@ -187,18 +188,24 @@ def motion_of(name: str, trajectory: Trajectory, horizon: float) -> Motion:
     breaks, coeffs = _pieces(name, trajectory)
     ends = horner(coeffs, np.diff(breaks), 0).reshape(-1, 3)
     _check_continuous(name, breaks, coeffs[1:, 0], ends[:-1])
-    end = ends[-1:]
+    breaks = breaks + start_s
+    if start_s > 0.0:
+        breaks = np.concatenate([[0.0], breaks])
+        coeffs = np.concatenate([_hold(coeffs[0, 0], coeffs.shape[1]), coeffs])
     if horizon > breaks[-1]:
-        hold = np.zeros((1, coeffs.shape[1], 3))
-        hold[0, 0] = end[0]
         breaks = np.append(breaks, horizon)
-        coeffs = np.concatenate([coeffs, hold])
+        coeffs = np.concatenate([coeffs, _hold(ends[-1], coeffs.shape[1])])
     return Motion(np.asarray(breaks, dtype=float), np.asarray(coeffs, dtype=float))
 
 
-def _check_continuous(
-    name: str, breaks: FloatArray, starts: FloatArray, ends: FloatArray
-) -> None:
+def _hold(point: FloatArray, order: int) -> FloatArray:
+    """One piece standing at ``point`` (3,): shape (1, order, 3)."""
+    hold = np.zeros((1, order, 3))
+    hold[0, 0] = point
+    return hold
+
+
+def _check_continuous(name: str, breaks: FloatArray, starts: FloatArray, ends: FloatArray) -> None:
     """Refuse a position that jumps where pieces meet: the bounds hold only for a continuous one."""
     jumps = np.linalg.norm(starts - ends, axis=1)
     if jumps.size and jumps.max() > JUMP_TOLERANCE_M:

@@ -179,16 +179,29 @@ def check_separation(
     pos = np.stack([m.position(t) for m in motions])
     locals_ = [m.local(t[:-1], t[1:]) for m in motions]
     closest = _Closest(first.size, minimum)
-    candidates = _candidates(pos, locals_, t, first, second, minimum)
-    grid = _grid_intervals(candidates, pos, locals_, t, first, second)
+    candidates = _candidates(
+        pos=pos, locals_=locals_, t=t, first=first, second=second, minimum=minimum
+    )
+    grid = _grid_intervals(
+        candidates=candidates, pos=pos, locals_=locals_, t=t, first=first, second=second
+    )
     closest.record(grid.pair, grid.a, grid.da)
     closest.record(grid.pair, grid.b, grid.db)
     lower, count = _refine(grid, motions, first, second, closest)
     examined = np.unique(candidates[0]).size
-    return _result(minimum, lower, count, closest, first, second, examined)
+    return _result(
+        minimum=minimum,
+        lower=lower,
+        count=count,
+        closest=closest,
+        first=first,
+        second=second,
+        examined=examined,
+    )
 
 
 def _candidates(
+    *,
     pos: FloatArray,
     locals_: Sequence[LocalMotion],
     t: FloatArray,
@@ -216,6 +229,7 @@ def _candidates(
 
 
 def _grid_intervals(
+    *,
     candidates: tuple[IntArray, IntArray],
     pos: FloatArray,
     locals_: Sequence[LocalMotion],
@@ -352,6 +366,7 @@ def _local(motions: Sequence[Motion], who: IntArray, a: FloatArray, b: FloatArra
 
 
 def _result(
+    *,
     minimum: float,
     lower: tuple[float, int, float],
     count: int,
@@ -362,10 +377,10 @@ def _result(
 ) -> Separation:
     encounters = []
     for p in np.flatnonzero(np.isfinite(closest.first_bad)):
-        encounters.append(_encounter(int(p), float(closest.first_bad[p]), closest, first, second))
+        encounters.append(_encounter(int(p), float(closest.first_bad[p]), closest, (first, second)))
     bound, pair, when = lower
     if not encounters and bound < minimum:  # not found closer, not proven farther either
-        encounters.append(_encounter(pair, when, closest, first, second, proven=False))
+        encounters.append(_encounter(pair, when, closest, (first, second), proven=False))
     encounters.sort(key=lambda e: (e.first_time_s, e.drones))
     best = int(np.argmin(closest.d))
     finite_lower = min(bound, closest.best)
@@ -383,8 +398,9 @@ def _result(
 
 
 def _encounter(
-    p: int, when: float, closest: _Closest, first: IntArray, second: IntArray, proven: bool = True
+    p: int, when: float, closest: _Closest, pairs: tuple[IntArray, IntArray], proven: bool = True
 ) -> Encounter:
+    first, second = pairs
     return Encounter(
         drones=(int(first[p]), int(second[p])),
         first_time_s=when,
