@@ -119,9 +119,9 @@ def _checked(area: Any) -> Polygon | MultiPolygon:
             f"--geofence: got a {getattr(area, 'geom_type', type(area).__name__)}, expected a "
             "Polygon or MultiPolygon"
         )
-    if area.is_empty or area.area <= 0.0:
-        raise InputError("--geofence: got an empty polygon, expected one enclosing an area")
-    if not area.is_valid:
+    if not area.is_empty and not area.is_valid:
         reason = shapely.is_valid_reason(area)
         raise InputError(f"--geofence: got an invalid polygon ({reason}), expected a valid one")
+    if area.is_empty or area.area <= 0.0:
+        raise InputError("--geofence: got an empty polygon, expected one enclosing an area")
     return area

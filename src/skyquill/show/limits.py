@@ -111,7 +111,7 @@ def check_limits(
             values = value_of(s)
             k = int(np.argmax(values * sense))
             if worst is None or values[k] * sense > worst.value * sense:
-                worst = Measured(check, float(values[k]), limit, s.name, float(s.t[k]))
+                worst = Measured(check, float(values[k]) + 0.0, limit, s.name, float(s.t[k]))
             if limit is not None:
                 bad = np.flatnonzero(values * sense > limit * sense)
                 if bad.size:
