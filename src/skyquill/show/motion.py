@@ -10,6 +10,8 @@ trajectory kind is turned into one (:func:`motion_of`):
 * :class:`~skyquill.trajectory.SplineTrajectory` by its exact conversion;
 * :class:`~skyquill.trajectory.SampledTrajectory` (``trajectory.csv``) as
   skyquill flies it: the cubic Hermite through the positions and velocities;
+* :class:`~skyquill.trajectory.RetimedPath` (coverage) by composing its curve's
+  polynomial spans with its timing law's pieces;
 * :class:`~skyquill.trajectory.RestToRestSequence` piece after piece.
 
 A drone that has finished holds its last position until the show ends.
@@ -28,15 +30,19 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from functools import cached_property
+from itertools import pairwise
 
 import numpy as np
+from numpy.polynomial import Polynomial
 from numpy.typing import NDArray
-from scipy.interpolate import CubicHermiteSpline
+from scipy.interpolate import BSpline, CubicHermiteSpline
+from scipy.optimize import brentq
 
 from skyquill.errors import InputError
 from skyquill.trajectory import (
     PiecewisePolynomial,
     RestToRestSequence,
+    RetimedPath,
     SampledTrajectory,
     SplineTrajectory,
     Trajectory,
@@ -227,10 +233,70 @@ def _pieces(name: str, traj: Trajectory) -> tuple[FloatArray, FloatArray]:
         return np.asarray(hermite.x), np.asarray(hermite.c)[::-1].transpose(1, 0, 2)
     if isinstance(traj, RestToRestSequence):
         return _joined(name, traj)
+    if isinstance(traj, RetimedPath):
+        return _retimed(traj)
     raise InputError(
         f"{name}: got a {type(traj).__name__} trajectory, expected a polynomial, B-spline, "
-        "sampled or sequence trajectory (the guaranteed check needs polynomial pieces)"
+        "sampled, retimed or sequence trajectory (the guaranteed check needs polynomial pieces)"
     )
+
+
+def _retimed(traj: RetimedPath) -> tuple[FloatArray, FloatArray]:
+    """``C(u(t))`` exactly: cut where ``u`` crosses a knot of ``C``, compose the polynomials.
+
+    Between two cuts ``C`` is one polynomial of degree ``k`` in ``u`` and ``u`` one of
+    degree ``q`` in ``t``, so ``C(u(t))`` is one polynomial of degree ``k q``
+    (:mod:`numpy.polynomial` composes them).
+    """
+    knots, taylor = _curve_spans(traj.curve)
+    breaks = [0.0]
+    pieces: list[FloatArray] = []
+    timing = traj.timing
+    for i in range(timing.n_pieces):
+        start, width = float(timing.breaks[i]), float(timing.breaks[i + 1] - timing.breaks[i])
+        u = Polynomial(timing.coeffs[i, :, 0])
+        for a, b in pairwise(_knot_crossings(u, width, knots)):
+            local = u(Polynomial([a, 1.0]))  # u on [a, b], in time from a
+            pieces.append(_composed(local, 0.5 * (b - a), knots, taylor))
+            breaks.append(start + b)
+    width = max(p.shape[0] for p in pieces)
+    coeffs = np.stack([np.pad(p, ((0, width - p.shape[0]), (0, 0))) for p in pieces])
+    return np.array(breaks), coeffs
+
+
+def _composed(u: Polynomial, middle: float, knots: FloatArray, taylor: FloatArray) -> FloatArray:
+    """``C(u(tau))`` on a stretch where ``u`` stays in one span: coefficients (K, 3), lowest first.
+
+    ``middle`` is a time inside the stretch, which picks the span.
+    """
+    span = int(np.clip(np.searchsorted(knots, u(middle), "right") - 1, 0, knots.size - 2))
+    shifted = u - knots[span]
+    axes = [np.asarray(Polynomial(taylor[span, :, a])(shifted).coef, float) for a in range(3)]
+    size = max(c.size for c in axes)  # numpy trims the zeros of a constant axis
+    return np.stack([np.pad(c, (0, size - c.size)) for c in axes], axis=1)
+
+
+def _curve_spans(curve: BSpline) -> tuple[FloatArray, FloatArray]:
+    """Distinct knots of ``curve`` (S + 1,) and its Taylor coefficients at each span's start.
+
+    Returns the knots and coefficients (S, k + 1, 3) in ``u - knots[s]``, lowest first.
+    """
+    k = curve.k
+    knots = np.unique(curve.t[k : curve.t.size - k])
+    orders = [curve, *(curve.derivative(m) for m in range(1, k + 1))]
+    taylor = [
+        np.asarray(d(knots[:-1]), dtype=float) / math.factorial(m) for m, d in enumerate(orders)
+    ]
+    return knots, np.stack(taylor, axis=1)
+
+
+def _knot_crossings(u: Polynomial, width: float, knots: FloatArray) -> list[float]:
+    """0, the times in ``(0, width)`` where the rising ``u`` crosses a knot, and ``width``."""
+    low, high = float(u(0.0)), float(u(width))
+    inner = knots[(knots > low) & (knots < high)]
+    times = [brentq(lambda x, knot=knot: float(u(x)) - knot, 0.0, width) for knot in inner]
+    cuts = sorted({0.0, width, *times})
+    return [c for c in cuts if 0.0 <= c <= width]
 
 
 def _joined(name: str, seq: RestToRestSequence) -> tuple[FloatArray, FloatArray]:

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from scipy.interpolate import BSpline
+from scipy.interpolate import make_interp_spline
 from show_cases import line, move
 
 from skyquill.errors import InputError
@@ -18,6 +18,17 @@ from skyquill.trajectory import (
 )
 
 
+def _retimed() -> RetimedPath:
+    """A cubic curve flown along a smooth-step timing law (as coverage's speed planning does)."""
+    rng = np.random.default_rng(0)
+    curve = make_interp_spline(np.linspace(0.0, 1.0, 12), rng.normal(size=(12, 3)), k=3)
+    t = np.linspace(0.0, 5.0, 9)
+    x = t / 5.0
+    return RetimedPath.from_samples(
+        curve, t, x**2 * (3 - 2 * x), 6 * x * (1 - x) / 5.0, 6 * (1 - 2 * x) / 25.0
+    )
+
+
 def _sampled() -> SampledTrajectory:
     traj = move([0, 0, 1], [2, 1, 2], 3.0)
     s = traj.sample(20.0)
@@ -28,6 +39,7 @@ KINDS: dict[str, Trajectory] = {
     "polynomial": line([0, 0, 1], [1, 2, 0], 2.0),
     "bspline": move([0, 0, 1], [2, 1, 2], 3.0),
     "sampled": _sampled(),
+    "retimed": _retimed(),
     "sequence": RestToRestSequence(
         (move([0, 0, 1], [1, 0, 1], 2.0), move([1, 0, 1], [1, 1, 1], 2.5))
     ),
@@ -71,11 +83,23 @@ def test_a_jump_between_pieces_is_refused() -> None:
         motion_of("d0", jumpy, 2.0)
 
 
-def test_a_retimed_path_is_refused_by_name() -> None:
-    curve = BSpline(np.array([0, 0, 1, 1.0]), np.array([[0, 0, 1], [1, 0, 1.0]]), 1)
-    timing = PiecewisePolynomial(np.array([0.0, 2.0]), np.array([[[0.0], [0.5]]]))
-    with pytest.raises(InputError, match=r"d1: got a RetimedPath trajectory, expected"):
-        motion_of("d1", RetimedPath(curve, timing), 2.0)
+class _Unknown:
+    """A trajectory kind the check does not know (only the protocol)."""
+
+    duration = 1.0
+    dim = 3
+    breakpoints = np.array([0.0, 1.0])
+
+    def evaluate(self, t: np.ndarray, order: int = 0) -> np.ndarray:
+        return np.zeros((np.asarray(t).size, 3))
+
+    def sample(self, rate: float) -> None:
+        raise NotImplementedError
+
+
+def test_an_unknown_kind_is_refused_by_name() -> None:
+    with pytest.raises(InputError, match=r"d1: got a _Unknown trajectory, expected a polynomial"):
+        motion_of("d1", _Unknown(), 2.0)  # type: ignore[arg-type]
 
 
 def test_two_axes_are_refused() -> None:
