@@ -9,9 +9,9 @@ from hypothesis import strategies as st
 from show_cases import line, move, planted
 
 from skyquill.errors import InputError
-from skyquill.show import ShowDrone, separation_of
+from skyquill.show import ShowDrone, separation, separation_of
 from skyquill.show.motion import motion_of
-from skyquill.show.separation import TOLERANCE_M, check_separation
+from skyquill.show.separation import TOLERANCE_M, guaranteed_separation
 from skyquill.trajectory import PiecewisePolynomial, SplineTrajectory
 from skyquill.trajectory.horner import horner
 
@@ -82,14 +82,14 @@ def test_a_late_start_waits_at_its_first_position() -> None:
 
 
 def test_one_drone_has_no_pair() -> None:
-    result = check_separation([motion_of("a", line([0, 0, 0], [1, 0, 0], 1.0), 1.0)], 3.0)
+    result = guaranteed_separation([motion_of("a", line([0, 0, 0], [1, 0, 0], 1.0), 1.0)], 3.0)
     assert result.passed and result.pairs == 0 and result.lower_bound_m == np.inf
 
 
 def test_negative_minimum_is_refused() -> None:
     motion = motion_of("a", line([0, 0, 0], [1, 0, 0], 1.0), 1.0)
     with pytest.raises(InputError, match=r"minimum_m: got -1"):
-        check_separation([motion, motion], -1.0)
+        guaranteed_separation([motion, motion], -1.0)
 
 
 def _continuous(seed: int, pieces: int, order: int) -> PiecewisePolynomial:
@@ -134,3 +134,14 @@ def test_a_hundred_drones_are_pruned_to_their_neighbours() -> None:
     assert result.passed and result.pairs == 4950
     assert result.pairs_examined < 400  # neighbours only: the rest pruned by bounding boxes
     assert 2.0 <= result.lower_bound_m <= result.attained_m <= result.lower_bound_m + TOLERANCE_M
+
+
+def test_pairs_compared_in_chunks_give_the_same_answer(monkeypatch: pytest.MonkeyPatch) -> None:
+    drones = [
+        ShowDrone(move([0, 3 * k, 1], [10, 3 * k + (k % 2), 1 + k % 3], 10.0 + k), f"d{k}")
+        for k in range(8)
+    ]
+    whole = separation_of(drones, 1.0)
+    monkeypatch.setattr(separation, "CHUNK", 7)
+    chunked = separation_of(drones, 1.0)
+    assert chunked == whole

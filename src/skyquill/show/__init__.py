@@ -14,7 +14,7 @@ from skyquill.show.geofence import Geofence, read_geofence
 from skyquill.show.limits import ShowLimits
 from skyquill.show.load import ShowDrone, load_show
 from skyquill.show.report import Measured, ShowReport, Violation
-from skyquill.show.separation import Encounter, Separation, check_separation
+from skyquill.show.separation import Encounter, Separation, guaranteed_separation
 
 __all__ = [
     "MIN_DISTANCE_M",
@@ -26,8 +26,8 @@ __all__ = [
     "ShowLimits",
     "ShowReport",
     "Violation",
-    "check_separation",
     "check_show",
+    "guaranteed_separation",
     "load_show",
     "read_geofence",
     "separation_of",

@@ -9,7 +9,7 @@ from skyquill.show.limits import ShowLimits, check_limits, check_start
 from skyquill.show.load import ShowDrone
 from skyquill.show.motion import motion_of
 from skyquill.show.report import ShowReport, Violation
-from skyquill.show.separation import Separation, check_separation
+from skyquill.show.separation import Separation, guaranteed_separation
 from skyquill.validation import as_float
 
 #: Skybrush's default distance between drones outdoors, m.
@@ -24,7 +24,7 @@ def separation_of(drones: Sequence[ShowDrone], min_distance_m: float) -> Separat
     """
     horizon = max(d.end_s for d in drones)
     motions = [motion_of(d.name, d.trajectory, horizon, d.start_s) for d in drones]
-    return check_separation(motions, min_distance_m)
+    return guaranteed_separation(motions, min_distance_m)
 
 
 def check_show(

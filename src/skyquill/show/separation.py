@@ -35,6 +35,8 @@ WINDOW = 32
 TOLERANCE_M = 0.01
 #: Narrowest interval bisected, s: below it an interval that is still not proven is reported.
 MIN_WIDTH_S = 1e-6
+#: Pair-windows whose bounding boxes are compared at once (memory: ~100 bytes each).
+CHUNK = 2_000_000
 #: Most intervals held at once (memory: ~20 float64 each).
 MAX_INTERVALS = 5_000_000
 
@@ -150,7 +152,7 @@ class _Closest:
         return float(self.d.min()) if self.d.size else math.inf
 
 
-def check_separation(
+def guaranteed_separation(
     motions: Sequence[Motion], minimum_m: float, *, step_s: float = STEP_S
 ) -> Separation:
     """The guaranteed closest approach of ``motions`` (all on one clock), against ``minimum_m``.
@@ -177,13 +179,13 @@ def check_separation(
     horizon = motions[0].horizon
     t = np.linspace(0.0, horizon, max(1, math.ceil(horizon / step_s)) + 1)
     pos = np.stack([m.position(t) for m in motions])
-    locals_ = [m.local(t[:-1], t[1:]) for m in motions]
+    # Only the speed bounds of the whole grid are kept: the derivatives are recomputed
+    # for the intervals that survive the pruning.
+    speed = np.stack([m.local(t[:-1], t[1:]).speed for m in motions])
     closest = _Closest(first.size, minimum)
-    candidates = _candidates(
-        pos=pos, locals_=locals_, t=t, first=first, second=second, minimum=minimum
-    )
+    candidates = _candidates(pos=pos, speed=speed, t=t, first=first, second=second, minimum=minimum)
     grid = _grid_intervals(
-        candidates=candidates, pos=pos, locals_=locals_, t=t, first=first, second=second
+        candidates=candidates, pos=pos, motions=motions, t=t, first=first, second=second
     )
     closest.record(grid.pair, grid.a, grid.da)
     closest.record(grid.pair, grid.b, grid.db)
@@ -203,7 +205,7 @@ def check_separation(
 def _candidates(
     *,
     pos: FloatArray,
-    locals_: Sequence[LocalMotion],
+    speed: FloatArray,
     t: FloatArray,
     first: IntArray,
     second: IntArray,
@@ -213,26 +215,38 @@ def _candidates(
     n_int = t.size - 1
     starts = np.arange(0, n_int, WINDOW)
     ends = np.minimum(starts + WINDOW, n_int)
-    speed = np.stack([lm.speed for lm in locals_])
     # Within an interval a drone is within speed * width / 2 of one of its ends.
     grow = np.maximum.reduceat(speed * np.diff(t)[None, :] / 2.0, starts, axis=1)[..., None]
     lo = np.minimum(np.minimum.reduceat(pos[:, :-1], starts, axis=1), pos[:, ends]) - grow
     hi = np.maximum(np.maximum.reduceat(pos[:, :-1], starts, axis=1), pos[:, ends]) + grow
-    gap = np.maximum(0.0, np.maximum(lo[first] - hi[second], lo[second] - hi[first]))
-    box_gap = np.linalg.norm(gap, axis=2)  # (pairs, windows)
+    chunks = _chunks(first.size, starts.size)
     # The distance at each window's start is one the show attains: pairs whose boxes
     # stay farther apart than it (and than the minimum) cannot hold the closest approach.
-    sampled = np.linalg.norm(pos[first][:, starts] - pos[second][:, starts], axis=2)
-    threshold = max(minimum, float(sampled.min()))
-    pair, window = np.nonzero(box_gap <= threshold)
-    return pair, window
+    sampled = min(
+        float(np.linalg.norm(pos[first[c]][:, starts] - pos[second[c]][:, starts], axis=2).min())
+        for c in chunks
+    )
+    threshold = max(minimum, sampled)
+    found = []
+    for c in chunks:
+        i, j = first[c], second[c]
+        gap = np.maximum(0.0, np.maximum(lo[i] - hi[j], lo[j] - hi[i]))
+        pair, window = np.nonzero(np.linalg.norm(gap, axis=2) <= threshold)
+        found.append((pair + c.start, window))
+    return np.concatenate([p for p, _ in found]), np.concatenate([w for _, w in found])
+
+
+def _chunks(n_pairs: int, n_windows: int) -> list[slice]:
+    """Slices of the pairs that keep a chunk's (pairs, windows, 3) arrays within bounds."""
+    size = max(1, CHUNK // n_windows)
+    return [slice(s, min(s + size, n_pairs)) for s in range(0, n_pairs, size)]
 
 
 def _grid_intervals(
     *,
     candidates: tuple[IntArray, IntArray],
     pos: FloatArray,
-    locals_: Sequence[LocalMotion],
+    motions: Sequence[Motion],
     t: FloatArray,
     first: IntArray,
     second: IntArray,
@@ -247,16 +261,8 @@ def _grid_intervals(
     i, j = first[pair], second[pair]
     da = np.linalg.norm(pos[i, k] - pos[j, k], axis=1)
     db = np.linalg.norm(pos[i, k + 1] - pos[j, k + 1], axis=1)
-    width = max(lm.derivatives.shape[1] for lm in locals_)
-    derivs = np.stack([_pad(lm.derivatives, width) for lm in locals_])
-    inside = np.stack([lm.inside for lm in locals_])
-    speed = np.stack([lm.speed for lm in locals_])
     a, b = t[k], t[k + 1]
-    w = _relative(
-        LocalMotion(derivs[i, k], inside[i, k], speed[i, k]),
-        LocalMotion(derivs[j, k], inside[j, k], speed[j, k]),
-        0.5 * (b - a),
-    )
+    w = _relative(_local(motions, i, a, b), _local(motions, j, a, b), 0.5 * (b - a))
     return _Intervals(pair, a, b, da, db, w)
 
 
