@@ -168,16 +168,19 @@ def guaranteed_separation(
 
     Raises
     ------
+    InputError
+        A negative or non-finite ``minimum_m``, a ``step_s`` that is not positive.
     SolverError
         More than :data:`MAX_INTERVALS` intervals would have to be bisected at once.
     """
     minimum = as_float("minimum_m", minimum_m, nonneg=True)
+    step = as_float("step_s", step_s, positive=True)
     n = len(motions)
     first, second = np.triu_indices(n, 1)
     if n < 2:
         return Separation(minimum, math.inf, math.inf, (-1, -1), math.nan, (), 0, 0, 0)
     horizon = motions[0].horizon
-    t = np.linspace(0.0, horizon, max(1, math.ceil(horizon / step_s)) + 1)
+    t = np.linspace(0.0, horizon, max(1, math.ceil(horizon / step)) + 1)
     pos = np.stack([m.position(t) for m in motions])
     # Only the speed bounds of the whole grid are kept: the derivatives are recomputed
     # for the intervals that survive the pruning.
