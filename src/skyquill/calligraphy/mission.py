@@ -1014,28 +1014,27 @@ def _pen_windows(roles: FloatArray, times: FloatArray, n: int) -> tuple[tuple[fl
 def check_separation(
     trajectories: list[Trajectory], minimum_m: float = 1.0, rate_hz: float = 50.0
 ) -> float:
-    """Smallest pairwise distance over the whole flight, m; raise if below ``minimum_m``.
+    """Guaranteed smallest pairwise distance over the whole flight, m; raise if below ``minimum_m``.
 
+    Not sampled: :func:`skyquill.show.separation_of` bounds the distance between
+    samples, so a show that passes here passes ``skyquill check --min-distance``.
     Drones that finish early hold their last position (landed at home).
+    ``rate_hz`` is kept for callers and no longer used.
     """
+    from skyquill.show import ShowDrone, separation_of
+
     minimum = as_float("minimum_m", minimum_m, positive=True)
-    horizon = max(t.duration for t in trajectories)
-    t = np.linspace(0.0, horizon, max(2, math.ceil(horizon * rate_hz) + 1))
-    tracks = [tr.evaluate(np.minimum(t, tr.duration)) for tr in trajectories]
-    closest = math.inf
-    for i in range(len(tracks)):
-        for j in range(i + 1, len(tracks)):
-            gap = np.linalg.norm(tracks[i] - tracks[j], axis=1)
-            k = int(np.argmin(gap))
-            if gap[k] < closest:
-                closest = float(gap[k])
-            if gap[k] < minimum:
-                raise InfeasibleError(
-                    f"separation: drones {i} and {j} come within {gap[k]:.3f} m at "
-                    f"t = {t[k]:.2f} s, expected at least {minimum:g} m",
-                    ("separation",),
-                )
-    return closest
+    as_float("rate_hz", rate_hz, positive=True)
+    drones = [ShowDrone(tr, f"drone {i}") for i, tr in enumerate(trajectories)]
+    result = separation_of(drones, minimum)
+    if not result.passed:
+        e = result.encounters[0]
+        raise InfeasibleError(
+            f"separation: drones {e.drones[0]} and {e.drones[1]} come within {e.closest_m:.3f} m "
+            f"at t = {e.first_time_s:.2f} s, expected at least {minimum:g} m",
+            ("separation",),
+        )
+    return result.lower_bound_m
 
 
 #: How far the simulated board is raised into the planned tip's path when the

@@ -160,6 +160,7 @@ def parse_vector3(option: str, text: str, unit: str) -> FloatArray:
 
 # Register the commands (each module adds its own to ``app``).
 from skyquill.cli import (  # noqa: E402
+    check_cmd,
     cover_cmd,
     export_cmd,
     fit_cmd,
@@ -173,6 +174,7 @@ from skyquill.cli import (  # noqa: E402
 
 __all__ = [
     "app",
+    "check_cmd",
     "cover_cmd",
     "export_cmd",
     "fit_cmd",

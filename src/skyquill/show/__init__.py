@@ -1,0 +1,34 @@
+"""Show validation: any set of trajectories checked together as one show (``skyquill check``).
+
+* :mod:`.load` -- the drones of plan directories, trajectory files and ``.skyc`` archives;
+* :mod:`.motion` -- a drone as exact polynomial pieces on the show clock, with speed bounds;
+* :mod:`.separation` -- the closest approach of every pair, guaranteed between samples;
+* :mod:`.geofence` -- a polygon in the show's metres and a ceiling;
+* :mod:`.limits` -- speeds, acceleration, altitude and geofence per drone, sampled densely;
+* :mod:`.report` -- violations, measured extremes, the report;
+* :mod:`.check` -- all of it on one show.
+"""
+
+from skyquill.show.check import MIN_DISTANCE_M, check_show, separation_of
+from skyquill.show.geofence import Geofence, read_geofence
+from skyquill.show.limits import ShowLimits
+from skyquill.show.load import ShowDrone, load_show
+from skyquill.show.report import Measured, ShowReport, Violation
+from skyquill.show.separation import Encounter, Separation, guaranteed_separation
+
+__all__ = [
+    "MIN_DISTANCE_M",
+    "Encounter",
+    "Geofence",
+    "Measured",
+    "Separation",
+    "ShowDrone",
+    "ShowLimits",
+    "ShowReport",
+    "Violation",
+    "check_show",
+    "guaranteed_separation",
+    "load_show",
+    "read_geofence",
+    "separation_of",
+]

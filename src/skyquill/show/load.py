@@ -1,0 +1,113 @@
+"""The drones of a show, read from plan directories, trajectory files and ``.skyc`` archives.
+
+Every path is read by the reader that already exists for it
+(:func:`skyquill.io.plan_dir.read_plan`, :func:`skyquill.io.skyc.read_show_json`);
+several paths are one show on one clock.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from skyquill.errors import InputError
+from skyquill.io.plan_dir import read_plan
+from skyquill.io.skyc import read_show_json, show_trajectories
+from skyquill.trajectory import Trajectory
+
+#: File types read, by suffix.
+SUFFIXES = (".json", ".csv", ".skyc")
+
+
+@dataclass(frozen=True)
+class ShowDrone:
+    """One drone of a show.
+
+    Attributes
+    ----------
+    name
+        Where it came from (``plan/trajectory_0``, ``show.skyc/drone3``).
+    trajectory
+        Its flight, z-up world frame, m, on its own clock from 0.
+    start_s
+        Show time of the trajectory's time 0, s, >= 0. Before it the drone
+        waits at its first position, after its end it holds its last.
+    """
+
+    trajectory: Trajectory
+    name: str
+    start_s: float = 0.0
+
+    @property
+    def end_s(self) -> float:
+        """Show time at which it has finished, s."""
+        return self.start_s + self.trajectory.duration
+
+
+def load_show(paths: Sequence[Path]) -> list[ShowDrone]:
+    """Every drone of ``paths`` (plan directories, trajectory ``.json``/``.csv``, ``.skyc``).
+
+    Raises
+    ------
+    InputError
+        No path, a path that does not exist or has another suffix, or what the
+        file's reader refuses.
+    """
+    if not paths:
+        raise InputError("PATH: got none, expected a plan directory, trajectory file or .skyc")
+    drones = [drone for path in paths for drone in _read(Path(path))]
+    if not drones:  # pragma: no cover - every reader refuses an empty input
+        raise InputError("PATH: got no drone, expected at least one")
+    return drones
+
+
+def _read(path: Path) -> list[ShowDrone]:
+    if not path.exists():
+        raise InputError(
+            f"PATH: got {str(path)!r}, which does not exist; expected a plan directory, a "
+            "trajectory .json/.csv or a .skyc"
+        )
+    suffix = path.suffix.lower()
+    if path.is_file() and suffix not in SUFFIXES:
+        raise InputError(
+            f"PATH: got {str(path)!r}, expected a plan directory or a file ending in "
+            f"{', '.join(SUFFIXES)}"
+        )
+    if suffix == ".skyc" and path.is_file():
+        return _read_skyc(path)
+    prefix = path.name if path.is_dir() else path.parent.name
+    return [
+        ShowDrone(planned.trajectory, f"{prefix}/{name}" if prefix else name)
+        for name, planned in read_plan(path)
+    ]
+
+
+def _read_skyc(path: Path) -> list[ShowDrone]:
+    """The drones of a ``.skyc`` as their firmware plays them, on the show's clock."""
+    show = read_show_json(path)
+    drones: list[Any] = show["swarm"]["drones"]
+    starts = [_firmware_zero(d["settings"]["trajectory"]) for d in drones]
+    first = min(starts)  # a takeoff before the first keyframe moves the show's 0 earlier
+    return [
+        ShowDrone(traj, f"{path.name}/{_name(i, d)}", start - first)
+        for i, (traj, d, start) in enumerate(
+            zip(show_trajectories(show), drones, starts, strict=True)
+        )
+    ]
+
+
+def _firmware_zero(trajectory: dict[str, Any]) -> float:
+    """Show time of the firmware's 0, s.
+
+    The first keyframe; with a ``takeoffTime`` Skybrush puts a still segment from
+    ``-takeoffTime`` in front of it (:mod:`skyquill.io.skybrush_playback`).
+    """
+    takeoff = float(trajectory.get("takeoffTime", 0.0))
+    return -takeoff if takeoff > 0 else float(trajectory["points"][0][0])
+
+
+def _name(i: int, drone: dict[str, Any]) -> str:
+    name = drone["settings"].get("name")
+    return name if isinstance(name, str) and name else f"drone{i}"
