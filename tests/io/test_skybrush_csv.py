@@ -122,6 +122,14 @@ def test_bad_drones_are_refused_on_writing(tmp_path: Path) -> None:
         write_csv_zip([drone(), drone()], tmp_path / "x.zip")
 
 
+def test_a_carriage_return_the_csv_reader_refuses_is_an_input_error(tmp_path: Path) -> None:
+    """Found by the hypothesis test below: ``csv`` raises its own error on ``b'\\r\\x00'``."""
+    path = tmp_path / "r.zip"
+    _zip(path, {"a.csv": b"\r\x00"})
+    with pytest.raises(InputError, match=r"r\.zip: a\.csv: got text the CSV reader refuses"):
+        read_csv_zip(path)
+
+
 @settings(max_examples=100, deadline=None)
 @given(raw=st.binary(max_size=120), zipped=st.booleans())
 def test_random_bytes_give_an_input_error(raw: bytes, zipped: bool) -> None:

@@ -181,7 +181,12 @@ def _drone(archive: str, member: str, raw: bytes) -> CsvDrone:
         raise InputError(
             f"{where}: got a non-ASCII byte at {exc.start}, expected ASCII text"
         ) from None
-    rows = [(n, row) for n, row in enumerate(csv.reader(io.StringIO(text)), start=1) if row]
+    try:
+        rows = [(n, row) for n, row in enumerate(csv.reader(io.StringIO(text)), start=1) if row]
+    except csv.Error as exc:  # e.g. a NUL byte, or a lone carriage return inside a field
+        raise InputError(
+            f"{where}: got text the CSV reader refuses ({exc}), expected CSV rows"
+        ) from None
     if not rows or [c.strip().lower() for c in rows[0][1]] != [h.lower() for h in HEADER]:
         got = rows[0][1] if rows else []
         raise InputError(f"{where}: got the header {got!r:.80}, expected {','.join(HEADER)}")
