@@ -797,14 +797,7 @@ def _plan_jerk(
             ("coverage",),
         )
     flight, path = found
-    deadline.check("the dense check")
-    check = verify(flight.trajectory, coverage_limits(opts), guaranteed=False)
-    if check.max_excess > MAX_EXCESS:
-        raise InfeasibleError(
-            f"pattern 'zigzag-jerk': got a flight {100 * check.max_excess:.1f} % over the "
-            f"limits, expected at most {100 * MAX_EXCESS:g} %",
-            ("speed_lp",),
-        )
+    check = _within_limits(flight.trajectory, opts, "flight", deadline)
     coverage, missed = _measured(region, path, opts.width)
     return CoveragePlan(
         region=region,
@@ -818,6 +811,21 @@ def _plan_jerk(
         speed_plan=None,
         missed=missed,
     )
+
+
+def _within_limits(
+    trajectory: Trajectory, opts: CoverageOptions, what: str, deadline: Deadline
+) -> Verification:
+    """The dense check of ``trajectory``; a ``what`` over :data:`MAX_EXCESS` is refused."""
+    deadline.check("the dense check")
+    check = verify(trajectory, coverage_limits(opts), guaranteed=False)
+    if check.max_excess > MAX_EXCESS:
+        raise InfeasibleError(
+            f"pattern {opts.pattern!r}: got a {what} {100 * check.max_excess:.1f} % over the "
+            f"limits, expected at most {100 * MAX_EXCESS:g} %",
+            ("speed_lp",),
+        )
+    return check
 
 
 def _plan_mission(
@@ -841,14 +849,7 @@ def _plan_mission(
         plan_piece=flight,
         convex=opts.pattern in {"spiral", "zigzag-jerk"},
     )
-    deadline.check("the dense check")
-    check = verify(mission.trajectory, coverage_limits(opts), guaranteed=False)
-    if check.max_excess > MAX_EXCESS:
-        raise InfeasibleError(
-            f"pattern {opts.pattern!r}: got a mission {100 * check.max_excess:.1f} % over the "
-            f"limits, expected at most {100 * MAX_EXCESS:g} %",
-            ("speed_lp",),
-        )
+    check = _within_limits(mission.trajectory, opts, "mission", deadline)
     return CoveragePlan(
         region=region,
         options=opts,
