@@ -94,7 +94,7 @@ def test_a_concave_field_is_flown_in_convex_pieces() -> None:
 
 def test_a_field_too_short_to_turn_at_speed_is_named() -> None:
     """A turn at 3 m/s sweeps a loop 2.8 m deep: a 3 m square has no room for one."""
-    with pytest.raises(InfeasibleError, match="^pattern 'zigzag-jerk'"):
+    with pytest.raises(InfeasibleError, match=r"^pattern 'zigzag-jerk'"):
         plan_coverage(region_from_vertices([[0, 0], [3, 0], [3, 3], [0, 3]]), PAPER)
 
 

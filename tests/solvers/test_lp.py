@@ -94,7 +94,7 @@ def test_a_stalled_hot_start_is_told_by_iterations_and_solved_cold(
     """No wall-time guess: the same problem takes the same path on a busy machine."""
     if not highspy_available():
         pytest.skip("highspy not installed")
-    monkeypatch.setattr(lp_module, "COLD_SOLVE_ITERATIONS_PER_COLUMN", 0)
+    monkeypatch.setattr(lp_module, "HOT_SOLVE_ITERATIONS_PER_COLUMN", 0)
     lp = _box_lp("highspy")
     sol = lp.solve()
     assert sol.status == "optimal" and sol.solver == "linprog"

@@ -587,7 +587,7 @@ def _best_planned(
     estimates = []
     for trial, waypoints in candidates:
         deadline.check(f"the estimate of epsilon={trial.epsilon:g}, delta={trial.delta:g}")
-        estimates.append(_estimated_duration(waypoints, trial))
+        estimates.append(_estimated_duration(waypoints, trial, deadline))
     plans: list[CoveragePlan] = []
     for k in np.argsort(estimates, kind="stable"):
         if plans and estimates[k] > ESTIMATE_MARGIN * min(estimates):
@@ -599,7 +599,9 @@ def _best_planned(
     return plans
 
 
-def _estimated_duration(waypoints: FloatArray, options: CoverageOptions) -> float:
+def _estimated_duration(
+    waypoints: FloatArray, options: CoverageOptions, deadline: Deadline
+) -> float:
     """The flight time of ``waypoints``' spline by a coarse speed LP, s (inf: not timed).
 
     :data:`ESTIMATE_GRID` points, :data:`ESTIMATE_JERK_ITERATIONS` pseudo-jerk
@@ -613,9 +615,11 @@ def _estimated_duration(waypoints: FloatArray, options: CoverageOptions) -> floa
         speed = plan_speed(
             spiral_curve(waypoints), options.vmax, options.amax, options.jmax,
             n=ESTIMATE_GRID, jerk_iterations=ESTIMATE_JERK_ITERATIONS, refine_rounds=0,
-            max_excess=None, norm_sides=options.limit_norm_sides,
+            max_excess=None, norm_sides=options.limit_norm_sides, deadline=deadline,
         )  # fmt: skip
-    except InfeasibleError:
+    except InfeasibleError as exc:
+        if is_time_limit(exc):
+            raise
         return math.inf
     return float(speed.duration)
 

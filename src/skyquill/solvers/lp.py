@@ -8,7 +8,7 @@ linearisation, a local tightening) keeps one :class:`LinearProgram`:
   only the bounds that changed, so the dual simplex restarts from the previous
   optimal basis (tens of pivots instead of a cold solve).  A solve that ends
   neither optimal nor infeasible (a stalled hot start: more simplex
-  iterations per column than :data:`HOT_SOLVE_ITERATIONS_PER_COLUMN`) switches
+  iterations than :data:`HOT_SOLVE_ITERATIONS_PER_COLUMN` per column) switches
   the instance to ``"linprog"`` for good. The stall is told by iterations,
   not wall time, so that the same problem takes the same path on a busy
   machine (a 0.5 s limit sent plans to the slow cold solves under load).
@@ -50,13 +50,9 @@ LPBackend = Literal["highspy", "linprog"]
 LPStatus = Literal["optimal", "infeasible", "time_limit", "failed"]
 #: Backend names :func:`resolve_backend` accepts.
 LP_BACKENDS = ("auto", "highspy", "linprog")
-#: Simplex iterations per column after which a hot start counts as stalled: cold solves
-#: of the coverage speed LP took 0.6-1.7 per column, hot ones a few in all, so a hot
-#: start past 2 is slower than starting over (a notched pentagon's spiral: 4 s per hot
-#: run near 20 per column, 0.9 s per cold linprog solve). The first, cold solve of an
-#: instance gets :data:`COLD_SOLVE_ITERATIONS_PER_COLUMN`.
-HOT_SOLVE_ITERATIONS_PER_COLUMN = 2
-COLD_SOLVE_ITERATIONS_PER_COLUMN = 20
+#: Simplex iterations per column after which a hot start counts as stalled (cold
+#: solves of the coverage speed LP took 0.6-1.7 per column, hot ones a few in all).
+HOT_SOLVE_ITERATIONS_PER_COLUMN = 20
 
 __all__ = [
     "HOT_SOLVE_ITERATIONS_PER_COLUMN",
@@ -279,8 +275,6 @@ class _HighsModel:
         # Bounds the instance holds now.
         self.rows = (np.full(m, -np.inf), np.full(m, np.inf))
         self.cols = (np.zeros(n), np.full(n, np.inf))
-        # Whether a basis is there to start from (after the first optimal solve).
-        self.hot = False
 
     def solve(self, lp: LinearProgram, limit_s: float) -> LPSolution | None:
         """Pass the changed bounds and re-solve within ``limit_s`` s; None when HiGHS stalled."""
@@ -300,7 +294,6 @@ class _HighsModel:
         message = str(self.highs.modelStatusToString(status))
         if status == statuses.kInfeasible:
             return LPSolution("infeasible", None, "highspy", dt, message)
-        self.hot = True
         x = np.asarray(self.highs.getSolution().col_value, dtype=np.float64)
         return LPSolution("optimal", np.clip(x, lp.col_lower, lp.col_upper), "highspy", dt, message)
 
@@ -326,10 +319,7 @@ class _HighsModel:
         so the limit is set relative to the time already spent; its iteration
         count starts again at every run.
         """
-        per_column = (
-            HOT_SOLVE_ITERATIONS_PER_COLUMN if self.hot else COLD_SOLVE_ITERATIONS_PER_COLUMN
-        )
-        iterations = per_column * max(int(self.highs.getNumCol()), 1)
+        iterations = HOT_SOLVE_ITERATIONS_PER_COLUMN * max(int(self.highs.getNumCol()), 1)
         self.highs.setOptionValue("simplex_iteration_limit", iterations)
         self.highs.setOptionValue("time_limit", float(self.highs.getRunTime()) + limit_s)
         self.highs.run()
