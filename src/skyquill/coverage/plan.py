@@ -1010,6 +1010,9 @@ def _piece(
 SPLINE_DEGREE = 4
 #: Largest relative excess over a limit a returned plan may have (issue 5: <= 2 %).
 MAX_EXCESS = 0.02
+#: A speed plan whose mean speed is below this fraction of vmax has collapsed (the
+#: slowest real plans, tiny regions of tight corners, average over 5 %).
+MIN_MEAN_SPEED_FRACTION = 0.01
 #: Speed-LP grids tried in turn: (grid points as a multiple of ``n``, grid kind).
 GRID_LADDER: tuple[tuple[int, Literal["uniform", "adaptive"]], ...] = (
     (1, "uniform"),
@@ -1053,6 +1056,12 @@ def _timed(
             if is_time_limit(exc):
                 raise
             seen.append(f"{kind} grid of {factor * n}: {exc}")
+            continue
+        mean_speed = _length(_dense(curve)) / plan.duration
+        if mean_speed < MIN_MEAN_SPEED_FRACTION * options.vmax:
+            # A grid LP that all but stops the vehicle (a 6 m star: 68 h of flight)
+            # is a numerical collapse, not a plan; its dense check alone took 69 s.
+            seen.append(f"{kind} grid of {factor * n}: mean speed {mean_speed:.2g} m/s")
             continue
         deadline.check("the timing law")
         trajectory = plan.trajectory(options.altitude)
