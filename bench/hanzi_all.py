@@ -14,7 +14,8 @@ size); the planner raises ``InfeasibleError`` otherwise.
 The characters are spread over at most two worker processes (the machine has
 two cores), each with BLAS pinned to one thread (threadpoolctl). Every result
 is appended to a JSON-lines file as it arrives (``--resume`` skips the
-characters already there), and the summary is rewritten every
+characters already there; ``--report-only`` writes the report of what it
+holds, planning nothing), and the summary is rewritten every
 ``--flush-every`` characters, marked ``"partial": true`` until all are done,
 so an interrupted run still leaves its numbers.
 
@@ -113,13 +114,14 @@ def plan_char(char: str) -> dict[str, Any]:
         "strokes": len(medians.paths),
         "points": medians.n_points,
     }
-    start = time.perf_counter()
+    start, cpu = time.perf_counter(), time.process_time()
     try:
         show = plan_show([typed_strokes(char)], cli_options(), **cli_show_kwargs())
     except Exception as exc:  # every failure is reported, whatever its kind
         row |= {
             "passed": False,
             "time_s": time.perf_counter() - start,
+            "cpu_s": time.process_time() - cpu,
             "error_type": type(exc).__name__,
             "error": str(exc),
         }
@@ -132,6 +134,7 @@ def plan_char(char: str) -> dict[str, Any]:
     return row | {
         "passed": deviation <= tolerance,
         "time_s": time.perf_counter() - start,
+        "cpu_s": time.process_time() - cpu,
         "planning_time_s": summary["planning_time_s"],
         "deviation_m": deviation,
         "tolerance_m": tolerance,
@@ -220,9 +223,14 @@ def report(
         "resumed_rows": meta["resumed_rows"],
         "worker_time_sum_s": float(sum(r["time_s"] for r in rows)),
         "planning_time_s": _stats([r["time_s"] for r in rows]),
+        # CPU time of the worker process (one BLAS thread): what one free core would take.
+        "planning_cpu_s": _stats([r["cpu_s"] for r in rows if "cpu_s" in r])
+        | {"rows": sum("cpu_s" in r for r in rows)},
         "planning_time_note": (
             "wall time of typed_strokes + plan_show per character in a worker, "
-            f"{meta['workers']} workers sharing the machine with other jobs"
+            f"{meta['workers']} workers sharing the machine with other jobs (see the load "
+            "average); planning_cpu_s is the worker's CPU time, what one free core takes "
+            "(rows planned before it was recorded lack it)"
         ),
         "deviation_mm": _stats([1e3 * r["deviation_m"] for r in ok]),
         "deviation_over_tolerance": _stats(ratio)
@@ -273,8 +281,8 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
     chars = characters(args.sample)
     out = SAMPLE_RESULTS if args.sample is not None else RESULTS
     progress_file = Path(args.progress_file or _progress_default(args.sample))
-    done = _read_done(progress_file) if args.resume else {}
-    if not args.resume:
+    done = _read_done(progress_file) if args.resume or args.report_only else {}
+    if not (args.resume or args.report_only):
         progress_file.write_text("", encoding="utf-8")
     rows = [done[c] for c in chars if c in done]
     todo = [c for c in chars if c not in done]
@@ -295,6 +303,12 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
             "resumed_rows": len(rows),
             "pass_rule": "plan returned and summary deviation.max_m <= tolerance_m",
         }
+    if args.report_only:
+        # No planning: the report of what the progress file holds (partial if not all).
+        rows.sort(key=lambda r: r["char"])
+        final = report(rows, len(chars), meta | {"report_only": True}, 0.0)
+        _write(out, final)
+        return final
     start = time.perf_counter()
     with (
         ProcessPoolExecutor(max_workers=workers, initializer=_pin_blas) as pool,
@@ -330,6 +344,9 @@ def main() -> None:
     parser.add_argument("--sample", type=int, default=None, help="plan N characters only")
     parser.add_argument("--workers", type=int, default=MAX_WORKERS, help="processes (<= 2)")
     parser.add_argument("--resume", action="store_true", help="skip characters already done")
+    parser.add_argument(
+        "--report-only", action="store_true", help="write the report of the progress file only"
+    )
     parser.add_argument("--progress-file", default=None, help="JSON lines of the results")
     parser.add_argument("--flush-every", type=int, default=200, help="rewrite the summary")
     args = parser.parse_args()
