@@ -25,8 +25,8 @@ worker, two workers sharing the machine), the deviation distribution (in mm
 and as a fraction of the tolerance), and every failure with its character,
 code point, number of strokes and error, grouped by cause.
 
-Run: ``.venv/bin/python bench/hanzi_all.py`` (about 40 minutes on two
-cores); ``--sample N`` plans N characters drawn with a fixed seed and
+Run: ``.venv/bin/python bench/hanzi_all.py`` (about 30 minutes on two free
+cores: 0.36 s of CPU per character on average; hours on a loaded machine); ``--sample N`` plans N characters drawn with a fixed seed and
 writes ``hanzi_all_sample.json`` instead.
 """
 

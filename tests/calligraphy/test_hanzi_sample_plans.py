@@ -12,9 +12,12 @@ defaults, read from its signature, and the text goes through
 planner raises ``InfeasibleError`` beyond the tolerance) and
 ``deviation.max_m <= tolerance_m``.
 
-Measured: the 200 plans take about 95 s on one core (0.3-1.3 s each, median
-~0.45 s; more on a loaded machine), so each character is its own test and
-pytest-xdist spreads them over the workers (about 50 s with ``-n 2``).
+Measured: about 70 s of one core for the 200 plans (a character takes 0.31 s
+of CPU at the median, 0.36 s on average, 1.9 s at most, over the first 700 of
+the full benchmark; pytest's own user time for this file was 96 s with its
+imports), more than the ~60 s one test should take, so each character is its
+own test and pytest-xdist spreads them: ~40 s with ``-n 2`` on two free cores
+(257 s measured on this machine while other jobs loaded it to ~6).
 """
 
 from __future__ import annotations
