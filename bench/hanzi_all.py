@@ -26,8 +26,9 @@ and as a fraction of the tolerance), and every failure with its character,
 code point, number of strokes and error, grouped by cause.
 
 Run: ``.venv/bin/python bench/hanzi_all.py`` (about 30 minutes on two free
-cores: 0.36 s of CPU per character on average; hours on a loaded machine); ``--sample N`` plans N characters drawn with a fixed seed and
-writes ``hanzi_all_sample.json`` instead.
+cores: 0.36 s of CPU per character on average; hours on a loaded machine);
+``--sample N`` plans N characters drawn with a fixed seed and writes
+``hanzi_all_sample.json`` instead.
 """
 
 from __future__ import annotations

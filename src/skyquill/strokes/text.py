@@ -13,7 +13,6 @@ from skyquill.strokes.hanzi import EM, EM_BOTTOM, EM_TOP, hanzi_text
 from skyquill.strokes.hershey import line_extent, text_strokes
 from skyquill.strokes.model import FloatArray, Strokes
 
-
 #: Unicode name prefixes of what is written from hanzi medians: the ideographs, and
 #: the radical forms (U+2E80 block) that hanzi-writer-data also ships (⺀, ⺈, ...).
 CJK_NAMES = ("CJK UNIFIED IDEOGRAPH", "CJK COMPATIBILITY IDEOGRAPH", "CJK RADICAL")
