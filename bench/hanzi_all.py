@@ -287,6 +287,9 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
         progress_file.write_text("", encoding="utf-8")
     rows = [done[c] for c in chars if c in done]
     todo = [c for c in chars if c not in done]
+    # In a random (fixed) order: a run stopped early has planned a sample of the whole set,
+    # not its first code points.
+    todo = [todo[i] for i in np.random.default_rng(SEED).permutation(len(todo))]
     workers = min(args.workers, MAX_WORKERS)
     with threadpool_limits(limits=1):
         meta = {
