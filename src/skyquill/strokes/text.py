@@ -13,10 +13,14 @@ from skyquill.strokes.hanzi import EM, EM_BOTTOM, EM_TOP, hanzi_text
 from skyquill.strokes.hershey import line_extent, text_strokes
 from skyquill.strokes.model import FloatArray, Strokes
 
+#: Unicode name prefixes of what is written from hanzi medians: the ideographs, and
+#: the radical forms (U+2E80 block) that hanzi-writer-data also ships (⺀, ⺈, ...).
+CJK_NAMES = ("CJK UNIFIED IDEOGRAPH", "CJK COMPATIBILITY IDEOGRAPH", "CJK RADICAL")
+
 
 def is_cjk(text: str) -> bool:
-    """Whether ``text`` holds CJK ideographs (written from hanzi medians, not Hershey)."""
-    return any(unicodedata.name(c, "").startswith("CJK UNIFIED IDEOGRAPH") for c in text)
+    """Whether ``text`` holds CJK ideographs or radicals (hanzi medians, not Hershey)."""
+    return any(unicodedata.name(c, "").startswith(CJK_NAMES) for c in text)
 
 
 def split_text(text: str, parts: int) -> list[str]:
