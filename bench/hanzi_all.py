@@ -76,23 +76,9 @@ EXPLANATIONS: dict[str, str] = {}
 
 def cli_options() -> Any:
     """The :class:`WritingOptions` of ``skyquill write CHAR --out DIR`` with every default."""
-    from skyquill.calligraphy.brush import Brush
-    from skyquill.calligraphy.mission import WritingOptions
-    from skyquill.cli.write_cmd import write
-    from skyquill.limits import VehicleLimits
+    from skyquill.cli.write_cmd import default_writing_options
 
-    d = {k: p.default for k, p in inspect.signature(write).parameters.items()}
-    return WritingOptions(
-        size_m=d["size"],
-        limits=VehicleLimits(
-            d["vmax"], d["amax"], d["jmax"], d["vmax_axis"], d["amax_axis"], d["jmax_axis"]
-        ),
-        norm_sides=d["norm_sides"],
-        best_effort=d["best_effort"],
-        brush=Brush(length_m=d["brush_length"], press_depth_m=d["press_depth"]),
-        follow=d["follow"],
-        target=d["target"],
-    )
+    return default_writing_options()
 
 
 def cli_show_kwargs() -> dict[str, Any]:

@@ -28,11 +28,9 @@ from typing import Any
 import numpy as np
 import pytest
 
-from skyquill.calligraphy.brush import Brush
 from skyquill.calligraphy.mission import WritingOptions
 from skyquill.calligraphy.show import plan_show
-from skyquill.cli.write_cmd import write
-from skyquill.limits import VehicleLimits
+from skyquill.cli.write_cmd import default_writing_options, write
 from skyquill.strokes import bundled_hanzi, hanzi_strokes, typed_strokes
 
 SEED = 17
@@ -52,18 +50,7 @@ DEFAULTS = {k: p.default for k, p in inspect.signature(write).parameters.items()
 
 def _cli_options() -> WritingOptions:
     """``WritingOptions`` as ``skyquill write CHAR --out DIR`` builds them with every default."""
-    d = DEFAULTS
-    return WritingOptions(
-        size_m=d["size"],
-        limits=VehicleLimits(
-            d["vmax"], d["amax"], d["jmax"], d["vmax_axis"], d["amax_axis"], d["jmax_axis"]
-        ),
-        norm_sides=d["norm_sides"],
-        best_effort=d["best_effort"],
-        brush=Brush(length_m=d["brush_length"], press_depth_m=d["press_depth"]),
-        follow=d["follow"],
-        target=d["target"],
-    )
+    return default_writing_options()
 
 
 def test_the_sample_is_fixed_and_spread_over_the_set() -> None:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import inspect
 from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any
@@ -38,6 +39,7 @@ from skyquill.limits import VehicleLimits
 
 if TYPE_CHECKING:
     from skyquill.calligraphy.ink import InkFidelity
+    from skyquill.calligraphy.mission import WritingOptions
 
 
 def load_parts(
@@ -160,23 +162,18 @@ def write(
     force: Force = False,
 ) -> None:
     """Plan pen-up / pen-down writing flights; write CSVs, input_strokes.json, plot, summary."""
-    from skyquill.calligraphy.brush import Brush
-    from skyquill.calligraphy.mission import WritingOptions
     from skyquill.calligraphy.show import plan_show
     from skyquill.strokes import typed_parts
 
     with user_errors():
         check_out(out)
         rate = positive_rate(rate)
-        options = WritingOptions(
-            size_m=size,
-            limits=VehicleLimits(vmax, amax, jmax, vmax_axis, amax_axis, jmax_axis),
-            norm_sides=norm_sides,
-            best_effort=best_effort,
-            brush=Brush(length_m=brush_length, press_depth_m=press_depth),
-            follow=_follow(follow),
-            target=upload_target(target),
-        )
+        options = writing_options(
+            size=size, vmax=vmax, amax=amax, jmax=jmax, vmax_axis=vmax_axis,
+            amax_axis=amax_axis, jmax_axis=jmax_axis, norm_sides=norm_sides,
+            best_effort=best_effort, brush_length=brush_length, press_depth=press_depth,
+            follow=follow, target=target,
+        )  # fmt: skip
         if drones < 1:
             raise InputError(f"--drones: got {drones}, expected at least 1")
         if drones != 1:
@@ -383,3 +380,41 @@ def demo(out: OutDir = Path("out/demo"), force: Force = False) -> None:
         f"  {out / 'plot.png'}\n  {out / 'ink.png'}\n  {out / 'summary.json'}\n"
         f"  {out / 'trajectory.csv'}"
     )
+
+
+def writing_options(
+    *,
+    size: float,
+    vmax: float | None,
+    amax: float | None,
+    jmax: float | None,
+    vmax_axis: float | None,
+    amax_axis: float | None,
+    jmax_axis: float | None,
+    norm_sides: int | None,
+    best_effort: bool,
+    brush_length: float,
+    press_depth: float,
+    follow: str,
+    target: str | None,
+) -> WritingOptions:
+    """The ``WritingOptions`` :func:`write` plans with, from its own arguments."""
+    from skyquill.calligraphy.brush import Brush
+    from skyquill.calligraphy.mission import WritingOptions
+
+    return WritingOptions(
+        size_m=size,
+        limits=VehicleLimits(vmax, amax, jmax, vmax_axis, amax_axis, jmax_axis),
+        norm_sides=norm_sides,
+        best_effort=best_effort,
+        brush=Brush(length_m=brush_length, press_depth_m=press_depth),
+        follow=_follow(follow),
+        target=upload_target(target),
+    )
+
+
+def default_writing_options() -> WritingOptions:
+    """What ``skyquill write`` plans with when no option is given (benchmarks and tests)."""
+    defaults = {name: p.default for name, p in inspect.signature(write).parameters.items()}
+    wanted = inspect.signature(writing_options).parameters
+    return writing_options(**{name: defaults[name] for name in wanted})
