@@ -972,8 +972,11 @@ def _timed_path(
         legs = LegLimits(opts.vmax, opts.amax, opts.jmax, per_axis=opts.per_axis)
         flown = stop_and_go(_lifted(waypoints, opts.altitude), legs)
         return flown.trajectory, None, None
-    n = opts.grid or grid_points(_length(path))
-    speed_plan, trajectory, check = _timed(spiral_curve(waypoints), opts, n, deadline)
+    length = _length(path)
+    n = opts.grid or grid_points(length)
+    speed_plan, trajectory, check = _timed(
+        spiral_curve(waypoints), opts, n, deadline, length=length
+    )
     return trajectory, speed_plan, check
 
 
@@ -1022,13 +1025,15 @@ GRID_LADDER: tuple[tuple[int, Literal["uniform", "adaptive"]], ...] = (
 
 
 def _timed(
-    curve: Any, options: CoverageOptions, n: int, deadline: Deadline
+    curve: Any, options: CoverageOptions, n: int, deadline: Deadline, *, length: float
 ) -> tuple[SpeedPlan, Trajectory, Verification]:
     """The speed plan on the first grid of :data:`GRID_LADDER` that verifies, its trajectory
     and that check.
 
     The check is the one dense check of the trajectory the plan becomes (the
     one that is written and flown), not of the planner's own setpoints.
+
+    ``length`` is the path's (m), for the mean speed a collapsed plan is told by.
 
     A turn shorter than a grid cell (a join of a multi-spiral, the hook at a
     spiral's end) can make the grid LP stop the vehicle between two nodes --
@@ -1057,7 +1062,7 @@ def _timed(
                 raise
             seen.append(f"{kind} grid of {factor * n}: {exc}")
             continue
-        mean_speed = _length(_dense(curve)) / plan.duration
+        mean_speed = length / plan.duration
         if mean_speed < MIN_MEAN_SPEED_FRACTION * options.vmax:
             # A grid LP that all but stops the vehicle (a 6 m star: 68 h of flight)
             # is a numerical collapse, not a plan; its dense check alone took 69 s.
