@@ -42,6 +42,7 @@ from ruckig import InputParameter, Result, Ruckig, Synchronization, Trajectory
 from shapely.geometry import LineString, Polygon
 
 from skyquill.errors import InfeasibleError, SolverError
+from skyquill.optimize.legs import LegLimits, leg_pieces
 from skyquill.trajectory import PiecewisePolynomial
 from skyquill.validation import FloatArray
 
@@ -338,18 +339,10 @@ def _lane_pieces(start: State, end: State, limits: AxisLimits) -> tuple[FloatArr
     if length <= 0.0:
         return np.zeros(0), np.zeros((0, 4, 2))
     heading = offset / length
-    with np.errstate(divide="ignore"):
-        amax = float(np.min(limits.amax / np.abs(heading)))
-        jmax = float(np.min(limits.jmax / np.abs(heading)))
-    along = _ruckig(
-        (np.zeros(1), np.array([start[1] @ heading])),
-        (np.array([length]), np.array([end[1] @ heading])),
-        ([limits.vmax], [amax], [jmax]),
+    box = LegLimits(limits.vmax, limits.amax, limits.jmax, per_axis=True)
+    return leg_pieces(
+        start[0], end[0], box, speeds=(float(start[1] @ heading), float(end[1] @ heading))
     )
-    durations, scalar = _pieces(along)
-    coeffs = scalar * heading[None, None, :]
-    coeffs[:, 0, :] += start[0]
-    return durations, coeffs
 
 
 def _pieces(motion: Trajectory) -> tuple[FloatArray, FloatArray]:

@@ -61,9 +61,15 @@ class LegLimits:
 
 
 def leg_pieces(
-    start: FloatArray, end: FloatArray, limits: LegLimits
+    start: FloatArray,
+    end: FloatArray,
+    limits: LegLimits,
+    speeds: tuple[float, float] = (0.0, 0.0),
 ) -> tuple[FloatArray, FloatArray]:
-    """The time-optimal rest-to-rest move from ``start`` to ``end`` (d,) as cubic pieces.
+    """The time-optimal straight move from ``start`` to ``end`` (d,) as cubic pieces.
+
+    ``speeds`` are the speeds along the move at its start and end, m/s (rest to
+    rest by default; a coverage lane enters and leaves at speed).
 
     Returns
     -------
@@ -76,8 +82,8 @@ def leg_pieces(
     direction = (end - start) / length
     vmax, amax, jmax = limits.along(direction)
     inp = InputParameter(1)
-    inp.current_position = [0.0]
-    inp.target_position = [length]
+    inp.current_position, inp.current_velocity = [0.0], [speeds[0]]
+    inp.target_position, inp.target_velocity = [length], [speeds[1]]
     inp.max_velocity = [vmax]
     inp.max_acceleration = [amax]
     inp.max_jerk = [jmax]
