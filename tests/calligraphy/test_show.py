@@ -69,3 +69,21 @@ def test_a_progress_that_raises_stops_the_show(parts: list[Strokes]) -> None:
     for workers in (1, 2):
         with pytest.raises(StopError, match="planned drone"):
             plan_show(parts, OPTIONS, workers=workers, progress=stop_after_first)
+
+
+def test_plan_jobs_returns_missions_in_job_order_and_reports_each() -> None:
+    """plan_jobs (the show scripts' planner) keeps job order and calls progress per drone."""
+    from skyquill.calligraphy.show import layout, plan_jobs
+    from skyquill.strokes import typed_strokes
+
+    opts = WritingOptions()
+    parts = [typed_strokes("一"), typed_strokes("二")]
+    places = layout(2, opts.size_m, 1.0)
+    calls: list[tuple[int, int]] = []
+    missions = plan_jobs(
+        [(p, b, opts, h) for p, (b, h) in zip(parts, places, strict=True)],
+        workers=1,
+        progress=lambda done, total, _: calls.append((done, total)),
+    )
+    assert [len(m.strokes_world) for m in missions] == [1, 2]
+    assert calls == [(0, 2), (1, 2), (2, 2)]

@@ -219,6 +219,33 @@ class _Steps:
         self.done(f"planned drone {i + 1} of {n}")
 
 
+def plan_jobs(
+    jobs: Sequence[Job],
+    workers: int | None = None,
+    scheduler: str | None = None,
+    progress: Progress | None = None,
+) -> list[Mission]:
+    """Plan independent writing missions in parallel, in job order.
+
+    Parameters
+    ----------
+    jobs
+        The arguments of :func:`plan_writing`, one tuple per drone.
+    workers, scheduler
+        As for :func:`plan_show`.
+    progress
+        See :data:`Progress`; ``total`` is the number of jobs.
+
+    Returns
+    -------
+    list of Mission
+        One per job, in the order of ``jobs``.
+    """
+    steps = _Steps(len(jobs), progress)
+    steps.start(f"planning {len(jobs)} drone(s)")
+    return _plan_all(list(jobs), workers, scheduler, steps)
+
+
 def _plan_all(
     jobs: list[Job], workers: int | None, scheduler: str | None, steps: _Steps
 ) -> list[Mission]:
