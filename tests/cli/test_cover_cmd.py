@@ -74,7 +74,9 @@ def test_cover_tunes_for_a_coverage_target(tmp_path: Path) -> None:
         (["--vmax", "-1"], "vmax"),
         (["--jmax", "0"], "jmax"),
         (["--pattern", "snake"], "pattern"),
-        (["--min-coverage", "1.5"], "min_coverage"),
+        (["--min-coverage", "1.5"], "--min-coverage: got 1.5, expected 0"),
+        (["--min-coverage", "-1"], "or a fraction in (0, 1]"),
+        (["--min-coverage", "nan"], "--min-coverage: got nan"),
     ],
 )
 def test_bad_input_exits_2_with_a_message(tmp_path: Path, extra: list[str], message: str) -> None:

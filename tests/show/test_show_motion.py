@@ -73,6 +73,16 @@ def test_speed_bound_holds_on_random_intervals(kind: str) -> None:
         assert speed.max() <= s * (1 + 1e-9) + 1e-12
 
 
+def test_a_round_off_jump_is_accepted_and_recorded() -> None:
+    """A file's micrometre jumps (a Skybrush show as played) are kept as the motion's slack."""
+    coeffs = np.zeros((2, 1, 3))
+    coeffs[1, 0] = [2e-6, 0.0, 0.0]
+    motion = motion_of("d0", PiecewisePolynomial(np.array([0.0, 1.0, 2.0]), coeffs), 2.0)
+    assert motion.jump_m == pytest.approx(2e-6)
+    across = motion.local(np.array([0.5, 1.2]), np.array([1.5, 1.8]))
+    assert across.jump.tolist() == pytest.approx([2e-6, 0.0])
+
+
 def test_a_jump_between_pieces_is_refused() -> None:
     coeffs = np.zeros((2, 1, 3))
     coeffs[1, 0] = [1.0, 0.0, 0.0]

@@ -27,6 +27,20 @@ def _dense_min(trajectories: list[PiecewisePolynomial], rate: float = 1000.0) ->
     )
 
 
+def test_a_jump_towards_the_other_drone_is_inside_the_bound() -> None:
+    """A drone that jumps 0.9 mm closer where its pieces meet: the bound still holds."""
+    still = PiecewisePolynomial(np.array([0.0, 2.0]), np.zeros((1, 1, 3)))
+    coeffs = np.zeros((2, 2, 3))
+    coeffs[0, 0], coeffs[0, 1] = [1.0, 0.0, 0.0], [-0.1, 0.0, 0.0]  # 1 m to 0.9 m
+    coeffs[1, 0], coeffs[1, 1] = [0.9 - 9e-4, 0.0, 0.0], [0.1, 0.0, 0.0]  # jumps 0.9 mm in
+    jumpy = PiecewisePolynomial(np.array([0.0, 1.0, 2.0]), coeffs)
+    motions = [motion_of("a", still, 2.0), motion_of("b", jumpy, 2.0)]
+    result = guaranteed_separation(motions, 0.5)
+    true_min = 0.9 - 9e-4
+    assert result.lower_bound_m <= true_min
+    assert result.lower_bound_m >= true_min - 4 * 9e-4 - TOLERANCE_M
+
+
 def test_planted_50_ms_violation_missed_at_5_hz_is_found() -> None:
     hover, flyer, start = planted()
     assert _dense_min([hover, flyer], rate=5.0) > 3.0  # Skybrush's sampling passes it

@@ -151,6 +151,11 @@ def cover(
             target=upload_target(target),
             time_limit=time_limit,
         )
+        if not 0.0 <= min_coverage <= 1.0:  # NaN fails too
+            raise InputError(
+                f"--min-coverage: got {min_coverage:g}, expected 0 (fly --epsilon/--delta as "
+                "given) or a fraction in (0, 1]"
+            )
         with _BudgetBar() as bar:
             if min_coverage == 0.0:
                 plan = plan_coverage(shape, options, progress=bar.update)

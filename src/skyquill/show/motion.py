@@ -50,8 +50,12 @@ from skyquill.trajectory import (
 from skyquill.trajectory.horner import horner
 from skyquill.validation import FloatArray
 
-#: Largest position jump accepted where pieces meet, m (round-off of exported files).
-JUMP_TOLERANCE_M = 1e-6
+#: Largest position jump accepted where pieces meet, m. Exported files are not exactly
+#: continuous: Skybrush stores millimetres and its firmware evaluates in float32, so a
+#: skyquill ``.skyc`` played back jumps by a few micrometres. Jumps up to this are
+#: accounted for in the separation bound (:attr:`Motion.jump_m`); a larger one is not
+#: round-off but a broken trajectory.
+JUMP_TOLERANCE_M = 1e-3
 
 
 @dataclass(frozen=True)
@@ -67,11 +71,15 @@ class LocalMotion:
         Whether the interval lies within one polynomial piece, shape (N,).
     speed
         A guaranteed bound of the speed on each interval, shape (N,), m/s.
+    jump
+        A bound of how far the position jumps inside each interval (where pieces
+        meet; 0 where ``inside``), shape (N,), m.
     """
 
     derivatives: FloatArray
     inside: NDArray[np.bool_]
     speed: FloatArray
+    jump: FloatArray
 
 
 def taylor_bound(derivatives: FloatArray, half_width: FloatArray) -> FloatArray:
@@ -96,10 +104,13 @@ class Motion:
         Piece boundaries, shape (P + 1,), s, from 0 to the horizon.
     coeffs
         Power-basis coefficients in local time, shape (P, K, 3), lowest first (m / s^j).
+    jump_m
+        The largest position jump where two pieces meet, m (round-off of a file).
     """
 
     breaks: FloatArray
     coeffs: FloatArray
+    jump_m: float = 0.0
 
     @property
     def horizon(self) -> float:
@@ -140,7 +151,7 @@ class Motion:
         if not inside.all():
             speed[~inside] = self._straddling(a[~inside], b[~inside], first[~inside], last[~inside])
         derivatives[~inside] = 0.0
-        return LocalMotion(derivatives, inside, speed)
+        return LocalMotion(derivatives, inside, speed, (last - first) * self.jump_m)
 
     def _straddling(
         self, a: FloatArray, b: FloatArray, first: NDArray[np.intp], last: NDArray[np.intp]
@@ -193,7 +204,7 @@ def motion_of(name: str, trajectory: Trajectory, horizon: float, start_s: float 
         raise InputError(f"{name}: got {trajectory.dim} axes, expected 3 (x, y, z)")
     breaks, coeffs = _pieces(name, trajectory)
     ends = horner(coeffs, np.diff(breaks), 0).reshape(-1, 3)
-    _check_continuous(name, breaks, coeffs[1:, 0], ends[:-1])
+    jump = _largest_jump(name, breaks, coeffs[1:, 0], ends[:-1])
     breaks = breaks + start_s
     if start_s > 0.0:
         breaks = np.concatenate([[0.0], breaks])
@@ -201,7 +212,7 @@ def motion_of(name: str, trajectory: Trajectory, horizon: float, start_s: float 
     if horizon > breaks[-1]:
         breaks = np.append(breaks, horizon)
         coeffs = np.concatenate([coeffs, _hold(ends[-1], coeffs.shape[1])])
-    return Motion(np.asarray(breaks, dtype=float), np.asarray(coeffs, dtype=float))
+    return Motion(np.asarray(breaks, dtype=float), np.asarray(coeffs, dtype=float), jump)
 
 
 def _hold(point: FloatArray, order: int) -> FloatArray:
@@ -211,15 +222,18 @@ def _hold(point: FloatArray, order: int) -> FloatArray:
     return hold
 
 
-def _check_continuous(name: str, breaks: FloatArray, starts: FloatArray, ends: FloatArray) -> None:
-    """Refuse a position that jumps where pieces meet: the bounds hold only for a continuous one."""
+def _largest_jump(name: str, breaks: FloatArray, starts: FloatArray, ends: FloatArray) -> float:
+    """The largest jump where pieces meet, m; refused above :data:`JUMP_TOLERANCE_M`."""
     jumps = np.linalg.norm(starts - ends, axis=1)
-    if jumps.size and jumps.max() > JUMP_TOLERANCE_M:
-        k = int(np.argmax(jumps))
+    if not jumps.size:
+        return 0.0
+    k = int(np.argmax(jumps))
+    if jumps[k] > JUMP_TOLERANCE_M:
         raise InputError(
             f"{name}: got a jump of {jumps[k]:.3g} m at t = {breaks[k + 1]:.6g} s, expected a "
             f"continuous trajectory (at most {JUMP_TOLERANCE_M:g} m where pieces meet)"
         )
+    return float(jumps[k])
 
 
 def _pieces(name: str, traj: Trajectory) -> tuple[FloatArray, FloatArray]:

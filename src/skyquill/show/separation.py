@@ -120,14 +120,23 @@ class _Intervals:
     da: FloatArray
     db: FloatArray
     w: FloatArray
+    jump: FloatArray
 
     def lower(self) -> FloatArray:
-        slack = 0.5 * (self.da + self.db - self.w * (self.b - self.a))
+        # A jump J inside the interval (round-off where a file's pieces meet) can move the
+        # distance by J at the jump and J again against the Lipschitz line: 2 J of slack.
+        slack = 0.5 * (self.da + self.db - self.w * (self.b - self.a)) - 2.0 * self.jump
         return np.minimum(np.minimum(self.da, self.db), slack)
 
     def take(self, keep: NDArray[np.bool_]) -> _Intervals:
         return _Intervals(
-            self.pair[keep], self.a[keep], self.b[keep], self.da[keep], self.db[keep], self.w[keep]
+            self.pair[keep],
+            self.a[keep],
+            self.b[keep],
+            self.da[keep],
+            self.db[keep],
+            self.w[keep],
+            self.jump[keep],
         )
 
 
@@ -184,9 +193,9 @@ def guaranteed_separation(
     pos = np.stack([m.position(t) for m in motions])
     # Only the speed bounds of the whole grid are kept: the derivatives are recomputed
     # for the intervals that survive the pruning.
-    speed = np.stack([m.local(t[:-1], t[1:]).speed for m in motions])
+    reach = np.stack([_reach(m, t) for m in motions])
     closest = _Closest(first.size, minimum)
-    candidates = _candidates(pos=pos, speed=speed, t=t, first=first, second=second, minimum=minimum)
+    candidates = _candidates(pos=pos, reach=reach, t=t, first=first, second=second, minimum=minimum)
     grid = _grid_intervals(
         candidates=candidates, pos=pos, motions=motions, t=t, first=first, second=second
     )
@@ -205,10 +214,19 @@ def guaranteed_separation(
     )
 
 
+def _reach(motion: Motion, t: FloatArray) -> FloatArray:
+    """How far a drone can stray from its grid samples in each interval (N - 1,), m.
+
+    Half the interval at its speed bound, plus any jump where its pieces meet.
+    """
+    local = motion.local(t[:-1], t[1:])
+    return np.asarray(local.speed * np.diff(t) / 2.0 + local.jump)
+
+
 def _candidates(
     *,
     pos: FloatArray,
-    speed: FloatArray,
+    reach: FloatArray,
     t: FloatArray,
     first: IntArray,
     second: IntArray,
@@ -218,8 +236,8 @@ def _candidates(
     n_int = t.size - 1
     starts = np.arange(0, n_int, WINDOW)
     ends = np.minimum(starts + WINDOW, n_int)
-    # Within an interval a drone is within speed * width / 2 of one of its ends.
-    grow = np.maximum.reduceat(speed * np.diff(t)[None, :] / 2.0, starts, axis=1)[..., None]
+    # Within an interval a drone is within ``reach`` of one of its ends.
+    grow = np.maximum.reduceat(reach, starts, axis=1)[..., None]
     lo = np.minimum(np.minimum.reduceat(pos[:, :-1], starts, axis=1), pos[:, ends]) - grow
     hi = np.maximum(np.maximum.reduceat(pos[:, :-1], starts, axis=1), pos[:, ends]) + grow
     chunks = _chunks(first.size, starts.size)
@@ -265,8 +283,8 @@ def _grid_intervals(
     da = np.linalg.norm(pos[i, k] - pos[j, k], axis=1)
     db = np.linalg.norm(pos[i, k + 1] - pos[j, k + 1], axis=1)
     a, b = t[k], t[k + 1]
-    w = _relative(_local(motions, i, a, b), _local(motions, j, a, b), 0.5 * (b - a))
-    return _Intervals(pair, a, b, da, db, w)
+    one, two = _local(motions, i, a, b), _local(motions, j, a, b)
+    return _Intervals(pair, a, b, da, db, _relative(one, two, 0.5 * (b - a)), one.jump + two.jump)
 
 
 def _pad(derivatives: FloatArray, width: int) -> FloatArray:
@@ -341,14 +359,15 @@ def _split(
     a = np.concatenate([items.a, mid])
     b = np.concatenate([mid, items.b])
     ii, jj = np.concatenate([i, i]), np.concatenate([j, j])
-    w = _relative(_local(motions, ii, a, b), _local(motions, jj, a, b), 0.5 * (b - a))
+    one, two = _local(motions, ii, a, b), _local(motions, jj, a, b)
     return _Intervals(
         np.concatenate([items.pair, items.pair]),
         a,
         b,
         np.concatenate([items.da, dm]),
         np.concatenate([dm, items.db]),
-        w,
+        _relative(one, two, 0.5 * (b - a)),
+        one.jump + two.jump,
     )
 
 
@@ -365,13 +384,15 @@ def _local(motions: Sequence[Motion], who: IntArray, a: FloatArray, b: FloatArra
     derivs = np.zeros((a.size, width, 3))
     inside = np.zeros(a.size, dtype=bool)
     speed = np.empty(a.size)
+    jump = np.empty(a.size)
     for d in np.unique(who):
         mask = who == d
         lm = motions[d].local(a[mask], b[mask])
         derivs[mask] = _pad(lm.derivatives, width)
         inside[mask] = lm.inside
         speed[mask] = lm.speed
-    return LocalMotion(derivs, inside, speed)
+        jump[mask] = lm.jump
+    return LocalMotion(derivs, inside, speed, jump)
 
 
 def _result(
