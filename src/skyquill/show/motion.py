@@ -151,7 +151,7 @@ class Motion:
         if not inside.all():
             speed[~inside] = self._straddling(a[~inside], b[~inside], first[~inside], last[~inside])
         derivatives[~inside] = 0.0
-        return LocalMotion(derivatives, inside, speed, (last - first) * self.jump_m)
+        return LocalMotion(derivatives, inside, speed, (last - first).astype(float) * self.jump_m)
 
     def _straddling(
         self, a: FloatArray, b: FloatArray, first: NDArray[np.intp], last: NDArray[np.intp]
