@@ -158,3 +158,40 @@ def test_the_zipped_csv_round_trips_with_lights_to_the_ms(
         )
     summary = json.loads(json.dumps(report.as_dict()))
     assert summary["delivered"][0]["limits"][0]["relative_excess"] == 0.0  # the speed
+
+
+def _per_stroke(plans: list[NamedPlan]) -> list[NamedPlan]:
+    """The plans with each pen window in its own colour (a palette of three, cycled)."""
+    palette = [(255, 0, 0), (0, 255, 0), (0, 0, 255)]
+    out = []
+    for name, plan in plans:
+        colors = tuple(palette[k % 3] for k in range(len(plan.pen_windows_s)))
+        out.append(
+            (name, PlannedTrajectory(plan.trajectory, plan.pen_windows_s, plan.limits, colors))
+        )
+    return out
+
+
+def test_a_colour_per_stroke_is_what_skybrush_shows(plans: list[NamedPlan], tmp_path: Path) -> None:
+    """Each stroke lit in its own colour: the .skyc read back shows it, within half a frame."""
+    coloured = _per_stroke(plans)
+    report = EXPORTERS["skyc"](coloured, tmp_path / "yong.skyc", ExportOptions())
+    show = read_show_json(report.files[0])
+    _, plan = coloured[0]
+    data = program_bytes("l", show["swarm"]["drones"][0]["settings"]["lights"])
+    mid_ms = np.array([500.0 * (a + b) for a, b in plan.pen_windows_s])
+    shown = light_colors(light_slices("l", data, 30_000), mid_ms)
+    np.testing.assert_array_equal(shown, np.array(plan.pen_rgb))
+    per_drone = report.details["lights"]["per_drone"]
+    assert all(d["max_offset_ms"] <= 10 and d["colors"] == 3 for d in per_drone)
+
+
+def test_a_colour_per_stroke_is_in_the_zipped_csv(plans: list[NamedPlan], tmp_path: Path) -> None:
+    coloured = _per_stroke(plans)
+    report = EXPORTERS["skybrush-csv"](coloured, tmp_path / "yong.zip", ExportOptions())
+    assert report.details["lights_exact_to_ms"]
+    drone = read_csv_zip(report.files[0])[0]
+    _, plan = coloured[0]
+    for (a, b), rgb in zip(plan.pen_windows_s, plan.pen_rgb, strict=True):
+        rows = drone.colors[(drone.t_ms >= round(a * 1000)) & (drone.t_ms <= round(b * 1000))]
+        assert rows.size and np.all(rows == rgb)

@@ -95,3 +95,26 @@ def test_a_broken_lights_object_is_an_input_error(lights: object, match: str) ->
 def test_a_bad_colour_is_named(rgb: object) -> None:
     with pytest.raises(InputError, match=r"light_rgb: got .*expected three integers in 0..255"):
         check_rgb("light_rgb", rgb)
+
+
+def test_touching_windows_of_two_colours_switch_on_the_frame() -> None:
+    red, blue = (255, 0, 0), (0, 0, 255)
+    windows = [(1.0, 1.2), (1.2, 1.5), (2.0, 2.4)]
+    frames = lights.colored_frames(windows, [red, blue, blue])
+    assert frames == [(50, 60, red), (60, 75, blue), (100, 120, blue)]
+    program = encode_light_program(windows, [red, blue, blue], 3.0)
+    colors = light_colors(light_slices("p", program, 3000), np.array([1100.0, 1300.0, 1700.0]))
+    np.testing.assert_array_equal(colors, [red, blue, (0, 0, 0)])
+
+
+@pytest.mark.parametrize(
+    ("colors", "message"),
+    [
+        ([(1, 2, 3)], r"rgb: got 1 colours, expected one per pen window \(2\)"),
+        ([(1, 2, 3), (1, 2, 300)], r"rgb\[1\]: got \(1, 2, 300\), expected three integers"),
+        ("red", "expected one R, G, B triple per pen window"),
+    ],
+)
+def test_bad_colours_per_window_are_named(colors: object, message: str) -> None:
+    with pytest.raises(InputError, match=message):
+        encode_light_program([(0.0, 1.0), (2.0, 3.0)], colors, 4.0)  # type: ignore[arg-type]

@@ -32,6 +32,33 @@ def test_limits_and_pen_round_trip(tmp_path: Path) -> None:
     np.testing.assert_array_equal(back.pen(np.array([0.0, 0.3])), [0.0, 1.0])
 
 
+def test_a_colour_per_window_round_trips(tmp_path: Path) -> None:
+    windows, colors = ((0.1, 0.5), (0.8, 1.0)), ((255, 0, 0), (0, 10, 255))
+    write_trajectory_json(tmp_path / "t.json", PlannedTrajectory(SPLINE, windows, (), colors))
+    back = read_trajectory_json(tmp_path / "t.json")
+    assert back.pen_rgb == colors
+    np.testing.assert_array_equal(
+        back.light(np.array([0.0, 0.3, 0.9]), (1, 1, 1)), [[0, 0, 0], [255, 0, 0], [0, 10, 255]]
+    )
+    plain = PlannedTrajectory(SPLINE, windows)
+    assert plain.colors((7, 7, 7)) == ((7, 7, 7), (7, 7, 7))
+
+
+def test_a_colour_count_that_is_not_the_window_count_is_named(tmp_path: Path) -> None:
+    with pytest.raises(InputError, match=r"pen_rgb: got 1 colours, expected one per pen window"):
+        PlannedTrajectory(SPLINE, ((0.1, 0.5), (0.8, 1.0)), (), ((255, 0, 0),))
+    data = json.loads(_written(tmp_path))
+    data["pen_rgb"] = [[1, 2, 3], [4, 5]]
+    (tmp_path / "bad.json").write_text(json.dumps(data))
+    with pytest.raises(InputError, match=r"bad.json: pen_rgb\[1\]: got \[4, 5\]"):
+        read_trajectory_json(tmp_path / "bad.json")
+
+
+def _written(tmp_path: Path) -> str:
+    write_trajectory_json(tmp_path / "w.json", PlannedTrajectory(SPLINE, ((0.1, 0.5), (0.8, 1.0))))
+    return (tmp_path / "w.json").read_text()
+
+
 def test_version_1_is_read(tmp_path: Path) -> None:
     legacy = {
         "format": "skyquill-bspline",

@@ -21,7 +21,8 @@ from numpy.typing import NDArray
 
 from skyquill.export.base import ExportOptions, ExportReport, NamedPlan, check_delivered
 from skyquill.io.skybrush_csv import CsvDrone, read_csv_zip, write_csv_zip
-from skyquill.io.trajectory_json import PlannedTrajectory, pen_down
+from skyquill.io.skybrush_lights import RGB
+from skyquill.io.trajectory_json import PlannedTrajectory, light_at
 
 
 def _ms_windows(windows_s: Sequence[tuple[float, float]]) -> list[tuple[int, int]]:
@@ -36,20 +37,20 @@ def _row_times(plan: PlannedTrajectory, rate_hz: float) -> NDArray[np.int64]:
     return np.unique(np.clip(times, 0, end)).astype(np.int64)
 
 
-def csv_drone(
-    name: str, plan: PlannedTrajectory, rate_hz: float, rgb: tuple[int, int, int]
-) -> CsvDrone:
-    """The rows of one drone: lit in ``rgb`` on every millisecond of a pen window, else black."""
+def _ms_light(plan: PlannedTrajectory, t_ms: NDArray[np.int64], rgb: RGB) -> NDArray[np.int64]:
+    """The light at ``t_ms`` (N,): each pen window's colour on its milliseconds, else black."""
+    return light_at(t_ms, _ms_windows(plan.pen_windows_s), plan.colors(rgb))
+
+
+def csv_drone(name: str, plan: PlannedTrajectory, rate_hz: float, rgb: RGB) -> CsvDrone:
+    """The rows of one drone: lit on every millisecond of a pen window, in the window's colour."""
     t_ms = _row_times(plan, rate_hz)
     positions = plan.trajectory.evaluate(np.minimum(t_ms / 1000, plan.trajectory.duration))
-    lit = pen_down(t_ms, _ms_windows(plan.pen_windows_s)).astype(bool)
-    colors = np.where(lit[:, None], np.array(rgb), 0).astype(np.int64)
-    return CsvDrone(name, t_ms, positions, colors)
+    return CsvDrone(name, t_ms, positions, _ms_light(plan, t_ms, rgb))
 
 
-def _lights_exact(back: CsvDrone, plan: PlannedTrajectory, rgb: tuple[int, int, int]) -> bool:
-    lit = np.all(back.colors == np.array(rgb), axis=1)
-    return bool(np.array_equal(lit, pen_down(back.t_ms, _ms_windows(plan.pen_windows_s)) > 0))
+def _lights_exact(back: CsvDrone, plan: PlannedTrajectory, rgb: RGB) -> bool:
+    return bool(np.array_equal(back.colors, _ms_light(plan, back.t_ms, rgb)))
 
 
 @dataclass(frozen=True)

@@ -30,8 +30,9 @@ from skyquill.export.base import (
 from skyquill.export.skybrush_validation import validation_settings
 from skyquill.io.skybrush_keyframes import skybrush_keyframes
 from skyquill.io.skybrush_lights import (
+    RGB,
+    colored_frames,
     encode_light_program,
-    frame_windows,
     light_colors,
     light_slices,
     program_bytes,
@@ -44,7 +45,7 @@ from skyquill.io.skyc import (
     show_location,
     write_skyc,
 )
-from skyquill.io.trajectory_json import pen_down
+from skyquill.io.trajectory_json import PlannedTrajectory
 
 #: A limit excess below this counts as none (float rounding of the read-back), relative.
 EXCESS_TOLERANCE = 1e-9
@@ -69,7 +70,7 @@ class SkycExporter:
                 name,
                 skybrush_keyframes(plan.trajectory),
                 encode_light_program(
-                    plan.pen_windows_s, options.light_rgb, plan.trajectory.duration
+                    plan.pen_windows_s, plan.colors(options.light_rgb), plan.trajectory.duration
                 ),
             )
             for name, plan in plans
@@ -96,7 +97,7 @@ class SkycExporter:
             for (name, plan), back in zip(plans, played, strict=True)
         )
         lights = [
-            _light_mismatch(show, i, plan.pen_windows_s, options.light_rgb, back.duration)
+            _light_mismatch(show, i, plan, options.light_rgb, back.duration)
             for i, ((_, plan), back) in enumerate(zip(plans, played, strict=True))
         ]
         details = _details(drones, delivered, lights, validation)
@@ -132,21 +133,26 @@ def _location_shift(show: dict[str, Any], frame: GeoFrame) -> float:
 def _light_mismatch(
     show: dict[str, Any],
     index: int,
-    windows_s: Sequence[tuple[float, float]],
-    rgb: tuple[int, int, int],
+    plan: PlannedTrajectory,
+    rgb: RGB,
     duration_s: float,
 ) -> dict[str, Any]:
-    """Where the light Skybrush shows differs from the pen, on every millisecond of the show."""
+    """Where the light Skybrush shows differs from the pen's, on every millisecond of the show.
+
+    Each millisecond compares the colour shown with the colour of the pen window it falls
+    in (black outside).
+    """
     where = f"show.json: swarm.drones[{index}].settings.lights"
     data = program_bytes(where, show["swarm"]["drones"][index]["settings"]["lights"])
     t_ms = np.arange(0.0, np.ceil(duration_s * 1000) + 1)
-    lit = np.all(light_colors(light_slices(where, data, t_ms[-1]), t_ms) == rgb, axis=1)
-    wrong = lit != pen_down(t_ms / 1000, windows_s).astype(bool)
+    shown = light_colors(light_slices(where, data, t_ms[-1]), t_ms)
+    wrong = np.any(shown != plan.light(t_ms / 1000, rgb), axis=1)
     # the longest run of wrong milliseconds: how far a switch is from the pen's
     runs = np.diff(np.flatnonzero(np.diff(np.concatenate([[0], wrong.astype(int), [0]]))))[::2]
     return {
-        "windows": len(windows_s),
-        "lit_windows": len(frame_windows(windows_s)),
+        "windows": len(plan.pen_windows_s),
+        "lit_windows": len(colored_frames(plan.pen_windows_s, plan.colors(rgb))),
+        "colors": len(set(plan.colors(rgb))),
         "max_offset_ms": int(runs.max()) if runs.size else 0,
     }
 

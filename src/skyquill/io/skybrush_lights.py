@@ -42,30 +42,67 @@ RGB = tuple[int, int, int]
 
 def check_rgb(name: str, rgb: Any) -> RGB:
     """``rgb`` as three integers in 0..255; :class:`InputError` naming ``name`` otherwise."""
-    ok = (
-        isinstance(rgb, Sequence)
-        and not isinstance(rgb, str)
-        and len(rgb) == 3
-        and all(isinstance(c, int | np.integer) and not isinstance(c, bool) for c in rgb)
-        and all(0 <= int(c) <= 255 for c in rgb)
-    )
-    if not ok:
+    if not (_is_rgb(rgb) and all(0 <= int(c) <= 255 for c in rgb)):
         raise InputError(f"{name}: got {rgb!r:.60}, expected three integers in 0..255 (R, G, B)")
     return (int(rgb[0]), int(rgb[1]), int(rgb[2]))
 
 
-def frame_windows(windows_s: Sequence[tuple[float, float]]) -> list[tuple[int, int]]:
-    """Pen windows (s) as light windows on the 20 ms frame clock: rounded, merged, non-empty."""
-    out: list[tuple[int, int]] = []
-    for a, b in sorted(windows_s):
+def window_colors(name: str, windows: Sequence[Any], colors: Any) -> tuple[RGB, ...]:
+    """``colors`` checked to be one R, G, B triple per window.
+
+    Raises
+    ------
+    InputError
+        Naming ``name``: not a sequence of triples, a colour that is not three integers
+        in 0..255, or a count that is not the number of windows.
+    """
+    if isinstance(colors, str | bytes) or not isinstance(colors, Sequence) or _is_rgb(colors):
+        raise InputError(f"{name}: got {colors!r:.60}, expected one R, G, B triple per pen window")
+    if len(colors) != len(windows):
+        raise InputError(
+            f"{name}: got {len(colors)} colours, expected one per pen window ({len(windows)})"
+        )
+    return tuple(check_rgb(f"{name}[{i}]", c) for i, c in enumerate(colors))
+
+
+def _is_rgb(value: Any) -> bool:
+    return (
+        isinstance(value, Sequence)
+        and not isinstance(value, str)
+        and len(value) == 3
+        and all(isinstance(c, int | np.integer) and not isinstance(c, bool) for c in value)
+    )
+
+
+def colored_frames(
+    windows_s: Sequence[tuple[float, float]], colors: Sequence[RGB]
+) -> list[tuple[int, int, RGB]]:
+    """Pen windows (s) and their colours as light windows on the 20 ms frame clock.
+
+    Ends are rounded to the nearest frame; a window shorter than half a frame vanishes
+    (Skybrush cannot show it); windows that touch or overlap after rounding merge when
+    they have the same colour, else the later one starts where it starts and the earlier
+    one ends there.
+    """
+    out: list[tuple[int, int, RGB]] = []
+    for (a, b), rgb in sorted(zip(windows_s, colors, strict=True)):
         start, end = round(a * 1000 / FRAME_MS), round(b * 1000 / FRAME_MS)
         if end <= start:
-            continue  # shorter than half a frame: Skybrush cannot show it
+            continue
         if out and start <= out[-1][1]:
-            out[-1] = (out[-1][0], max(out[-1][1], end))
-        else:
-            out.append((start, end))
+            before, stop, color = out.pop()
+            if color == rgb:
+                start, end = before, max(stop, end)
+            elif start > before:
+                out.append((before, start, color))
+        out.append((start, end, rgb))
     return out
+
+
+def frame_windows(windows_s: Sequence[tuple[float, float]]) -> list[tuple[int, int]]:
+    """Pen windows (s) of one colour as light windows on the 20 ms frame clock (merged)."""
+    white = ((255, 255, 255),) * len(windows_s)
+    return [(a, b) for a, b, _ in colored_frames(windows_s, white)]
 
 
 def _varuint(value: int) -> bytes:
@@ -78,24 +115,28 @@ def _varuint(value: int) -> bytes:
 
 
 def encode_light_program(
-    windows_s: Sequence[tuple[float, float]], rgb: RGB, duration_s: float
+    windows_s: Sequence[tuple[float, float]], colors: RGB | Sequence[RGB], duration_s: float
 ) -> bytes:
-    """Bytecode: black, then ``rgb`` during every pen window, black until ``duration_s``.
+    """Bytecode: black, then each pen window in its colour, black until ``duration_s``.
 
     Parameters
     ----------
     windows_s
         Pen-down windows ``(start, end)`` on the show clock, s.
-    rgb
-        The pen-down colour, three integers in 0..255.
+    colors
+        The pen-down colour (three integers in 0..255), or one per window.
     duration_s
         Length of the show, s (the program ends black at least one frame after the last
         window).
     """
-    rgb = check_rgb("rgb", rgb)
+    per_window = (
+        (check_rgb("rgb", colors),) * len(windows_s)
+        if _is_rgb(colors)
+        else window_colors("rgb", windows_s, colors)
+    )
     program = bytearray()
     now = 0
-    for start, end in frame_windows(windows_s):
+    for start, end, rgb in colored_frames(windows_s, per_window):
         if start > now:
             program += bytes([SET_BLACK]) + _varuint(start - now)
         program += bytes([SET_COLOR, *rgb]) + _varuint(end - start)

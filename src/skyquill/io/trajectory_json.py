@@ -8,6 +8,7 @@ trajectory itself::
      "frame": "world, z up, m, s",
      "trajectory": {"kind": "bspline" | "polynomial" | "retimed" | "sequence" | "sampled", ...},
      "pen_windows_s": [[t0, t1], ...],
+     "pen_rgb": [[r, g, b], ...],              (optional: one light colour per window)
      "limits": [{"type": "BoxLimit" | "CylinderLimit" | ..., <its fields>}, ...]}
 
 (:mod:`skyquill.trajectory.codec` gives each kind's fields.) Version 1 files,
@@ -25,10 +26,12 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from skyquill.errors import InputError
 from skyquill.io.atomic import write_text
 from skyquill.io.json_read import parse_json
+from skyquill.io.skybrush_lights import RGB, window_colors
 from skyquill.limits import BoxLimit, CylinderLimit, DerivativeLimit, NormLimit
 from skyquill.trajectory import Trajectory
 from skyquill.trajectory.codec import decode, encode
@@ -55,15 +58,32 @@ class PlannedTrajectory:
     limits
         The limits it was planned for (every exporter checks what its
         consumer will fly against them).
+    pen_rgb
+        The light's colour in each pen window, three integers 0..255 each (light
+        painting, shows); empty: the exporter's one colour for every window.
     """
 
     trajectory: Trajectory
     pen_windows_s: tuple[tuple[float, float], ...] = ()
     limits: tuple[DerivativeLimit, ...] = ()
+    pen_rgb: tuple[RGB, ...] = ()
+
+    def __post_init__(self) -> None:
+        if self.pen_rgb:
+            colors = window_colors("pen_rgb", self.pen_windows_s, self.pen_rgb)
+            object.__setattr__(self, "pen_rgb", colors)
 
     def pen(self, t: Any) -> Any:
         """1.0 where the pen is down at times ``t`` (N,), else 0.0."""
         return pen_down(t, self.pen_windows_s)
+
+    def colors(self, default: RGB) -> tuple[RGB, ...]:
+        """The colour of each pen window: :attr:`pen_rgb`, or ``default`` for all."""
+        return self.pen_rgb or (default,) * len(self.pen_windows_s)
+
+    def light(self, t: Any, default: RGB) -> NDArray[np.int64]:
+        """The light's colour at times ``t`` (N,), s: its window's, black outside (N, 3)."""
+        return light_at(t, self.pen_windows_s, self.colors(default))
 
 
 def pen_down(t: Any, windows: Sequence[tuple[float, float]]) -> FloatArray:
@@ -75,6 +95,17 @@ def pen_down(t: Any, windows: Sequence[tuple[float, float]]) -> FloatArray:
     return down
 
 
+def light_at(
+    t: Any, windows: Sequence[tuple[float, float]], colors: Sequence[RGB]
+) -> NDArray[np.int64]:
+    """The colour of the window each time ``t`` (N,) falls in, black outside, shape (N, 3)."""
+    times = np.asarray(t, dtype=float)
+    out = np.zeros((times.size, 3), dtype=np.int64)
+    for (start, end), rgb in zip(windows, colors, strict=True):
+        out[(times >= start) & (times <= end)] = rgb
+    return out
+
+
 def write_trajectory_json(path: str | Path, planned: PlannedTrajectory) -> None:
     """Write ``planned`` to ``path`` atomically."""
     data = {
@@ -83,6 +114,7 @@ def write_trajectory_json(path: str | Path, planned: PlannedTrajectory) -> None:
         "frame": "world, z up, m, s",
         "trajectory": encode(planned.trajectory),
         "pen_windows_s": [list(w) for w in planned.pen_windows_s],
+        **({"pen_rgb": [list(c) for c in planned.pen_rgb]} if planned.pen_rgb else {}),
         "limits": [_encode_limit(lim) for lim in planned.limits],
     }
     write_text(path, json.dumps(data, allow_nan=False) + "\n")
@@ -120,10 +152,13 @@ def _planned(data: object) -> PlannedTrajectory:
     limits = data.get("limits", [])
     if not isinstance(limits, list):
         raise InputError(f"limits: got a JSON {type(limits).__name__}, expected a list")
+    windows = _windows(data)
+    colors = data.get("pen_rgb", [])
     return PlannedTrajectory(
         decode(data.get("trajectory")),
-        _windows(data),
+        windows,
         tuple(_decode_limit(item) for item in limits),
+        window_colors("pen_rgb", windows, colors) if colors != [] else (),
     )
 
 
