@@ -165,17 +165,19 @@ def test_crazyswarm_round_trip_flies_in_the_simulator(targeted: Path, tmp_path: 
 def test_the_light_colour_reaches_the_skybrush_formats(fitted: Path, tmp_path: Path) -> None:
     out = tmp_path / "lit.zip"
     args = ["export", str(fitted), "--format", "skybrush-csv", "--out", str(out)]
-    result = runner.invoke(app, [*args, "--light", "10,20,30"])
+    result = runner.invoke(app, [*args, "--light", "#0a141e"])  # 10,20,30
     assert result.exit_code == 0, result.output
     summary = json.loads((tmp_path / "lit.summary.json").read_text())
     assert summary["lights_exact_to_ms"] and summary["format"] == "skybrush-csv"
 
 
-@pytest.mark.parametrize("light", ["10,20", "1,2,256", "red", "1,-2,3", "1.5,2,3"])
+@pytest.mark.parametrize("light", ["10,20", "1,2,256", "red", "1,-2,3", "1.5,2,3", "#12345g"])
 def test_a_bad_light_colour_is_named(fitted: Path, tmp_path: Path, light: str) -> None:
     out = tmp_path / "s.skyc"
     args = ["export", str(fitted), "--format", "skyc", "--out", str(out), "--light", light]
     result = runner.invoke(app, args)
     assert result.exit_code == 2
-    assert f"--light: got {light!r}, expected R,G,B with three integers in 0..255" in result.output
+    assert f"--light: got {light!r}, expected R,G,B with three integers in 0..255 or #RRGGBB" in (
+        result.output
+    )
     assert not out.exists()

@@ -7,7 +7,15 @@ from typing import Annotated
 
 import typer
 
-from skyquill.cli.main import Force, app, console, positive_rate, say_done, user_errors
+from skyquill.cli.main import (
+    Force,
+    app,
+    console,
+    parse_color,
+    positive_rate,
+    say_done,
+    user_errors,
+)
 from skyquill.coverage.geo import plan_frame
 from skyquill.errors import InputError
 from skyquill.export import EXPORTERS, ExportOptions
@@ -16,14 +24,6 @@ from skyquill.io.outputs import staged_output
 from skyquill.io.plan_dir import plan_files, read_plan
 
 FORMAT_HELP = "; ".join(f"{e.name}: {e.help}" for e in EXPORTERS.values())
-
-
-def _rgb(text: str) -> tuple[int, int, int]:
-    """``R,G,B`` as three integers in 0..255; the error names the flag."""
-    parts = text.split(",")
-    if len(parts) == 3 and all(p.strip().isdigit() and int(p) <= 255 for p in parts):
-        return (int(parts[0]), int(parts[1]), int(parts[2]))
-    raise InputError(f"--light: got {text!r}, expected R,G,B with three integers in 0..255")
 
 
 @app.command()
@@ -44,7 +44,7 @@ def export(
         str,
         typer.Option(
             "--light",
-            metavar="R,G,B",
+            metavar="R,G,B|#RRGGBB",
             help="Light colour while the pen is down (skyc, skybrush-csv), 0..255 each; "
             "off while it is up.",
         ),
@@ -62,7 +62,9 @@ def export(
                 f"--format {format}"
             )
         options = ExportOptions(
-            rate_hz=positive_rate(rate), light_rgb=_rgb(light), origin=plan_frame(plan)
+            rate_hz=positive_rate(rate),
+            light_rgb=parse_color("--light", light),
+            origin=plan_frame(plan),
         )
         plans = read_plan(plan)
         folder = out.parent

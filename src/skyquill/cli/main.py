@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import logging
 import math
+import string
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -158,6 +159,19 @@ def parse_vector3(option: str, text: str, unit: str) -> FloatArray:
     return np.array(values)
 
 
+def parse_color(flag: str, text: str) -> tuple[int, int, int]:
+    """A light colour given as ``R,G,B`` (integers 0..255) or ``#RRGGBB``; errors name ``flag``."""
+    parts = text.split(",")
+    if len(parts) == 3 and all(p.strip().isdigit() and int(p) <= 255 for p in parts):
+        return (int(parts[0]), int(parts[1]), int(parts[2]))
+    digits = text[1:]
+    if text.startswith("#") and len(digits) == 6 and all(c in string.hexdigits for c in digits):
+        return (int(digits[0:2], 16), int(digits[2:4], 16), int(digits[4:6], 16))
+    raise InputError(
+        f"{flag}: got {text!r}, expected R,G,B with three integers in 0..255 or #RRGGBB"
+    )
+
+
 # Register the commands (each module adds its own to ``app``).
 from skyquill.cli import (  # noqa: E402
     check_cmd,
@@ -167,6 +181,7 @@ from skyquill.cli import (  # noqa: E402
     fly_cmd,
     hanzi_cmd,
     paint_cmd,
+    render_cmd,
     reproduce_cmd,
     studio_cmd,
     write_cmd,
@@ -181,6 +196,7 @@ __all__ = [
     "fly_cmd",
     "hanzi_cmd",
     "paint_cmd",
+    "render_cmd",
     "reproduce_cmd",
     "studio_cmd",
     "write_cmd",
