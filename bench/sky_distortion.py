@@ -56,7 +56,7 @@ from skyquill.optimize import Boundary, PlaneDeviation, PointDeviation, Smoothin
 from skyquill.strokes import typed_strokes
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from common import jsonable, machine_info  # noqa: E402
+from common import jsonable, machine_info
 
 ROOT = Path(__file__).resolve().parents[1]
 RESULTS = ROOT / "bench" / "results" / "sky_distortion.json"
@@ -190,7 +190,8 @@ def main() -> None:
     for name in ("M", "M-aligned", "M_sweep", "word", "word_sweep"):
         for row in out[name]:
             views = "  ".join(
-                f"{v['angle_deg']:>4g}°: {v['max_mm']:7.2f} / {v['rms_mm']:6.2f}" for v in row["views"]
+                f"{v['angle_deg']:>4g}°: {v['max_mm']:7.2f} / {v['rms_mm']:6.2f}"
+                for v in row["views"]
             )
             extra = f" {row['limits'][:22]:<22}" if "limits" in row else ""
             print(

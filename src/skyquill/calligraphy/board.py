@@ -3,7 +3,7 @@
 A board maps 2-D stroke coordinates (metres, y up, origin at the bottom-left of
 the character) to 3-D positions in the world frame (z up), and says how to
 leave it between strokes. A board is a plane with an origin and three
-orthonormal axes, rows of :attr:`Board.axes_W`: ``e_u`` (the writing's x),
+orthonormal axes, the rows of :attr:`Board.axes` (world frame): ``e_u`` (the writing's x),
 ``e_v`` (the writing's y) and the normal ``n = e_u x e_v`` towards the
 vehicle's (or the audience's) side.
 
@@ -110,8 +110,8 @@ class Board:
         return self.kind != "sky"
 
     @property
-    def axes_W(self) -> FloatArray:
-        """Rows ``e_u``, ``e_v``, ``n`` (3, 3): the writing's x and y, and the normal, world frame."""
+    def axes(self) -> FloatArray:
+        """Rows ``e_u``, ``e_v``, ``n`` (3, 3), world frame: the writing's x and y, the normal."""
         if self.kind == "horizontal":
             return np.eye(3)
         yaw, tilt = math.radians(self.yaw_deg), math.radians(self.tilt_deg)
@@ -124,16 +124,16 @@ class Board:
     @property
     def normal(self) -> FloatArray:
         """Unit vector from the surface towards the vehicle's side (3,)."""
-        return np.asarray(self.axes_W[2])
+        return np.asarray(self.axes[2])
 
     def to_world(self, uv: FloatArray) -> FloatArray:
         """Stroke coordinates (K, 2), m, to tip positions on the surface (K, 3), m."""
         uv = np.asarray(uv, dtype=float)
-        return np.asarray(self.origin + uv @ self.axes_W[:2])
+        return np.asarray(self.origin + uv @ self.axes[:2])
 
     def to_board(self, p: FloatArray) -> FloatArray:
         """World points (K, 3) to (u, v, height above the surface) (K, 3)."""
-        return np.asarray((np.asarray(p, dtype=float) - self.origin) @ self.axes_W.T)
+        return np.asarray((np.asarray(p, dtype=float) - self.origin) @ self.axes.T)
 
 
 def sky_board(

@@ -98,9 +98,7 @@ def view_distortion(
         intended = project(board.to_board(stroke), angle_deg)
         gaps.append(polyline_distance(image, intended))
     every = np.concatenate(gaps)
-    return ViewDistortion(
-        float(angle_deg), float(every.max()), float(np.sqrt(np.mean(every**2)))
-    )
+    return ViewDistortion(float(angle_deg), float(every.max()), float(np.sqrt(np.mean(every**2))))
 
 
 def mission_distortion(
@@ -109,8 +107,6 @@ def mission_distortion(
     samples_per_stroke: int = 400,
 ) -> tuple[ViewDistortion, ...]:
     """:func:`view_distortion` of a writing mission's pen-down path at each of ``angles_deg``."""
-    paths = [
-        mission.tip(np.linspace(t0, t1, samples_per_stroke)) for t0, t1 in mission.pen_windows
-    ]
+    paths = [mission.tip(np.linspace(t0, t1, samples_per_stroke)) for t0, t1 in mission.pen_windows]
     strokes = list(mission.strokes_world)
     return tuple(view_distortion(paths, strokes, mission.board, a) for a in angles_deg)

@@ -638,7 +638,7 @@ def check_reach(board: Board, opts: WritingOptions) -> None:
     if board.kind == "horizontal":
         top = bottom + length + board.lift_m
     else:
-        rise = np.maximum(board.axes_W[:, 2], 0.0)  # how much e_u, e_v and n climb
+        rise = np.maximum(board.axes[:, 2], 0.0)  # how much e_u, e_v and n climb
         top = bottom + opts.size_m * float(rise[0] + rise[1]) + board.lift_m * float(rise[2])
     if bottom <= 0.0 or top > MAX_ALTITUDE_M:
         raise InputError(
