@@ -11,8 +11,9 @@ Two ways to share a light painting (issue 18, part 2):
   every drone's flight takes about as long and neighbours work in different
   bands; each drone sweeps its band in the same direction, so neighbours move
   alike at about the same pace and stay about a band apart (for light the
-  order of the strokes does not show in the picture). Whether they stay far enough apart is then decided by the guaranteed
-  separation check (:func:`~skyquill.calligraphy.mission.check_separation`).
+  order of the strokes does not show in the picture). Whether they stay far
+  enough apart is then decided by the guaranteed separation check
+  (:func:`~skyquill.calligraphy.mission.check_separation`).
 """
 
 from __future__ import annotations
