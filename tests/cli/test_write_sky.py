@@ -43,7 +43,7 @@ def test_twenty_drones_write_twenty_characters_in_a_grid(tmp_path: Path) -> None
     )
     assert result.exit_code == 0, result.output
     summary = json.loads((tmp_path / "summary.json").read_text())
-    assert len(summary["drones"]) == 20
+    assert len(summary["drones"]) == 20 and summary["grid"] == {"rows": 4, "columns": 5}
     assert summary["min_separation_m"] >= 1.0 and summary["max_excess"] <= 1e-9
     assert len(list(tmp_path.glob("trajectory_*.csv"))) == 20
 

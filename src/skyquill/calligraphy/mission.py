@@ -1064,9 +1064,9 @@ def _plane_terms(
     if board is None or board.has_contact or opts.plane_weight == 0:
         return ()
     pen = np.flatnonzero(roles >= 0)
-    t0, t1 = float(times[pen[0]]), float(times[pen[-1]])
-    if t1 <= t0:
+    if pen.size == 0 or times[pen[-1]] <= times[pen[0]]:
         return ()
+    t0, t1 = float(times[pen[0]]), float(times[pen[-1]])
     return (PlaneDeviation(board.normal, board.origin, t0, t1, opts.plane_weight),)
 
 

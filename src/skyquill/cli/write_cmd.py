@@ -397,7 +397,7 @@ class _Sharing:
         """With a split: each drone's strokes, board and home, and the summary's
         ``split`` section (the flight-time balance) once planned; else nothing."""
         if not self.split:
-            return _Places(parts, []), lambda show: {}
+            return _Places(parts, []), lambda show: self._grid(len(parts))
         from skyquill.calligraphy.artwork import split_homes, split_strokes
         from skyquill.calligraphy.board import Board
         from skyquill.calligraphy.show import DEFAULT_LIFT_M
@@ -423,6 +423,15 @@ class _Sharing:
             }
 
         return _Places(list(shared.parts), [(board, h) for h in homes]), balance
+
+    def _grid(self, n: int) -> dict[str, Any]:
+        """The summary's ``grid`` section for several sky boards, else nothing."""
+        if self.kind != "sky" or n < 2:
+            return {}
+        from skyquill.calligraphy.artwork import grid_shape
+
+        rows, columns = grid_shape(n, self.pose.grid)
+        return {"grid": {"rows": rows, "columns": columns}}
 
 
 @contextmanager
