@@ -43,6 +43,12 @@ bearing's travel -- is within the tolerance of the strokes
 (:func:`~skyquill.calligraphy.fidelity.planned_ink`). ``follow="path"`` fits
 the untilted tip (paper 000: the vehicle's path, offset by the brush), as on a
 wall.
+
+On a sky board (light painting) there is no brush: the pen is the vehicle's
+light, so the tip is the vehicle (:func:`tip_offset` is zero), the lift is 0
+(the transits stay in the plane) and paper 003 §5.3's plane-deviation cost
+(``WritingOptions.plane_weight``) holds the flight on the plane from the first
+stroke to the last, so the drawing keeps its shape seen from the side.
 """
 
 from __future__ import annotations
@@ -580,8 +586,11 @@ def route_times(
     lifts = contact_runs(roles == LIFT)
     # Where the legs from and to home end and start: above the first and last
     # stroke, or with no lifts (a sky board) on them.
-    pen = lifts or contact_runs(roles >= 0)
-    first, last = (lifts[0][0] - 1, lifts[-1][1]) if lifts else (pen[0][0], pen[-1][1] - 1)
+    if lifts:
+        first, last = lifts[0][0] - 1, lifts[-1][1]
+    else:
+        pen = contact_runs(roles >= 0)
+        first, last = pen[0][0], pen[-1][1] - 1
     from_home = first > 0  # else the route starts right above the first stroke
     if from_home:
         # The legs from and to home are long and straight, timed at the speed
