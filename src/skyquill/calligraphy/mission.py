@@ -43,6 +43,12 @@ bearing's travel -- is within the tolerance of the strokes
 (:func:`~skyquill.calligraphy.fidelity.planned_ink`). ``follow="path"`` fits
 the untilted tip (paper 000: the vehicle's path, offset by the brush), as on a
 wall.
+
+On a sky board (light painting) there is no brush: the pen is the vehicle's
+light, so the tip is the vehicle (:func:`tip_offset` is zero), the lift is 0
+(the transits stay in the plane) and paper 003 §5.3's plane-deviation cost
+(``WritingOptions.plane_weight``) holds the flight on the plane from the first
+stroke to the last, so the drawing keeps its shape seen from the side.
 """
 
 from __future__ import annotations
@@ -73,7 +79,14 @@ from skyquill.calligraphy.fidelity import (
 from skyquill.errors import InfeasibleError, InputError
 from skyquill.io.trajectory_json import pen_down
 from skyquill.limits import DerivativeLimit, VehicleLimits
-from skyquill.optimize import Boundary, PointDeviation, SmoothingProblem, resegment, solve
+from skyquill.optimize import (
+    Boundary,
+    PlaneDeviation,
+    PointDeviation,
+    SmoothingProblem,
+    resegment,
+    solve,
+)
 from skyquill.optimize.solve import FitResult
 from skyquill.optimize.timing import allocate_path_times
 from skyquill.optimize.workspace import Workspace
@@ -149,6 +162,17 @@ TIP_POLISH_PASSES = 2
 #: taken on the fast side of what is measured (p ~ 3.1) so that a predicted stretch never
 #: overshoots (:func:`_stretches_needed`).
 DEVIATION_EXPONENT = 3.5
+#: Weight of the plane-deviation cost on a sky board (paper 003 §5.3), per control
+#: point active from the first stroke to the last, against the jerk cost and the
+#: stroke samples' 1e4 each (~5 per knot span at 1 m/s). Measured
+#: (bench/sky_distortion.py, bench/results/sky_distortion.json): on "light" on a
+#: board at yaw 30°, tilt 20°, the largest distance off the plane falls from
+#: 1.43 mm (0) to 1.28, 0.79, 0.34, 0.12 mm at 1e3, 1e4, 1e5, 1e6, with the same
+#: flight time and in-plane fidelity; on paper 003's M with per-axis limits from
+#: 48.8 mm to 30, 20, 5.8, 0.9 mm, but above 1e5 the M misses its vertices by
+#: more (82.7 -> 84.8 mm): 1e5 keeps the drawing within a millimetre of the
+#: plane without trading the strokes for it.
+PLANE_WEIGHT = 1e5
 #: The ways to fit a vehicle's upload budget (:mod:`skyquill.calligraphy.budget`).
 TARGET_STRATEGIES: tuple[TargetStrategy, ...] = ("one-upload", "split")
 
@@ -216,6 +240,11 @@ class WritingOptions:
         The ways to fit ``target`` tried, in order (default
         :data:`TARGET_STRATEGIES`, cheapest flight first): ``"one-upload"`` and
         ``"split"``; one alone measures it (the budget benchmark).
+    plane_weight
+        On a sky board, the weight of paper 003's plane-deviation cost (§3.3.3,
+        §5.3) that keeps the flight on the board's plane from the first stroke
+        to the last, so the drawing is not distorted seen from the side
+        (default :data:`PLANE_WEIGHT`); 0 disables it. Unused on other boards.
     """
 
     size_m: float = 0.5
@@ -238,6 +267,7 @@ class WritingOptions:
     best_effort: bool = False
     target: UploadTarget | None = None
     target_strategies: tuple[TargetStrategy, ...] = TARGET_STRATEGIES
+    plane_weight: float = PLANE_WEIGHT
 
     def __post_init__(self) -> None:
         if not isinstance(self.limits, VehicleLimits):
@@ -263,7 +293,8 @@ class WritingOptions:
         self.limits.timing_bounds()  # the route is timed with a speed and an acceleration
         for name in ("size_m", "knot_interval", "stretch_factor"):
             as_float(name, getattr(self, name), positive=True)
-        for name in ("data_weight", "turning_weight", "transit_weight", "lift_weight"):
+        weights = ("data_weight", "turning_weight", "transit_weight", "lift_weight", "plane_weight")
+        for name in weights:
             as_float(name, getattr(self, name), nonneg=True)
         low, high = SIZE_RANGE_M
         if not low <= self.size_m <= high:
@@ -374,8 +405,8 @@ class Mission:
 
     @property
     def brush_offset(self) -> FloatArray:
-        """Vehicle position minus tip position (3,), m."""
-        return self.options.brush.length_m * self.board.normal
+        """Vehicle position minus tip position (3,), m (zero on a sky board)."""
+        return tip_offset(self.board, self.options)
 
     def tip(self, t: FloatArray) -> FloatArray:
         """Where the brush tip is at times ``t`` (N,): (N, 3), m.
@@ -425,6 +456,14 @@ class Mission:
         return entry
 
 
+def tip_offset(board: Board, opts: WritingOptions) -> FloatArray:
+    """Vehicle position minus pen-tip position (3,), m: the brush along the board's
+    normal, or zero on a sky board (the pen is the vehicle's light)."""
+    if not board.has_contact:
+        return np.zeros(3)
+    return np.asarray(opts.brush.length_m * board.normal)
+
+
 def offset_trajectory(traj: Trajectory, offset: FloatArray) -> Trajectory:
     """``traj`` moved by ``offset`` (d,), m: a spline or a sequence of splines."""
     if isinstance(traj, SplineTrajectory):
@@ -466,6 +505,13 @@ class _Route:
         self.points.append(points)
         self.role.append(np.full(len(points), role))
 
+    def add_stroke(self, points: FloatArray, role: int) -> None:
+        """Add a stroke's samples; with no lift (a sky board) the transit ends on its
+        first point, and that sample becomes the stroke's (times must increase)."""
+        if np.linalg.norm(points[0] - self.points[-1][-1]) < 1e-9:
+            self.points[-1], self.role[-1] = self.points[-1][:-1], self.role[-1][:-1]
+        self.add(points, role)
+
     def go_to(self, target: FloatArray, include_target: bool = True, role: int = -1) -> None:
         if np.linalg.norm(target - self.points[-1][-1]) < 1e-9:
             return  # already there: no repeated sample (times must increase)
@@ -490,7 +536,7 @@ def _route(
         route.go_to(stroke[0] + lift)
         # Touch down on the stroke's first point, lift straight up from its last.
         route.go_to(stroke[0], include_target=False, role=LIFT)
-        route.add(densify(stroke), i)
+        route.add_stroke(densify(stroke), i)
         route.go_to(stroke[-1] + lift, role=LIFT)
     if home is not None:
         route.go_to(np.array([home[0], home[1], route.points[-1][-1][2]]))
@@ -538,13 +584,20 @@ def route_times(
     share = TIP_TIMING_ACC if opts.follows_tip(board) else 0.5
     steps = np.diff(allocate_path_times(points, vmax, share * amax))
     lifts = contact_runs(roles == LIFT)
-    from_home = lifts[0][0] > 1  # else the route starts right above the first stroke
+    # Where the legs from and to home end and start: above the first and last
+    # stroke, or with no lifts (a sky board) on them.
+    if lifts:
+        first, last = lifts[0][0] - 1, lifts[-1][1]
+    else:
+        pen = contact_runs(roles >= 0)
+        first, last = pen[0][0], pen[-1][1] - 1
+    from_home = first > 0  # else the route starts right above the first stroke
     if from_home:
         # The legs from and to home are long and straight, timed at the speed
         # limit: the smoothed spline would brush past it there and make every
         # solve a conic one. A margin keeps them off it.
-        steps[: lifts[0][0] - 1] /= HOME_LEG_SPEED
-        steps[lifts[-1][1] :] /= HOME_LEG_SPEED
+        steps[:first] /= HOME_LEG_SPEED
+        steps[last:] /= HOME_LEG_SPEED
     jmax = opts.limits.jmax or opts.limits.jmax_axis
     if not opts.follows_tip(board) or jmax is None:
         return np.concatenate([[0.0], np.cumsum(steps)])
@@ -583,14 +636,19 @@ def check_reach(board: Board, opts: WritingOptions) -> None:
     :data:`MAX_ALTITUDE_M`.
     """
     length = opts.brush.length_m
-    if length < FRAME_CLEARANCE_M:
+    if board.has_contact and length < FRAME_CLEARANCE_M:
         raise InputError(
             f"brush length_m: got {length:g} m, expected at least {FRAME_CLEARANCE_M:g} m "
             "(a shorter brush cannot reach the board past the vehicle's frame)"
         )
     bottom = float(board.origin[2])
-    # The highest the vehicle goes: a lift above a horizontal board, a wall's top.
-    top = bottom + (length + board.lift_m if board.kind == "horizontal" else opts.size_m)
+    # The highest the vehicle goes: a lift above a horizontal board, a wall's
+    # top, a sky board's top corner (plus a lift that rises with its normal).
+    if board.kind == "horizontal":
+        top = bottom + length + board.lift_m
+    else:
+        rise = np.maximum(board.axes[:, 2], 0.0)  # how much e_u, e_v and n climb
+        top = bottom + opts.size_m * float(rise[0] + rise[1]) + board.lift_m * float(rise[2])
     if bottom <= 0.0 or top > MAX_ALTITUDE_M:
         raise InputError(
             f"board: got the writing from {bottom:g} m up, the vehicle up to {top:g} m, "
@@ -650,7 +708,7 @@ def plan_writing(
     check_reach(board, opts)
     home_pos = None if home is None else as_array("home", home, shape=(3,))
     if home_pos is not None:
-        home_pos = home_pos - opts.brush.length_m * board.normal  # the tip's home
+        home_pos = home_pos - tip_offset(board, opts)  # the tip's home
     scaled = strokes.scaled(opts.size_m)
     strokes_world = tuple(board.to_world(path) for path in scaled.paths)
     _check_route_size(strokes_world, board, home_pos)
@@ -825,7 +883,7 @@ def resegmented(
     gain = opts.tip_gain(board)
 
     def make(ts: FloatArray) -> SmoothingProblem:
-        return _problem(samples, plan.targets, ts, opts, gain=gain, n_ctrl=n_ctrl)
+        return _problem(samples, plan.targets, ts, opts, gain=gain, n_ctrl=n_ctrl, board=board)
 
     penalty = 0.0
     if opts.resegment == "free":
@@ -864,7 +922,8 @@ def _plan_at(
     """Solve at ``times``; with the swung tip fitted, polish the targets against the swing."""
     gain = opts.tip_gain(board)
     if gain is None:
-        fit = solve(_problem(samples, samples.points, times, opts), workspace=samples.workspace)
+        problem = _problem(samples, samples.points, times, opts, board=board)
+        fit = solve(problem, workspace=samples.workspace)
         return _measured(samples, fit, times, samples.points, board=board, opts=opts, scale=scale)
     pressed = samples.points - _press(samples, board, opts)
     targets = pressed
@@ -958,12 +1017,14 @@ def _problem(
     *,
     gain: FloatArray | None = None,
     n_ctrl: int | None = None,
+    board: Board | None = None,
 ) -> SmoothingProblem:
     """The smoothing problem of ``samples`` fitted to ``targets`` (N, 3) at ``times`` (N,).
 
     ``gain``: the deviation is of ``p + gain * a`` (the swung tip's first-order
     model) instead of ``p``; ``n_ctrl``: the control points (re-segmentation
-    keeps them), else from ``opts.knot_interval`` up to ``samples.max_spans``.
+    keeps them), else from ``opts.knot_interval`` up to ``samples.max_spans``;
+    ``board``: a sky board adds its plane's deviation cost (:func:`_plane_terms`).
     """
     duration = float(times[-1])
     spans = n_ctrl - opts.degree if n_ctrl else max(1, math.ceil(duration / opts.knot_interval))
@@ -997,10 +1058,25 @@ def _problem(
         n_ctrl=spans + opts.degree,
         duration=duration,
         smoothness={3: 1.0},
-        deviations=deviations,
+        deviations=deviations + _plane_terms(samples.roles, times, board, opts),
         boundary=Boundary.rest(targets[0], targets[-1], 3),
         limits=opts.derivative_limits(),
     )
+
+
+def _plane_terms(
+    roles: FloatArray, times: FloatArray, board: Board | None, opts: WritingOptions
+) -> tuple[PlaneDeviation, ...]:
+    """Paper 003 §5.3 on a sky board: the plane's deviation from the first stroke's
+    start to the last one's end, transits included (they stay in the plane, lift 0).
+    Off the board (take-off, landing) the flight leaves the plane on purpose."""
+    if board is None or board.has_contact or opts.plane_weight == 0:
+        return ()
+    pen = np.flatnonzero(roles >= 0)
+    if pen.size == 0 or times[pen[-1]] <= times[pen[0]]:
+        return ()
+    t0, t1 = float(times[pen[0]]), float(times[pen[-1]])
+    return (PlaneDeviation(board.normal, board.origin, t0, t1, opts.plane_weight),)
 
 
 def _pen_windows(roles: FloatArray, times: FloatArray, n: int) -> tuple[tuple[float, float], ...]:

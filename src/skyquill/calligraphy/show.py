@@ -1,7 +1,10 @@
-"""Several drones writing at once (paper 000 §6, Fig. 10-11): boards side by side.
+"""Several drones writing at once (paper 000 §6, Fig. 10-11): boards side by side or a sky grid.
 
-Each drone gets its own board and home, its mission is planned in a process
-of its own (planning is CPU-bound and independent), they all start together,
+Each drone gets its own board and home (side by side, or for sky boards a grid
+on one plane in the air: :func:`skyquill.calligraphy.artwork.sky_grid`; or the
+caller's places, e.g. one shared board: :mod:`skyquill.calligraphy.artwork`),
+its mission is planned in a process of its own (planning is CPU-bound and
+independent), they all start together,
 and the pairwise separation is checked over the whole flight, take-off and
 landing included: a violation is an error. Optionally each mission is then
 flown in closed-loop simulation over its board. This is the one show planner:
@@ -16,13 +19,14 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from types import ModuleType
-from typing import TYPE_CHECKING, Any, Literal
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from skyquill.calligraphy.board import Board
+from skyquill.calligraphy.artwork import sky_grid
+from skyquill.calligraphy.board import Board, BoardKind
 from skyquill.calligraphy.mission import (
     Mission,
     WritingOptions,
@@ -41,8 +45,16 @@ if TYPE_CHECKING:
 BOARD_MARGIN_M = 0.25
 
 #: Most drones in one show: the separation check compares every pair over the
-#: whole flight (n^2 / 2 distance sweeps) and paper 000's shows had a handful.
-MAX_DRONES = 64
+#: whole flight (n (n - 1) / 2 = 4950 pairs at 100, a few seconds of bounds),
+#: and 100 is the drone show of issue 18.
+MAX_DRONES = 100
+#: Most strokes over all drones of one show: the planning work (each stroke
+#: costs ~0.1-0.3 s of solving on one core, measured on Latin letters and
+#: hanzi), so about 5-15 minutes on two cores at the ceiling.
+MAX_SHOW_STROKES = 3_000
+#: Lift between strokes when none is given: a brush clears a contact board by
+#: 5 cm; on a sky board the light is off and the transits stay in the plane.
+DEFAULT_LIFT_M = {"horizontal": 0.05, "wall": 0.05, "sky": 0.0}
 
 #: How long to wait for a ``dask.distributed`` scheduler to answer, s.
 SCHEDULER_TIMEOUT_S = 5.0
@@ -86,22 +98,56 @@ def layout(
     separation_m: float,
     *,
     height_m: float = 1.0,
-    kind: Literal["horizontal", "wall"] = "horizontal",
-    lift_m: float = 0.05,
+    kind: BoardKind = "horizontal",
+    lift_m: float | None = None,
+    yaw_deg: float = 0.0,
+    tilt_deg: float = 0.0,
+    grid: tuple[int, int] | None = None,
 ) -> list[tuple[Board, FloatArray]]:
-    """Boards side by side along x, each with a home on the ground 1 m in front of it.
+    """Each drone's board and home (3,), m.
 
-    A horizontal board lies at ``height_m``; a wall is the plane ``y = 0`` with
-    the character's bottom at ``height_m``.
+    Horizontal boards and walls side by side along x, each with a home on the
+    ground 1 m in front of it: a horizontal board lies at ``height_m``; a wall
+    is the plane ``y = 0`` with the character's bottom at ``height_m``. Sky
+    boards in a grid on one plane of pose ``yaw_deg``, ``tilt_deg`` whose
+    bottom edge is at ``height_m`` (``grid``: rows and columns, else nearly
+    square; :func:`~skyquill.calligraphy.artwork.sky_grid`). ``lift_m``:
+    ``None`` for :data:`DEFAULT_LIFT_M`.
     """
     as_int("drones", n, low=1, high=MAX_DRONES)
+    lift = DEFAULT_LIFT_M.get(kind, 0.05) if lift_m is None else lift_m
+    if kind == "sky":
+        places = sky_grid(
+            n, size_m, separation_m, height_m=height_m, yaw_deg=yaw_deg, tilt_deg=tilt_deg,
+            grid=grid,
+        )  # fmt: skip
+        return [(replace(board, lift_m=lift), home) for board, home in places]
+    if grid is not None:
+        raise InputError(f"grid: got {grid!r} for {kind} boards, expected None (sky boards only)")
     pitch = as_float("size_m", size_m, positive=True) + separation_m + BOARD_MARGIN_M
     out = []
     for i in range(n):
         origin = np.array([i * pitch, 0.0, height_m])
         home = np.array([i * pitch + 0.5 * size_m, -1.0, 0.0])
-        out.append((Board(kind, origin, lift_m), home))
+        out.append((Board(kind, origin, lift, yaw_deg, tilt_deg), home))
     return out
+
+
+def check_show_size(parts: Sequence[Strokes]) -> None:
+    """Refuse a show above :data:`MAX_DRONES` drones or :data:`MAX_SHOW_STROKES` strokes.
+
+    Estimated before any planning: the strokes over all drones are the
+    planning work, the ``n (n - 1) / 2`` pairs the separation check's.
+    """
+    n = len(parts)
+    strokes = sum(p.n_strokes for p in parts)
+    pairs = n * (n - 1) // 2
+    if n > MAX_DRONES or strokes > MAX_SHOW_STROKES:
+        raise InputError(
+            f"drones: got {n} drones writing {strokes:,} strokes ({pairs:,} pairs to keep "
+            f"apart), expected at most {MAX_DRONES} drones and {MAX_SHOW_STROKES:,} strokes "
+            "in all (fewer drones or a shorter text)"
+        )
 
 
 def plan_show(
@@ -111,11 +157,15 @@ def plan_show(
     workers: int | None = None,
     *,
     scheduler: str | None = None,
-    board_kind: Literal["horizontal", "wall"] = "horizontal",
+    board_kind: BoardKind = "horizontal",
     board_height_m: float = 1.0,
-    lift_m: float = 0.05,
+    lift_m: float | None = None,
     fly: bool = False,
     progress: Progress | None = None,
+    board_yaw_deg: float = 0.0,
+    board_tilt_deg: float = 0.0,
+    grid: tuple[int, int] | None = None,
+    places: Sequence[tuple[Board, FloatArray]] | None = None,
 ) -> Show:
     """Plan one mission per part (one drone each) and check their separation.
 
@@ -139,11 +189,12 @@ def plan_show(
         ``pip install 'skyquill[dask]'`` here, and skyquill on a remote
         cluster's workers. The missions are the same as planned locally.
     board_kind
-        ``"horizontal"`` boards (paper 000) or ``"wall"``; see :func:`layout`.
+        ``"horizontal"`` boards (paper 000), ``"wall"`` or ``"sky"`` (light
+        painting, a grid on one plane); see :func:`layout`.
     board_height_m
-        Height of the boards (a wall's: of the writing's bottom), m.
+        Height of the boards (a wall's or a sky grid's: of the writing's bottom), m.
     lift_m
-        Brush lift between strokes, m.
+        Pen lift between strokes, m; ``None``: :data:`DEFAULT_LIFT_M`.
     fly
         Also fly every mission in closed-loop simulation, in this process, after
         the separation check (:attr:`Show.flights`).
@@ -151,6 +202,13 @@ def plan_show(
         See :data:`Progress`; with a process pool or a cluster it is called as
         the drones arrive, in any order. ``total`` is the number of drones,
         twice that with ``fly``.
+    board_yaw_deg, board_tilt_deg, grid
+        Sky boards: the plane's pose, degrees, and the grid's rows and columns
+        (``None``: nearly square); see :func:`layout`.
+    places
+        Each drone's board and home, instead of :func:`layout`'s (e.g. drones
+        sharing one board: :func:`~skyquill.calligraphy.artwork.split_strokes`);
+        the board arguments above are then unused.
 
     Returns
     -------
@@ -160,17 +218,23 @@ def plan_show(
     Raises
     ------
     InputError
-        Separation not positive, dask not installed, or the scheduler not
-        reachable within :data:`SCHEDULER_TIMEOUT_S`.
+        Separation not positive, a show above the ceilings
+        (:func:`check_show_size`), ``places`` not one per part, dask not
+        installed, or the scheduler not reachable within :data:`SCHEDULER_TIMEOUT_S`.
     InfeasibleError
         A drone cannot be planned, or two drones come closer than ``separation_m``.
     """
     opts = options or WritingOptions()
     separation = as_float("separation_m", separation_m, positive=True)
     height = as_float("board_height_m", board_height_m)
-    places = layout(
-        len(parts), opts.size_m, separation, height_m=height, kind=board_kind, lift_m=lift_m
-    )
+    check_show_size(parts)
+    if places is None:
+        places = layout(
+            len(parts), opts.size_m, separation, height_m=height, kind=board_kind,
+            lift_m=lift_m, yaw_deg=board_yaw_deg, tilt_deg=board_tilt_deg, grid=grid,
+        )  # fmt: skip
+    elif len(places) != len(parts):
+        raise InputError(f"places: got {len(places)}, expected one per part ({len(parts)})")
     jobs = [(part, board, opts, home) for part, (board, home) in zip(parts, places, strict=True)]
     steps = _Steps(len(jobs) * (2 if fly else 1), progress)
     steps.start(f"planning {len(jobs)} drone(s)")

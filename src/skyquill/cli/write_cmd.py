@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import dataclasses
 import inspect
-from collections.abc import Sequence
+from collections.abc import Callable, Iterator, Sequence
+from contextlib import contextmanager
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any
 
@@ -38,6 +39,7 @@ from skyquill.io.trajectory_json import PlannedTrajectory
 from skyquill.limits import VehicleLimits
 
 if TYPE_CHECKING:
+    from skyquill.calligraphy.board import BoardKind
     from skyquill.calligraphy.ink import InkFidelity
     from skyquill.calligraphy.mission import WritingOptions
 
@@ -135,14 +137,57 @@ def write(
         bool,
         typer.Option(help="Write the plan even if the path is beyond the 1 % tolerance."),
     ] = False,
-    drones: Annotated[int, typer.Option(help="Drones writing at once, boards side by side.")] = 1,
+    drones: Annotated[
+        int,
+        typer.Option(
+            help="Drones writing at once: boards side by side (a grid in the sky with "
+            "--board sky), or one drawing shared with --split strokes."
+        ),
+    ] = 1,
     rate: Annotated[float, typer.Option(help="Sample rate of the CSVs, Hz.")] = 100.0,
     fly: Annotated[bool, typer.Option(help="Also fly each drone in simulation (RPT).")] = False,
-    board: Annotated[str, typer.Option(help="horizontal (the paper's) or wall.")] = "horizontal",
+    board: Annotated[
+        str,
+        typer.Option(
+            help="horizontal (the paper's), wall, or sky (light painting on a plane in the "
+            "air, no contact: the pen is the drone's light)."
+        ),
+    ] = "horizontal",
     board_height: Annotated[
-        float, typer.Option(help="Height of the board (a wall: of the writing's bottom), m.")
+        float,
+        typer.Option(help="Height of the board (a wall or sky board: of the writing's bottom), m."),
     ] = 1.0,
-    lift: Annotated[float, typer.Option(help="Brush lift between strokes, m.")] = 0.05,
+    board_yaw: Annotated[
+        float, typer.Option(help="Sky board: turn about the vertical, degrees (0: facing -y).")
+    ] = 0.0,
+    board_tilt: Annotated[
+        float, typer.Option(help="Sky board: lean back from vertical, degrees (-80 to 80).")
+    ] = 0.0,
+    plane_weight: Annotated[
+        float | None,
+        typer.Option(
+            help="Sky board: weight of the cost that keeps the path on the board's plane "
+            "(paper 003 §5.3); 0 disables it. Default 1e5."
+        ),
+    ] = None,
+    grid: Annotated[
+        str | None,
+        typer.Option(help="Sky boards of several drones: ROWSxCOLUMNS (default nearly square)."),
+    ] = None,
+    split: Annotated[
+        str | None,
+        typer.Option(
+            help="'strokes': share one drawing's strokes among --drones drones on one board, "
+            "each flight about as long."
+        ),
+    ] = None,
+    separation: Annotated[
+        float, typer.Option(help="Least distance between any two drones at any time, m.")
+    ] = 1.0,
+    lift: Annotated[
+        float | None,
+        typer.Option(help="Brush lift between strokes, m (default 0.05; sky boards: none)."),
+    ] = None,
     follow: Annotated[
         str,
         typer.Option(
@@ -163,40 +208,53 @@ def write(
 ) -> None:
     """Plan pen-up / pen-down writing flights; write CSVs, input_strokes.json, plot, summary."""
     from skyquill.calligraphy.show import plan_show
-    from skyquill.strokes import typed_parts
 
     with user_errors():
         check_out(out)
         rate = positive_rate(rate)
+        kind = _board_kind(board, fly)
+        pose = _sky_pose(kind, board_yaw, board_tilt, plane_weight, grid, lift)
         options = writing_options(
             size=size, vmax=vmax, amax=amax, jmax=jmax, vmax_axis=vmax_axis,
             amax_axis=amax_axis, jmax_axis=jmax_axis, norm_sides=norm_sides,
             best_effort=best_effort, brush_length=brush_length, press_depth=press_depth,
-            follow=follow, target=target,
+            follow=follow, target=target, plane_weight=plane_weight,
         )  # fmt: skip
         if drones < 1:
             raise InputError(f"--drones: got {drones}, expected at least 1")
-        if drones != 1:
-            if text is None or strokes is not None or svg is not None:
-                raise InputError("--drones: several drones need TEXT to share out, got a file")
-            # One scale for the whole line: each drone's part keeps its size in it.
-            parts = typed_parts(text, drones, font, hanzi)
-        else:
+        sharing = _Sharing(kind, board_height, pose, lift, separation, _split(split, drones))
+        if sharing.split or drones == 1:
             parts = load_parts(text, strokes, svg, hanzi, font, true_size=true_size, layers=layers)
+        else:
+            if text is None or strokes is not None or svg is not None:
+                raise InputError(
+                    "--drones: several drones need TEXT to share out, got a file "
+                    "(or --split strokes)"
+                )
+            parts = _text_parts(text, drones, font, hanzi, by_character=kind == "sky")
         if true_size:
             options = dataclasses.replace(options, size_m=true_size_m(parts))
-        with console.status(f"planning {len(parts)} writing flight(s)"):
+        places, extra = sharing.places(parts, drones, options)
+        if sharing.split:
+            parts = places.parts
+        with _progress_bar() as progress:
             show = plan_show(
                 parts,
                 options,
+                separation,
                 scheduler=scheduler,
-                board_kind=_board_kind(board, fly),
+                board_kind=kind,
                 board_height_m=board_height,
                 lift_m=lift,
                 fly=fly,
+                progress=progress,
+                board_yaw_deg=pose.yaw_deg,
+                board_tilt_deg=pose.tilt_deg,
+                grid=pose.grid,
+                places=places.places if sharing.split else None,
             )
         inputs = [p for p in (strokes, svg, hanzi) if p is not None]
-        summary = write_outputs(show, out, rate, force=force, inputs=inputs)
+        summary = write_outputs(show, out, rate, force=force, inputs=inputs, extra=extra(show))
     say_done(
         f"{out}: {summary['duration_s']:.1f} s of flight, planned in "
         f"{summary['planning_time_s']:.2f} s, deviation {1e3 * summary['deviation']['max_m']:.2f}"
@@ -222,17 +280,192 @@ def _follow(name: str) -> Any:
 
 
 def _board_kind(name: str, fly: bool) -> Any:
-    if name not in ("horizontal", "wall"):
-        raise InputError(f"--board: got {name!r}, expected horizontal or wall")
-    if fly and name == "wall":
-        raise InputError("--fly: got --board wall, expected horizontal (the simulated board)")
+    if name not in ("horizontal", "wall", "sky"):
+        raise InputError(f"--board: got {name!r}, expected horizontal, wall or sky")
+    if fly and name != "horizontal":
+        raise InputError(
+            f"--fly: got --board {name}, expected horizontal (the simulated contact board)"
+        )
     return name
 
 
+@dataclasses.dataclass(frozen=True)
+class _Pose:
+    """A sky board's pose and grid from the command line (zeros and ``None`` otherwise)."""
+
+    yaw_deg: float = 0.0
+    tilt_deg: float = 0.0
+    grid: tuple[int, int] | None = None
+
+
+def _sky_pose(
+    kind: str,
+    yaw: float,
+    tilt: float,
+    plane_weight: float | None,
+    grid: str | None,
+    lift: float | None,
+) -> _Pose:
+    """``--board-yaw``, ``--board-tilt``, ``--plane-weight``, ``--grid`` against ``--board``."""
+    from skyquill.calligraphy.board import MAX_TILT_DEG
+
+    given = {
+        "--board-yaw": yaw != 0.0,
+        "--board-tilt": tilt != 0.0,
+        "--plane-weight": plane_weight is not None,
+        "--grid": grid is not None,
+    }
+    if kind != "sky":
+        for flag, used in given.items():
+            if used:
+                raise InputError(f"{flag}: got it with --board {kind}, expected --board sky")
+        return _Pose()
+    if lift is not None:
+        raise InputError(
+            f"--lift: got {lift:g} m with --board sky, expected none (the light is off between "
+            "strokes and the transits stay in the board's plane)"
+        )
+    if not (np.isfinite(yaw) and -180.0 <= yaw <= 180.0):
+        raise InputError(f"--board-yaw: got {yaw:g}, expected -180 to 180 degrees")
+    if not (np.isfinite(tilt) and abs(tilt) <= MAX_TILT_DEG):
+        raise InputError(
+            f"--board-tilt: got {tilt:g}, expected -{MAX_TILT_DEG:g} to {MAX_TILT_DEG:g} degrees "
+            "from vertical"
+        )
+    if plane_weight is not None and not (np.isfinite(plane_weight) and plane_weight >= 0):
+        raise InputError(f"--plane-weight: got {plane_weight:g}, expected >= 0 (0: off)")
+    return _Pose(yaw, tilt, None if grid is None else _grid(grid))
+
+
+def _grid(text: str) -> tuple[int, int]:
+    """``"4x5"`` to ``(4, 5)``."""
+    rows, sep, columns = text.lower().partition("x")
+    if not (sep and rows.strip().isdigit() and columns.strip().isdigit()):
+        raise InputError(f"--grid: got {text!r}, expected ROWSxCOLUMNS, e.g. 4x5")
+    shape = int(rows), int(columns)
+    if min(shape) < 1:
+        raise InputError(f"--grid: got {text!r}, expected at least one row and one column")
+    return shape
+
+
+def _split(name: str | None, drones: int) -> bool:
+    """Whether ``--split strokes`` was asked for (checked)."""
+    if name is None:
+        return False
+    if name != "strokes":
+        raise InputError(f"--split: got {name!r}, expected strokes")
+    if drones < 2:
+        raise InputError(f"--split: got --drones {drones}, expected at least 2 drones to share")
+    return True
+
+
+def _text_parts(
+    text: str, drones: int, font: str, hanzi: Path | None, *, by_character: bool
+) -> list[Any]:
+    """``text`` shared among ``drones`` with one scale: by words (hanzi: characters),
+    or on a sky grid, when there are fewer words than drones, a character each."""
+    from skyquill.strokes import typed_parts
+
+    if by_character and len(text.split()) < drones:
+        # typed_parts shares Latin text by words: one word per character.
+        text = " ".join(c for c in text if not c.isspace())
+    return typed_parts(text, drones, font, hanzi)
+
+
+@dataclasses.dataclass(frozen=True)
+class _Places:
+    """Drones sharing one board (``--split strokes``): their parts and places."""
+
+    parts: list[Any]
+    places: list[tuple[Any, Any]]
+
+
+@dataclasses.dataclass(frozen=True)
+class _Sharing:
+    """How several drones share the work: own boards (plan_show's layout) or a split."""
+
+    kind: BoardKind
+    height_m: float
+    pose: _Pose
+    lift_m: float | None
+    separation_m: float
+    split: bool
+
+    def places(
+        self, parts: list[Any], drones: int, options: WritingOptions
+    ) -> tuple[_Places, Callable[[Any], dict[str, Any]]]:
+        """With a split: each drone's strokes, board and home, and the summary's
+        ``split`` section (the flight-time balance) once planned; else nothing."""
+        if not self.split:
+            return _Places(parts, []), lambda show: self._grid(len(parts))
+        from skyquill.calligraphy.artwork import split_homes, split_strokes
+        from skyquill.calligraphy.board import Board
+        from skyquill.calligraphy.show import DEFAULT_LIFT_M
+
+        if len(parts) != 1:
+            raise InputError("--split: got SVG layers (--layers keep), expected one drawing")
+        lift = DEFAULT_LIFT_M[self.kind] if self.lift_m is None else self.lift_m
+        origin = np.array([0.0, 0.0, self.height_m])
+        board = Board(self.kind, origin, lift, self.pose.yaw_deg, self.pose.tilt_deg)
+        shared = split_strokes(parts[0], drones, board, options)
+        homes = split_homes(shared, board, options.size_m, self.separation_m)
+
+        def balance(show: Any) -> dict[str, Any]:
+            times = [m.trajectory.duration for m in show.missions]
+            return {
+                "split": {
+                    "by": "strokes",
+                    "strokes_per_drone": [list(s) for s in shared.strokes],
+                    "estimated_writing_s": list(shared.estimated_s),
+                    "flight_time_s": times,
+                    "max_over_min_flight_time": max(times) / min(times),
+                }
+            }
+
+        return _Places(list(shared.parts), [(board, h) for h in homes]), balance
+
+    def _grid(self, n: int) -> dict[str, Any]:
+        """The summary's ``grid`` section for several sky boards, else nothing."""
+        if self.kind != "sky" or n < 2:
+            return {}
+        from skyquill.calligraphy.artwork import grid_shape
+
+        rows, columns = grid_shape(n, self.pose.grid)
+        return {"grid": {"rows": rows, "columns": columns}}
+
+
+@contextmanager
+def _progress_bar() -> Iterator[Callable[[int, int, str], None]]:
+    """A rich bar of the drones planned (and flown), fed by ``plan_show``'s ``progress``."""
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn
+
+    with Progress(
+        TextColumn("{task.description}"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        console=console,
+        transient=True,
+    ) as bar:
+        task = bar.add_task("planning", total=None)
+
+        def report(done: int, total: int, stage: str) -> None:
+            bar.update(task, completed=done, total=total, description=stage)
+
+        yield report
+
+
 def write_outputs(
-    show: Any, out: Path, rate: float, *, force: bool = False, inputs: Sequence[Path] = ()
+    show: Any,
+    out: Path,
+    rate: float,
+    *,
+    force: bool = False,
+    inputs: Sequence[Path] = (),
+    extra: dict[str, Any] | None = None,
 ) -> dict[str, Any]:
     """The plan directory: trajectories, ``input_strokes.json``, ``plot.png``, ``summary.json``.
+
+    ``extra``: more top-level sections of ``summary.json`` (``--split``'s balance).
 
     Flown over a horizontal board (``show.flights``), also each drone's
     simulated ink beside its input: ``ink.png`` (``ink_<i>.png`` for several
@@ -278,7 +511,8 @@ def write_outputs(
                 "vehicle_limits": missions[0].options.limits.as_dict(),
                 "min_separation_m": closest,
                 "drones": per_drone,
-            },
+            }
+            | (extra or {}),
             plot=lambda path: plot_missions(missions, path, "skyquill write"),
         )
 
@@ -397,12 +631,13 @@ def writing_options(
     press_depth: float,
     follow: str,
     target: str | None,
+    plane_weight: float | None = None,
 ) -> WritingOptions:
     """The ``WritingOptions`` :func:`write` plans with, from its own arguments."""
     from skyquill.calligraphy.brush import Brush
     from skyquill.calligraphy.mission import WritingOptions
 
-    return WritingOptions(
+    options = WritingOptions(
         size_m=size,
         limits=VehicleLimits(vmax, amax, jmax, vmax_axis, amax_axis, jmax_axis),
         norm_sides=norm_sides,
@@ -411,6 +646,9 @@ def writing_options(
         follow=_follow(follow),
         target=upload_target(target),
     )
+    if plane_weight is None:
+        return options
+    return dataclasses.replace(options, plane_weight=plane_weight)
 
 
 def default_writing_options() -> WritingOptions:
