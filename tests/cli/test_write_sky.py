@@ -10,7 +10,9 @@ import pytest
 from typer.testing import CliRunner
 
 from skyquill.calligraphy.board import sky_board
-from skyquill.cli.main import app
+from skyquill.cli.main import app, parse_color
+from skyquill.io.skybrush_lights import light_slices, program_bytes
+from skyquill.io.skyc import read_show_json
 
 runner = CliRunner()
 
@@ -35,17 +37,40 @@ def test_write_on_a_turned_sky_board(tmp_path: Path) -> None:
     np.testing.assert_allclose(on_plane[:, 2], 0.0, atol=1e-12)  # no brush offset
 
 
-@pytest.mark.timeout(120)
-def test_twenty_drones_write_twenty_characters_in_a_grid(tmp_path: Path) -> None:
-    text = "ABCDEFGHIJKLMNOPQRST"
-    result = runner.invoke(
-        app, ["write", text, "--drones", "20", "--board", "sky", "--out", str(tmp_path)]
-    )
+PALETTE = ["#ff3000", "0,160,255", "90,255,90", "#ffffff"]
+
+
+@pytest.mark.timeout(300)
+def test_twenty_drones_write_twenty_characters_exported_with_lights_and_checked(
+    tmp_path: Path,
+) -> None:
+    """Issue 18's must-show: 20 characters by 20 drones in the air, each lit in its colour,
+    exported to .skyc, loaded back and proven apart by ``skyquill check`` (not the planner)."""
+    text, plan = "ABCDEFGHIJKLMNOPQRST", tmp_path / "plan"
+    colors = [a for c in PALETTE for a in ("--light-color", c)]
+    args = ["write", text, "--drones", "20", "--board", "sky", *colors, "--out", str(plan)]
+    result = runner.invoke(app, args)
     assert result.exit_code == 0, result.output
-    summary = json.loads((tmp_path / "summary.json").read_text())
+    summary = json.loads((plan / "summary.json").read_text())
     assert len(summary["drones"]) == 20 and summary["grid"] == {"rows": 4, "columns": 5}
     assert summary["min_separation_m"] >= 1.0 and summary["max_excess"] <= 1e-9
-    assert len(list(tmp_path.glob("trajectory_*.csv"))) == 20
+    assert len(list(plan.glob("trajectory_*.csv"))) == 20
+    assert (plan / "long_exposure.png").is_file() and (plan / "preview.gif").is_file()
+    skyc = tmp_path / "show.skyc"
+    result = runner.invoke(app, ["export", str(plan), "--format", "skyc", "--out", str(skyc)])
+    assert result.exit_code == 0, result.output
+    show = read_show_json(skyc)
+    expected = [parse_color("c", PALETTE[i % 4]) for i in range(20)]
+    for i, drone in enumerate(show["swarm"]["drones"]):
+        data = program_bytes("l", drone["settings"]["lights"])
+        shown = {tuple(int(c) for c in s.start_rgb) for s in light_slices("l", data, 1e6)}
+        assert shown == {(0, 0, 0), expected[i]}
+    check = tmp_path / "check"
+    args = ["check", str(skyc), "--min-distance", "1", "--out", str(check)]
+    result = runner.invoke(app, args)
+    assert result.exit_code == 0, result.output
+    verdict = json.loads((check / "summary.json").read_text())
+    assert verdict["separation"]["guaranteed_lower_bound_m"] >= 1.0
 
 
 def test_split_strokes_balances_the_flights(tmp_path: Path) -> None:
@@ -95,3 +120,27 @@ def test_bad_input(tmp_path: Path, args: list[str], message: str) -> None:
     result = runner.invoke(app, ["write", *args, "--out", str(tmp_path / "o")])
     assert result.exit_code == 2, result.output
     assert message in " ".join(result.output.split())
+
+
+def test_a_colour_per_stroke_is_kept_in_the_plan(tmp_path: Path) -> None:
+    args = ["write", "Hi", "--board", "sky", "--color-by", "stroke", "--out", str(tmp_path)]
+    colors = ["--light-color", "#ff0000", "--light-color", "0,0,255"]
+    result = runner.invoke(app, [*args, *colors])
+    assert result.exit_code == 0, result.output
+    planned = json.loads((tmp_path / "trajectory.json").read_text())
+    n = len(planned["pen_windows_s"])
+    assert planned["pen_rgb"] == [[255, 0, 0] if k % 2 == 0 else [0, 0, 255] for k in range(n)]
+    assert json.loads((tmp_path / "summary.json").read_text())["pictures"]["lit_windows"] == n
+
+
+@pytest.mark.parametrize(
+    ("extra", "message"),
+    [
+        (["--light-color", "blue"], "--light-color: got 'blue', expected R,G,B"),
+        (["--color-by", "word"], "--color-by: got 'word', expected one of drone, stroke"),
+    ],
+)
+def test_bad_light_colours_exit_2(tmp_path: Path, extra: list[str], message: str) -> None:
+    result = runner.invoke(app, ["write", "Hi", "--board", "sky", "--out", str(tmp_path), *extra])
+    assert result.exit_code == 2 and message in result.output
+    assert not (tmp_path / "summary.json").exists()

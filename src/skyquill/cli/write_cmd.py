@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import inspect
+import math
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
@@ -26,6 +27,7 @@ from skyquill.cli.main import (
     app,
     check_out,
     console,
+    parse_color,
     positive_rate,
     say_done,
     upload_target,
@@ -35,8 +37,10 @@ from skyquill.errors import InputError
 from skyquill.io.atomic import atomic_path, write_json
 from skyquill.io.outputs import staged_output
 from skyquill.io.plan_dir import trajectory_names, write_plan
+from skyquill.io.skybrush_lights import RGB
 from skyquill.io.trajectory_json import PlannedTrajectory
 from skyquill.limits import VehicleLimits
+from skyquill.show.lights import COLOR_BY, window_palette
 
 if TYPE_CHECKING:
     from skyquill.calligraphy.board import BoardKind
@@ -203,15 +207,31 @@ def write(
         str | None,
         typer.Option(help="dask.distributed scheduler address (or 'local') for large shows."),
     ] = None,
+    light_color: Annotated[
+        list[str] | None,
+        typer.Option(
+            metavar="R,G,B|#RRGGBB",
+            help="Light colour while the pen is down (kept in trajectory.json for the Skybrush "
+            "exports); repeat for a palette, given out per --color-by.",
+        ),
+    ] = None,
+    color_by: Annotated[
+        str, typer.Option(help="drone (each drone the next colour) or stroke (each stroke).")
+    ] = "drone",
     target: Target = None,
     force: Force = False,
 ) -> None:
-    """Plan pen-up / pen-down writing flights; write CSVs, input_strokes.json, plot, summary."""
+    """Plan pen-up / pen-down writing flights; write CSVs, input_strokes.json, plot, summary.
+
+    On a sky board (light painting) also long_exposure.png, the photograph of the lights
+    from in front, and preview.gif (``skyquill render`` shows them from any view).
+    """
     from skyquill.calligraphy.show import plan_show
 
     with user_errors():
         check_out(out)
         rate = positive_rate(rate)
+        palette = _palette(light_color, color_by)
         kind = _board_kind(board, fly)
         pose = _sky_pose(kind, board_yaw, board_tilt, plane_weight, grid, lift)
         options = writing_options(
@@ -254,7 +274,9 @@ def write(
                 places=places.places if sharing.split else None,
             )
         inputs = [p for p in (strokes, svg, hanzi) if p is not None]
-        summary = write_outputs(show, out, rate, force=force, inputs=inputs, extra=extra(show))
+        summary = write_outputs(
+            show, out, rate, force=force, inputs=inputs, extra=extra(show), palette=palette
+        )
     say_done(
         f"{out}: {summary['duration_s']:.1f} s of flight, planned in "
         f"{summary['planning_time_s']:.2f} s, deviation {1e3 * summary['deviation']['max_m']:.2f}"
@@ -462,10 +484,15 @@ def write_outputs(
     force: bool = False,
     inputs: Sequence[Path] = (),
     extra: dict[str, Any] | None = None,
+    palette: tuple[Sequence[RGB], str] | None = None,
 ) -> dict[str, Any]:
     """The plan directory: trajectories, ``input_strokes.json``, ``plot.png``, ``summary.json``.
 
     ``extra``: more top-level sections of ``summary.json`` (``--split``'s balance).
+    ``palette``: the light colours and how they are given out (``"drone"`` or
+    ``"stroke"``, :func:`~skyquill.show.lights.window_palette`), kept per pen window in
+    each ``trajectory.json``. On sky boards also ``long_exposure.png`` and
+    ``preview.gif`` (:func:`~skyquill.viz.light_painting.write_pictures`).
 
     Flown over a horizontal board (``show.flights``), also each drone's
     simulated ink beside its input: ``ink.png`` (``ink_<i>.png`` for several
@@ -480,10 +507,11 @@ def write_outputs(
     planned = []
     strokes_json: list[Any] = []
     inks: dict[str, InkFidelity] = {}  # ink picture name: the fidelity it shows
-    for mission, (name, _) in zip(missions, names, strict=True):
+    colors = _window_colors(missions, palette)
+    for mission, (name, _), rgb in zip(missions, names, colors, strict=True):
         vehicle = mission.vehicle_trajectory()
         limits = mission.limits
-        planned.append(PlannedTrajectory(vehicle, tuple(mission.pen_windows), limits))
+        planned.append(PlannedTrajectory(vehicle, tuple(mission.pen_windows), limits, rgb))
         strokes_json.append([(s + mission.brush_offset).tolist() for s in mission.strokes_world])
         flight = show.flights[len(per_drone)] if show.flights else None
         fidelity = _ink_fidelity(mission, flight)
@@ -501,6 +529,7 @@ def write_outputs(
     with staged_output(out, "write", force=force, inputs=inputs) as stage:
         write_json(stage / "input_strokes.json", payload, indent=None)
         _write_ink_pictures(stage, inks)
+        pictures = _light_pictures(stage, missions, planned)
         return write_plan(
             stage,
             planned,
@@ -512,9 +541,40 @@ def write_outputs(
                 "min_separation_m": closest,
                 "drones": per_drone,
             }
+            | pictures
             | (extra or {}),
             plot=lambda path: plot_missions(missions, path, "skyquill write"),
         )
+
+
+def _palette(colors: list[str] | None, by: str) -> tuple[list[RGB], str] | None:
+    """``--light-color`` (repeated) and ``--color-by``, checked; ``None`` without colours."""
+    if by not in COLOR_BY:
+        raise InputError(f"--color-by: got {by!r}, expected one of {', '.join(COLOR_BY)}")
+    if not colors:
+        return None
+    return [parse_color("--light-color", c) for c in colors], by
+
+
+def _window_colors(
+    missions: Sequence[Any], palette: tuple[Sequence[RGB], str] | None
+) -> list[tuple[RGB, ...]]:
+    """Each mission's colour per pen window; empty tuples without a palette."""
+    if palette is None:
+        return [()] * len(missions)
+    return window_palette([len(m.pen_windows) for m in missions], *palette)
+
+
+def _light_pictures(
+    stage: Path, missions: Sequence[Any], planned: Sequence[PlannedTrajectory]
+) -> dict[str, Any]:
+    """Light painting (sky boards): the long exposure and the preview; else nothing."""
+    if missions[0].board.kind != "sky":
+        return {}
+    from skyquill.viz.light_painting import write_pictures
+
+    # The preview keeps every light on screen: it builds up the photograph.
+    return {"pictures": write_pictures(planned, stage, trail_s=math.inf)}
 
 
 def _ink_fidelity(mission: Any, flight: Any) -> InkFidelity | None:
