@@ -226,7 +226,7 @@ def write(
     On a sky board (light painting) also long_exposure.png, the photograph of the lights
     from in front, and preview.gif (``skyquill render`` shows them from any view).
     """
-    from skyquill.calligraphy.show import plan_show
+    from skyquill.calligraphy.show import MAX_DRONES, plan_show
 
     with user_errors():
         check_out(out)
@@ -240,8 +240,8 @@ def write(
             best_effort=best_effort, brush_length=brush_length, press_depth=press_depth,
             follow=follow, target=target, plane_weight=plane_weight,
         )  # fmt: skip
-        if drones < 1:
-            raise InputError(f"--drones: got {drones}, expected at least 1")
+        if not 1 <= drones <= MAX_DRONES:  # before the text is typed: that takes seconds
+            raise InputError(f"--drones: got {drones}, expected 1 to {MAX_DRONES}")
         sharing = _Sharing(kind, board_height, pose, lift, separation, _split(split, drones))
         if sharing.split or drones == 1:
             parts = load_parts(text, strokes, svg, hanzi, font, true_size=true_size, layers=layers)
