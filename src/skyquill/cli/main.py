@@ -168,6 +168,7 @@ from skyquill.cli import (  # noqa: E402
     hanzi_cmd,
     paint_cmd,
     reproduce_cmd,
+    show_cmd,
     studio_cmd,
     write_cmd,
 )
@@ -182,6 +183,7 @@ __all__ = [
     "hanzi_cmd",
     "paint_cmd",
     "reproduce_cmd",
+    "show_cmd",
     "studio_cmd",
     "write_cmd",
 ]

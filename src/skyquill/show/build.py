@@ -19,7 +19,7 @@ import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 from scipy.optimize import linear_sum_assignment
@@ -228,7 +228,7 @@ def build_show(
     return ShowPlan(drones, homes, tuple(records), times, line.closest)
 
 
-def _fly(
+def _fly(  # noqa: PLR0917 - one scene, the script, the timeline and where to plan
     scene: Scene,
     script: ShowScript,
     line: _Timeline,
@@ -237,7 +237,7 @@ def _fly(
     scheduler: str | None,
 ) -> tuple[str, dict[str, Any]]:
     if isinstance(scene, Takeoff):
-        _climb(line, homes, homes + [0.0, 0.0, scene.altitude_m], scene.stagger_s, script)
+        _climb(line, homes, homes + np.array([0.0, 0.0, scene.altitude_m]), scene.stagger_s, script)
         return "takeoff", {"altitude_m": scene.altitude_m}
     if isinstance(scene, FormationScene):
         formation = make_formation(scene, script)
@@ -250,7 +250,7 @@ def _fly(
         line.hold(scene.duration_s, scene.color)
         return "hold", {}
     assert isinstance(scene, Land)
-    air = homes + [0.0, 0.0, scene.altitude_m]
+    air = homes + np.array([0.0, 0.0, scene.altitude_m])
     pads = assign(line.positions, air)
     _transition(line, air[pads], script)
     _climb(line, air[pads], homes[pads], scene.stagger_s, script)
@@ -321,7 +321,11 @@ def _write(
     parts = typed_parts(scene.text, count, scene.font)
     options = WritingOptions(size_m=scene.size_m, limits=script.limits)
     boards = writing_boards(count, scene, script.safety_m)
-    jobs: list[Job] = [(part, board, options, None) for part, board in zip(parts, boards, strict=True)]
+    # home=None: each flight starts and ends hovering at its board (plan_writing takes
+    # it; calligraphy.show.Job's annotation says FloatArray).
+    jobs = [
+        cast(Job, (part, board, options, None)) for part, board in zip(parts, boards, strict=True)
+    ]
     missions = plan_jobs(jobs, workers, scheduler)
     flights = [m.vehicle_trajectory() for m in missions]
     starts = np.array([f.evaluate(np.zeros(1))[0] for f in flights])
@@ -382,4 +386,6 @@ def _merged(pieces: list[PiecewisePolynomial]) -> PiecewisePolynomial:
     order = max(p.coeffs.shape[1] for p in pieces)
     coeffs = [np.pad(p.coeffs, ((0, 0), (0, order - p.coeffs.shape[1]), (0, 0))) for p in pieces]
     durations = np.concatenate([np.diff(p.breaks) for p in pieces])
-    return PiecewisePolynomial(np.concatenate([[0.0], np.cumsum(durations)]), np.concatenate(coeffs))
+    return PiecewisePolynomial(
+        np.concatenate([[0.0], np.cumsum(durations)]), np.concatenate(coeffs)
+    )

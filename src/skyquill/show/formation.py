@@ -225,8 +225,7 @@ def home_grid(count: int, *, origin: FloatArray, spacing_m: float, safety_m: flo
     spacing = as_float("home_spacing", spacing_m, positive=True)
     if spacing < as_float("safety_distance", safety_m, positive=True):
         raise InputError(
-            f"home_spacing: got {spacing:g} m, expected at least the safety distance "
-            f"{safety_m:g} m"
+            f"home_spacing: got {spacing:g} m, expected at least the safety distance {safety_m:g} m"
         )
     corner = as_array("home_origin", origin, shape=(2,))
     cols = math.ceil(math.sqrt(n))

@@ -14,7 +14,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-
 from skyquill.errors import InputError
 from skyquill.io.skybrush_lights import check_rgb
 from skyquill.limits import VehicleLimits
@@ -246,9 +245,7 @@ def _scene(t: Any, where: str, base: Path) -> Scene:
         raise InputError(f"{where}: got {type(t).__name__}, expected a table")
     kind = t.get("type")
     if kind not in _SCENES:
-        raise InputError(
-            f"{where}.type: got {kind!r}, expected one of {', '.join(_SCENES)}"
-        )
+        raise InputError(f"{where}.type: got {kind!r}, expected one of {', '.join(_SCENES)}")
     return _SCENES[kind](t, where, base)
 
 
@@ -307,8 +304,7 @@ def _check_order(scenes: tuple[Scene, ...]) -> None:
     for i, s in enumerate(scenes[1:-1], start=1):
         if isinstance(s, Takeoff | Land):
             raise InputError(
-                f"scene[{i}].type: got {_name(s)!r}, expected takeoff only first and land "
-                "only last"
+                f"scene[{i}].type: got {_name(s)!r}, expected takeoff only first and land only last"
             )
 
 
@@ -341,4 +337,3 @@ def load_script(path: Path) -> ShowScript:
         return parse_script(text, file.parent)
     except InputError as exc:
         raise InputError(f"{file.name}: {exc}") from None
-

@@ -153,9 +153,7 @@ def _hold(p: FloatArray, duration: float) -> tuple[FloatArray, FloatArray]:
     return np.array([duration]), coeffs
 
 
-def _flight(
-    a: FloatArray, b: FloatArray, wave: Wave | None, total: float
-) -> PiecewisePolynomial:
+def _flight(a: FloatArray, b: FloatArray, wave: Wave | None, total: float) -> PiecewisePolynomial:
     parts = []
     if wave is None:
         parts.append(_hold(a, max(total, STILL_M)))
@@ -246,7 +244,9 @@ def _waves(ok: _Allowed, moving: NDArray[np.bool_]) -> tuple[IntArray | None, tu
     for _ in range(n + 1):
         assert wave is not None
         wi, wj = wave[i], wave[j]
-        fine = np.where(wi == wj, ok.together[i, j], np.where(wi < wj, ok.first[i, j], ok.first[j, i]))
+        fine = np.where(
+            wi == wj, ok.together[i, j], np.where(wi < wj, ok.first[i, j], ok.first[j, i])
+        )
         if fine.all():
             return np.where(moving, wave, -1), (-1, -1)
         bi, bj = i[~fine], j[~fine]
@@ -336,7 +336,7 @@ def _proven(planned: Transition, d: float, label: Sequence[str]) -> Transition:
     )
 
 
-def _unresolved(
+def _unresolved(  # noqa: PLR0917 - private: the pair, why, and what places them
     a: FloatArray,
     b: FloatArray,
     pair: tuple[int, int],
