@@ -73,8 +73,18 @@ def test_a_crossing_that_needs_a_delay_is_resolved() -> None:
     _verify(starts, goals, 2.0)
 
 
-def test_an_impossible_swap_names_the_pair_and_the_time() -> None:
+def test_a_swap_on_one_line_is_resolved_by_a_depth_layer() -> None:
+    # No delay helps (each waits where the other passes): one drone steps out of the plane.
     starts = np.array([[0.0, 0, 5], [10.0, 0, 5]])
+    moves = plan_transition(starts, starts[::-1].copy(), LIMITS, 2.0)
+    assert len(moves.legs) == 3
+    assert sorted(np.abs(moves.layers).tolist()) == [0, 1]
+    _verify(starts, starts[::-1].copy(), 2.0)
+
+
+def test_an_impossible_swap_names_the_pair_and_the_time() -> None:
+    # Swapping along the layers' own axis: stepping out runs into the other drone.
+    starts = np.array([[0.0, 0, 5], [0.0, 2.5, 5]])
     with pytest.raises(InfeasibleError, match=r"drone 0 and drone 1 come within 0\.000 m at t = "):
         plan_transition(starts, starts[::-1].copy(), LIMITS, 2.0)
 

@@ -39,6 +39,7 @@ from skyquill.show.formation import (
     shape_formation,
 )
 from skyquill.show.motion import motion_of
+from skyquill.show.moves import hold, staggered
 from skyquill.show.script import (
     RGB,
     FormationScene,
@@ -50,7 +51,7 @@ from skyquill.show.script import (
     WriteScene,
 )
 from skyquill.show.separation import guaranteed_separation
-from skyquill.show.transition import assign, plan_transition, staggered
+from skyquill.show.transition import assign, plan_transition
 from skyquill.trajectory import PiecewisePolynomial, Trajectory, concatenate
 from skyquill.validation import FloatArray
 
@@ -137,24 +138,23 @@ class _Timeline:
             self.positions[i] = end
         self.now += duration
 
-    def hold(self, duration: float, color: RGB | None, who: list[int] | None = None) -> None:
-        """Everyone holds ``duration``; ``who`` (default all) lit in ``color`` if given."""
+    def hold(self, duration: float, color: RGB | None) -> None:
+        """Everyone holds ``duration`` s, lit in ``color`` if one is given."""
         if duration <= MIN_HOLD_S:
             return
-        for i in who if who is not None else range(len(self.drones)):
-            if color is not None:
+        if color is not None:
+            for i in range(len(self.drones)):
                 self.light(i, self.now, self.now + duration, color)
         self.append([_hold(p, duration) for p in self.positions], duration)
 
     def light(self, i: int, start: float, end: float, color: RGB) -> None:
+        """Drone ``i``'s light on in ``color`` from ``start`` to ``end`` (show clock, s)."""
         self.drones[i].windows.append((start, end))
         self.drones[i].colors.append(color)
 
 
 def _hold(p: FloatArray, duration: float) -> PiecewisePolynomial:
-    coeffs = np.zeros((1, 4, 3))
-    coeffs[0, 0] = p
-    return PiecewisePolynomial(np.array([0.0, duration]), coeffs)
+    return PiecewisePolynomial(np.array([0.0, duration]), hold(p, duration)[1])
 
 
 def leg_limits(script: ShowScript) -> LegLimits:
@@ -219,7 +219,8 @@ def build_show(
         progress(0, total, "planning the show")
     for k, scene in enumerate(script.scenes):
         start, clock = line.now, time.perf_counter()
-        kind, detail = _fly(scene, script, line, homes, workers, scheduler)
+        where = _Where(workers, scheduler, _writing_progress(progress, k, total))
+        kind, detail = _fly(scene, script, line, homes, where)
         times[kind] = times.get(kind, 0.0) + time.perf_counter() - clock
         records.append({"type": kind, "start_s": start, "end_s": line.now} | detail)
         if progress is not None:
@@ -228,13 +229,29 @@ def build_show(
     return ShowPlan(drones, homes, tuple(records), times, line.closest)
 
 
-def _fly(  # noqa: PLR0917 - one scene, the script, the timeline and where to plan
-    scene: Scene,
-    script: ShowScript,
-    line: _Timeline,
-    homes: FloatArray,
-    workers: int | None,
-    scheduler: str | None,
+@dataclass(frozen=True)
+class _Where:
+    """Where writing flights are planned, and whom to tell (:func:`plan_jobs`)."""
+
+    workers: int | None
+    scheduler: str | None
+    progress: Progress | None
+
+
+def _writing_progress(progress: Progress | None, scene: int, total: int) -> Progress | None:
+    """Each writing flight planned, reported as part of scene ``scene``."""
+    if progress is None:
+        return None
+    outer = progress
+
+    def report(done: int, count: int, stage: str) -> None:
+        outer(scene, total, f"scene {scene + 1} of {total} (write): {stage}")
+
+    return report
+
+
+def _fly(
+    scene: Scene, script: ShowScript, line: _Timeline, homes: FloatArray, where: _Where
 ) -> tuple[str, dict[str, Any]]:
     if isinstance(scene, Takeoff):
         _climb(line, homes, homes + np.array([0.0, 0.0, scene.altitude_m]), scene.stagger_s, script)
@@ -245,7 +262,7 @@ def _fly(  # noqa: PLR0917 - one scene, the script, the timeline and where to pl
         line.hold(scene.hold_s, scene.color)
         return "formation", {"shape": formation.name, "spacing_m": formation.spacing_m}
     if isinstance(scene, WriteScene):
-        return "write", _write(scene, script, line, workers, scheduler)
+        return "write", _write(scene, script, line, where)
     if isinstance(scene, Hold):
         line.hold(scene.duration_s, scene.color)
         return "hold", {}
@@ -304,13 +321,7 @@ def _writers(text: str, scene: WriteScene) -> int:
     return len("".join(text.split())) if is_cjk(text) else len(text.split())
 
 
-def _write(
-    scene: WriteScene,
-    script: ShowScript,
-    line: _Timeline,
-    workers: int | None,
-    scheduler: str | None,
-) -> dict[str, Any]:
+def _write(scene: WriteScene, script: ShowScript, line: _Timeline, where: _Where) -> dict[str, Any]:
     from skyquill.strokes import typed_parts
 
     count = _writers(scene.text, scene)
@@ -326,7 +337,7 @@ def _write(
     jobs = [
         cast(Job, (part, board, options, None)) for part, board in zip(parts, boards, strict=True)
     ]
-    missions = plan_jobs(jobs, workers, scheduler)
+    missions = plan_jobs(jobs, where.workers, where.scheduler, where.progress)
     flights = [m.vehicle_trajectory() for m in missions]
     starts = np.array([f.evaluate(np.zeros(1))[0] for f in flights])
     # The drones nearest the boards write (rectangular assignment); the others stay.
