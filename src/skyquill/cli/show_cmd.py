@@ -10,7 +10,7 @@ import typer
 from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
 from skyquill.cli.main import Force, OutDir, app, check_out, console, say_done, user_errors
-from skyquill.errors import InfeasibleError
+from skyquill.errors import InfeasibleError, InputError
 from skyquill.io.atomic import write_json
 from skyquill.io.outputs import staged_output
 from skyquill.io.plan_dir import trajectory_names, write_plan
@@ -44,6 +44,8 @@ def show(
     """
     with user_errors():
         check_out(out)
+        if workers is not None and workers < 1:
+            raise InputError(f"--workers: got {workers}, expected at least 1")
         show_script = load_script(script)
         stages: dict[str, float] = {}
         plan = _plan(show_script, workers, scheduler)

@@ -19,15 +19,12 @@ import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any, cast
+from typing import Any
 
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 from scipy.spatial.distance import cdist
 
-from skyquill.calligraphy.board import Board
-from skyquill.calligraphy.mission import WritingOptions
-from skyquill.calligraphy.show import Job, plan_jobs
 from skyquill.errors import InfeasibleError, InputError
 from skyquill.io.trajectory_json import PlannedTrajectory
 from skyquill.optimize.legs import LegLimits
@@ -52,13 +49,10 @@ from skyquill.show.script import (
 )
 from skyquill.show.separation import guaranteed_separation
 from skyquill.show.transition import assign, plan_transition
+from skyquill.show.writing import plan_writing_scene
 from skyquill.trajectory import PiecewisePolynomial, Trajectory, concatenate
 from skyquill.validation import FloatArray
 
-#: Brush lift between strokes on the writing boards, m (the light is off then).
-LIFT_M = 0.05
-#: Extra room between writing boards beyond the safety distance, m.
-BOARD_MARGIN_M = 0.5
 #: Holds shorter than this are left out, s.
 MIN_HOLD_S = 1e-9
 
@@ -163,20 +157,6 @@ def leg_limits(script: ShowScript) -> LegLimits:
     if lim.vmax is None or lim.amax is None or lim.jmax is None:
         raise InputError("[limits]: got a missing limit, expected vmax, amax and jmax")
     return LegLimits(lim.vmax, lim.amax, lim.jmax)
-
-
-def writing_boards(count: int, scene: WriteScene, safety_m: float) -> list[Board]:
-    """The writing boards of a scene: vertical, facing -y, in rows of ``scene.columns``.
-
-    The one place where the writing surface is chosen (a sky board can replace
-    the wall here).
-    """
-    pitch = scene.size_m + safety_m + BOARD_MARGIN_M
-    return [
-        Board("wall", scene.origin + pitch * np.array([k % scene.columns, 0, k // scene.columns]),
-              LIFT_M)
-        for k in range(count)
-    ]  # fmt: skip
 
 
 def build_show(
@@ -313,47 +293,24 @@ def _transition(line: _Timeline, goals: FloatArray, script: ShowScript) -> None:
     line.append([moves.trajectory(i) for i in range(len(goals))], moves.duration)
 
 
-def _writers(text: str, scene: WriteScene) -> int:
-    from skyquill.strokes import is_cjk
-
-    if scene.drones is not None:
-        return scene.drones
-    return len("".join(text.split())) if is_cjk(text) else len(text.split())
-
-
 def _write(scene: WriteScene, script: ShowScript, line: _Timeline, where: _Where) -> dict[str, Any]:
-    from skyquill.strokes import typed_parts
-
-    count = _writers(scene.text, scene)
-    if count > script.drones:
-        raise InputError(
-            f"write.drones: got {count} writers, expected at most the show's {script.drones} drones"
-        )
-    parts = typed_parts(scene.text, count, scene.font)
-    options = WritingOptions(size_m=scene.size_m, limits=script.limits)
-    boards = writing_boards(count, scene, script.safety_m)
-    # home=None: each flight starts and ends hovering at its board (plan_writing takes
-    # it; calligraphy.show.Job's annotation says FloatArray).
-    jobs = [
-        cast(Job, (part, board, options, None)) for part, board in zip(parts, boards, strict=True)
-    ]
-    missions = plan_jobs(jobs, where.workers, where.scheduler, where.progress)
-    flights = [m.vehicle_trajectory() for m in missions]
-    starts = np.array([f.evaluate(np.zeros(1))[0] for f in flights])
+    writing = plan_writing_scene(
+        scene, script, workers=where.workers, scheduler=where.scheduler, progress=where.progress
+    )
     # The drones nearest the boards write (rectangular assignment); the others stay.
-    who, board = linear_sum_assignment(cdist(line.positions, starts, "sqeuclidean"))
+    who, board = linear_sum_assignment(cdist(line.positions, writing.starts, "sqeuclidean"))
     goals = line.positions.copy()
-    goals[who] = starts[board]
+    goals[who] = writing.starts[board]
     _transition(line, goals, script)
-    begin, duration = line.now, max(f.duration for f in flights)
-    writing: list[Trajectory] = [_hold(p, duration) for p in line.positions]
+    begin, duration = line.now, writing.duration_s
+    flights: list[Trajectory] = [_hold(p, duration) for p in line.positions]
     for i, k in zip(who, board, strict=True):
-        writing[i] = flights[k]
-        for a, b in missions[k].pen_windows:
+        flights[i] = writing.flights[k]
+        for a, b in writing.pen_windows[k]:
             line.light(int(i), begin + a, begin + b, scene.color)
-    line.closest = min(line.closest, _prove(writing, duration, script.safety_m))
-    line.append(writing, duration)
-    return {"text": scene.text, "writers": count, "duration_s": duration}
+    line.closest = min(line.closest, _prove(flights, duration, script.safety_m))
+    line.append(flights, duration)
+    return {"text": scene.text, "writers": len(writing.flights), "duration_s": duration}
 
 
 def _prove(flights: list[Trajectory], horizon: float, safety: float) -> float:
