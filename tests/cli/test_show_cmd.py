@@ -19,15 +19,27 @@ EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 runner = CliRunner()
 
 
-@pytest.fixture(scope="module")
-def small(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    out = tmp_path_factory.mktemp("show") / "out"
+@pytest.fixture
+def small(tmp_path: Path) -> Path:
+    out = tmp_path / "out"
     result = runner.invoke(app, ["show", str(EXAMPLES / "show_small.toml"), "--out", str(out)])
     assert result.exit_code == 0, result.output
     return out
 
 
-def test_the_small_example_writes_every_file(small: Path) -> None:
+def test_the_small_example_end_to_end(small: Path) -> None:
+    # One test for the one (16 s) run: files, summary, the independent check, the .skyc.
+    _files_and_summary(small)
+    _passes_the_independent_check(small)
+    _skyc_reads_back(small)
+    # skyquill check on the plan directory, with the script's limits: exit 0
+    limits = ["--max-speed-xy", "3", "--max-speed-up", "3", "--max-speed-down", "3"]
+    limits += ["--max-acceleration", "2", "--min-distance", "1.5"]
+    result = runner.invoke(app, ["check", str(small), *limits])
+    assert result.exit_code == 0, result.output
+
+
+def _files_and_summary(small: Path) -> None:
     for i in range(10):
         assert (small / f"trajectory_{i}.csv").is_file()
         assert (small / f"trajectory_{i}.json").is_file()
@@ -46,7 +58,7 @@ def test_the_small_example_writes_every_file(small: Path) -> None:
     assert len(lights["rgb"]) == len(lights["windows_s"]) > 0
 
 
-def test_the_written_show_passes_the_independent_check(small: Path) -> None:
+def _passes_the_independent_check(small: Path) -> None:
     script = load_script(EXAMPLES / "show_small.toml")
     drones = [ShowDrone(p.trajectory, n) for n, p in read_plan(small)]
     report = check_show(drones, script.safety_m, None)
@@ -59,7 +71,7 @@ def test_the_written_show_passes_the_independent_check(small: Path) -> None:
     assert gaps.min() >= 1.5
 
 
-def test_the_skyc_reads_back(small: Path) -> None:
+def _skyc_reads_back(small: Path) -> None:
     show = read_show_json(small / "show.skyc")
     assert len(show["swarm"]["drones"]) == 10
 
