@@ -89,10 +89,19 @@ def test_an_impossible_swap_names_the_pair_and_the_time() -> None:
         plan_transition(starts, starts[::-1].copy(), LIMITS, 2.0)
 
 
-def test_a_path_through_a_drone_that_stays_is_refused() -> None:
+def test_a_path_through_a_drone_that_stays_steps_around_it() -> None:
     starts = np.array([[0.0, 0, 5], [5.0, 0, 5]])
     goals = np.array([[10.0, 0, 5], [5.0, 0, 5]])
-    with pytest.raises(InfeasibleError, match=r"drone 0 and drone 1 .* drone 1 does not move"):
+    moves = plan_transition(starts, goals, LIMITS, 2.0)
+    assert len(moves.legs) == 3
+    _verify(starts, goals, 2.0)
+
+
+def test_a_drone_that_stays_in_the_way_of_a_layer_is_refused() -> None:
+    # 0 crosses the point where 1 stays; stepping out along y runs into 2, which stays too.
+    starts = np.array([[0.0, 0, 5], [5.0, 0, 5], [5.0, -2.5, 5], [5.0, 2.5, 5]])
+    goals = np.array([[10.0, 0, 5], [5.0, 0, 5], [5.0, -2.5, 5], [5.0, 2.5, 5]])
+    with pytest.raises(InfeasibleError, match=r"drone 0 and drone 1 come within 0\.000 m at t = "):
         plan_transition(starts, goals, LIMITS, 2.0)
 
 
@@ -103,6 +112,21 @@ def _spread(points: np.ndarray, spacing: float) -> np.ndarray:
         if all(np.linalg.norm(p - q) >= spacing for q in kept):
             kept.append(p)
     return np.array(kept)
+
+
+@settings(max_examples=15, deadline=None)
+@given(seed=st.integers(0, 2**31), n=st.integers(2, 12), shuffle=st.booleans())
+def test_random_planar_formations_always_transition_safely(
+    seed: int, n: int, shuffle: bool
+) -> None:
+    # Formations on the plane y = 0 (as the shows' are): delays or layers always work,
+    # even for a deliberately bad (random) assignment.
+    rng = np.random.default_rng(seed)
+    a = _spread(rng.uniform(0, 10, (80, 3)) * [1, 0, 1], 2.0)[:n]
+    b = _spread(rng.uniform(0, 10, (80, 3)) * [1, 0, 1] + [4, 0, 2], 2.0)[: len(a)]
+    a = a[: len(b)]
+    goals = b[rng.permutation(len(b))] if shuffle else b[assign(a, b)]
+    _verify(a, goals, 2.0)
 
 
 @settings(max_examples=15, deadline=None)

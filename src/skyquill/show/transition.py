@@ -15,8 +15,8 @@ would be the next row of drones; the layers are stacked along y instead):
 the drones whose straight paths conflict are coloured apart, each colour
 steps out of the plane to its own layer (layers the safety distance apart),
 crosses there, and steps back in; each of the three legs is itself planned
-in waves. When neither works (a path through a drone that does not move, two
-drones swapping places on one line), the transition is refused with an
+in waves. When neither works (two drones swapping places along the layers' axis,
+formations whose stepping out runs into another drone), the transition is refused with an
 :class:`~skyquill.errors.InfeasibleError` naming the pair and the time of
 their closest approach on straight synchronised paths.
 
@@ -167,15 +167,16 @@ def plan_transition(
     if not moving.any():
         return Transition(a, b, (), flat, np.inf)
     ok = allowed(a, b, moving, d * (1.0 + PLAN_MARGIN))
-    if ok.held.any():
+    if ok.held.any():  # no delay moves a drone that stays out of the way: layers may
         i, j = (int(k) for k in np.argwhere(ok.held)[0])
-        raise _unresolved(a, b, (i, j), f"{label[j]} does not move", limits, label)
-    waves, pair = order_waves(ok, moving)
+        waves, pair, why = None, (i, j), f"{label[i]}'s path passes {label[j]}, which stays"
+    else:
+        waves, pair = order_waves(ok, moving)
+        why = "neither delayed starts nor depth layers keep them apart"
     if waves is not None:
         return _proven(Transition(a, b, (scheduled(a, b, waves, limits),), flat, np.inf), d, label)
     layered = _layered(a, b, ok=ok, moving=moving, d=d, limits=limits)
     if layered is None:
-        why = "neither delayed starts nor depth layers keep them apart"
         raise _unresolved(a, b, pair, why, limits, label)
     return _proven(layered, d, label)
 
