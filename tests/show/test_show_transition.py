@@ -63,13 +63,25 @@ def test_grid_to_circle_is_proven_apart() -> None:
     _verify(grid, circle[assign(grid, circle)], 2.0)
 
 
-def test_a_crossing_that_needs_a_delay_is_resolved() -> None:
-    # Straight synchronised paths cross in the middle: one drone waits a wave.
+def test_a_crossing_is_resolved_by_the_faster_of_delays_and_layers() -> None:
+    # Straight synchronised paths cross in the middle.
     starts = np.array([[0.0, 0, 5], [0.0, 0, 15]])
     goals = np.array([[10.0, 0, 15], [10.0, 0, 5]])
     moves = plan_transition(starts, goals, LIMITS, 2.0)
-    assert sorted(moves.waves.tolist()) == [0, 1]
     assert moves.closest_m >= 2.0
+    waves = moves.legs[0].waves
+    assert len(moves.legs) == 3 or sorted(waves.tolist()) == [0, 1]
+    _verify(starts, goals, 2.0)
+
+
+def test_a_crossing_where_layers_are_blocked_is_resolved_by_a_delay() -> None:
+    # Drones that stay on both sides of the plane leave no room to step out: one waits.
+    still = np.array([[0.0, -2.5, 5], [0.0, -2.5, 15], [0.0, 2.5, 5], [0.0, 2.5, 15]])
+    starts = np.vstack([[[0.0, 0, 5], [0.0, 0, 15]], still])
+    goals = np.vstack([[[10.0, 0, 15], [10.0, 0, 5]], still])
+    moves = plan_transition(starts, goals, LIMITS, 2.0)
+    assert len(moves.legs) == 1
+    assert moves.waves.tolist() == [0, 1, -1, -1, -1, -1]
     _verify(starts, goals, 2.0)
 
 

@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 from scipy.optimize import linear_sum_assignment
 from scipy.spatial.distance import cdist
 
@@ -48,13 +49,17 @@ from skyquill.show.script import (
     WriteScene,
 )
 from skyquill.show.separation import guaranteed_separation
-from skyquill.show.transition import assign, plan_transition
+from skyquill.show.transition import Transition, assign, plan_transition
 from skyquill.show.writing import plan_writing_scene
 from skyquill.trajectory import PiecewisePolynomial, Trajectory, concatenate
 from skyquill.validation import FloatArray
 
 #: Holds shorter than this are left out, s.
 MIN_HOLD_S = 1e-9
+#: Spread of y within which points count as one vertical plane, m.
+PLANE_TOLERANCE_M = 1e-6
+
+IntArray = NDArray[np.intp]
 
 #: ``progress(done, total, stage)`` after each scene (``done = 0`` before the first).
 Progress = Callable[[int, int, str], None]
@@ -238,9 +243,13 @@ def _fly(
         return "takeoff", {"altitude_m": scene.altitude_m}
     if isinstance(scene, FormationScene):
         formation = make_formation(scene, script)
-        _transition(line, formation.points[assign(line.positions, formation.points)], script)
+        _, curtain = _reform(line, formation.points, script)
         line.hold(scene.hold_s, scene.color)
-        return "formation", {"shape": formation.name, "spacing_m": formation.spacing_m}
+        return "formation", {
+            "shape": formation.name,
+            "spacing_m": formation.spacing_m,
+            "via_curtain": curtain,
+        }
     if isinstance(scene, WriteScene):
         return "write", _write(scene, script, line, where)
     if isinstance(scene, Hold):
@@ -248,10 +257,9 @@ def _fly(
         return "hold", {}
     assert isinstance(scene, Land)
     air = homes + np.array([0.0, 0.0, scene.altitude_m])
-    pads = assign(line.positions, air)
-    _transition(line, air[pads], script)
+    pads, curtain = _reform(line, air, script)
     _climb(line, air[pads], homes[pads], scene.stagger_s, script)
-    return "land", {"altitude_m": scene.altitude_m}
+    return "land", {"altitude_m": scene.altitude_m, "via_curtain": curtain}
 
 
 def make_formation(scene: FormationScene, script: ShowScript) -> Formation:
@@ -284,13 +292,78 @@ def _climb(
     line.append(list(flights), duration)
 
 
-def _transition(line: _Timeline, goals: FloatArray, script: ShowScript) -> None:
+def _reform(line: _Timeline, targets: FloatArray, script: ShowScript) -> tuple[IntArray, bool]:
+    """Fly to ``targets`` (assigned) straight, or through a curtain when that is faster or safe.
+
+    The curtain is a vertical grid on the plane of the formation the drones
+    leave (or go to), above the pads' columns, spaced at least ``sqrt(2)``
+    times the safety distance: a formation reaches any other on its own plane
+    (delays or depth layers), and a grid at that spacing reaches the pads' air
+    grid in one wave (CAPT). Of the routes that can be kept apart the shorter
+    is flown. Returns each drone's target index, and whether the curtain was flown.
+    """
+    start = line.positions.copy()
+    routes: list[tuple[list[Transition], IntArray]] = []
+    error: InfeasibleError | None = None
+    try:
+        chosen = assign(start, targets)
+        routes.append(([_plan(start, targets[chosen], script)], chosen))
+    except InfeasibleError as exc:
+        error = exc
+    plane = _plane_y(start)
+    plane = _plane_y(targets) if plane is None else plane
+    if plane is not None:
+        bottom = float(min(start[:, 2].min(), targets[:, 2].min()))
+        stage = _curtain(script, plane, bottom)
+        try:
+            staged = stage[assign(start, stage)]
+            first = _plan(start, staged, script)
+            chosen = assign(staged, targets)
+            routes.append(([first, _plan(staged, targets[chosen], script)], chosen))
+        except InfeasibleError:
+            pass
+    if not routes:
+        assert error is not None
+        raise error
+    legs, chosen = min(routes, key=lambda r: sum(t.duration for t in r[0]))
+    for moves in legs:
+        _append(line, moves)
+    return chosen, len(legs) > 1
+
+
+def _plane_y(points: FloatArray) -> float | None:
+    """The y of the vertical plane facing -y that holds ``points``, if one does."""
+    return float(points[0, 1]) if np.ptp(points[:, 1]) <= PLANE_TOLERANCE_M else None
+
+
+def _curtain(script: ShowScript, plane_y: float, bottom_m: float) -> FloatArray:
+    """A vertical grid on ``y = plane_y`` above the pads' columns, from ``bottom_m`` up."""
+    spacing = max(script.home_spacing_m, math.sqrt(2.0) * script.safety_m)
+    origin = np.array([script.home_origin[0], plane_y, bottom_m])
+    columns = math.ceil(math.sqrt(script.drones))  # as many as the pads have (home_grid)
+    return grid_formation(
+        script.drones,
+        origin=origin,
+        columns=columns,
+        spacing_m=spacing,
+        safety_m=script.safety_m,
+    ).points
+
+
+def _plan(starts: FloatArray, goals: FloatArray, script: ShowScript) -> Transition:
     names = [f"drone {i}" for i in range(len(goals))]
-    moves = plan_transition(line.positions, goals, leg_limits(script), script.safety_m, names)
+    return plan_transition(starts, goals, leg_limits(script), script.safety_m, names)
+
+
+def _append(line: _Timeline, moves: Transition) -> None:
     if moves.duration <= 0.0:
         return
     line.closest = min(line.closest, moves.closest_m)
-    line.append([moves.trajectory(i) for i in range(len(goals))], moves.duration)
+    line.append([moves.trajectory(i) for i in range(len(moves.starts))], moves.duration)
+
+
+def _transition(line: _Timeline, goals: FloatArray, script: ShowScript) -> None:
+    _append(line, _plan(line.positions, goals, script))
 
 
 def _write(scene: WriteScene, script: ShowScript, line: _Timeline, where: _Where) -> dict[str, Any]:
@@ -299,6 +372,7 @@ def _write(scene: WriteScene, script: ShowScript, line: _Timeline, where: _Where
     )
     # The drones nearest the boards write (rectangular assignment); the others stay.
     who, board = linear_sum_assignment(cdist(line.positions, writing.starts, "sqeuclidean"))
+    places = line.positions.copy()
     goals = line.positions.copy()
     goals[who] = writing.starts[board]
     _transition(line, goals, script)
@@ -310,6 +384,9 @@ def _write(scene: WriteScene, script: ShowScript, line: _Timeline, where: _Where
             line.light(int(i), begin + a, begin + b, scene.color)
     line.closest = min(line.closest, _prove(flights, duration, script.safety_m))
     line.append(flights, duration)
+    # Back to their places: the formation is whole again, and the next transition
+    # starts from it (formations on one plane always transition: delays or layers).
+    _transition(line, places, script)
     return {"text": scene.text, "writers": len(writing.flights), "duration_s": duration}
 
 

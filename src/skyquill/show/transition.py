@@ -6,10 +6,11 @@ distance (:func:`assign`, scipy's ``linear_sum_assignment``).
 **Paths.** Straight rest-to-rest moves, the drones of a wave on one shared
 time-optimal profile within the limits (:mod:`skyquill.show.moves`).
 
-**Where straight paths come too close**, first **delayed starts**: drones go
+**Where straight paths come too close**, **delayed starts**: drones go
 in waves, one after another, ordered so that no path passes where another
 drone waits (:mod:`skyquill.show.waves`). Delays keep every drone in the
-formations' plane and cost only time. When no order works, **depth layers**
+formations' plane and cost only time. When no order works, or the layers
+below are faster than many waves flown one after another, **depth layers**
 (the formations stand on vertical planes facing -y, so "altitude" layers
 would be the next row of drones; the layers are stacked along y instead):
 the drones whose straight paths conflict are coloured apart, each colour
@@ -173,12 +174,17 @@ def plan_transition(
     else:
         waves, pair = order_waves(ok, moving)
         why = "neither delayed starts nor depth layers keep them apart"
+    delayed = None
     if waves is not None:
-        return _proven(Transition(a, b, (scheduled(a, b, waves, limits),), flat, np.inf), d, label)
+        delayed = Transition(a, b, (scheduled(a, b, waves, limits),), flat, np.inf)
+        if waves.max() == 0:
+            return _proven(delayed, d, label)
     layered = _layered(a, b, ok=ok, moving=moving, d=d, limits=limits)
-    if layered is None:
+    # Many waves flown one after another can take longer than stepping out and back.
+    options = [t for t in (delayed, layered) if t is not None]
+    if not options:
         raise _unresolved(a, b, pair, why, limits, label)
-    return _proven(layered, d, label)
+    return _proven(min(options, key=lambda t: t.duration), d, label)
 
 
 def _direct(a: FloatArray, b: FloatArray, d: float, limits: LegLimits) -> Moves | None:
