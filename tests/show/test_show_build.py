@@ -107,11 +107,11 @@ def test_limits_and_separation_hold_on_the_composed_flights(plan: ShowPlan) -> N
 def test_the_curtain_stands_on_the_plane_above_the_pads_columns() -> None:
     from scipy.spatial.distance import pdist
 
-    from skyquill.show.build import _curtain
     from skyquill.show.formation import home_grid
+    from skyquill.show.route import curtain
 
     script = parse_script(SCRIPT)
-    stage = _curtain(script, 4.0, 7.0)
+    stage = curtain(script, 4.0, 7.0)
     pads = home_grid(6, origin=script.home_origin, spacing_m=2.2, safety_m=1.5)
     assert np.all(stage[:, 1] == 4.0) and stage[:, 2].min() == pytest.approx(7.0)
     assert set(np.round(stage[:, 0], 6)) == set(np.round(pads[:, 0], 6))

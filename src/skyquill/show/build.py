@@ -2,8 +2,8 @@
 
 Scenes are flown one after another, all drones together: each scene starts
 when the slowest drone has finished the one before. Between scenes that
-place drones somewhere else, a transition (:mod:`skyquill.show.transition`)
-takes them there. Every drone's flight is one
+place drones somewhere else, a transition (:mod:`skyquill.show.transition`),
+or two through a curtain (:mod:`skyquill.show.route`), takes them there. Every drone's flight is one
 :class:`~skyquill.trajectory.RestToRestSequence` (straight moves and holds as
 cubic pieces, writing flights as splines), at rest where the pieces meet.
 
@@ -26,9 +26,8 @@ from numpy.typing import NDArray
 from scipy.optimize import linear_sum_assignment
 from scipy.spatial.distance import cdist
 
-from skyquill.errors import InfeasibleError, InputError
+from skyquill.errors import InfeasibleError
 from skyquill.io.trajectory_json import PlannedTrajectory
-from skyquill.optimize.legs import LegLimits
 from skyquill.show.formation import (
     Formation,
     circle_formation,
@@ -38,6 +37,7 @@ from skyquill.show.formation import (
 )
 from skyquill.show.motion import motion_of
 from skyquill.show.moves import hold, staggered
+from skyquill.show.route import leg_limits, plan_moves, route_to
 from skyquill.show.script import (
     RGB,
     FormationScene,
@@ -49,15 +49,13 @@ from skyquill.show.script import (
     WriteScene,
 )
 from skyquill.show.separation import guaranteed_separation
-from skyquill.show.transition import Transition, assign, plan_transition
+from skyquill.show.transition import Transition
 from skyquill.show.writing import plan_writing_scene
 from skyquill.trajectory import PiecewisePolynomial, Trajectory, concatenate
 from skyquill.validation import FloatArray
 
 #: Holds shorter than this are left out, s.
 MIN_HOLD_S = 1e-9
-#: Spread of y within which points count as one vertical plane, m.
-PLANE_TOLERANCE_M = 1e-6
 
 IntArray = NDArray[np.intp]
 
@@ -154,14 +152,6 @@ class _Timeline:
 
 def _hold(p: FloatArray, duration: float) -> PiecewisePolynomial:
     return PiecewisePolynomial(np.array([0.0, duration]), hold(p, duration)[1])
-
-
-def leg_limits(script: ShowScript) -> LegLimits:
-    """The moves' limits: the show's speed, acceleration and jerk norms."""
-    lim = script.limits
-    if lim.vmax is None or lim.amax is None or lim.jmax is None:
-        raise InputError("[limits]: got a missing limit, expected vmax, amax and jmax")
-    return LegLimits(lim.vmax, lim.amax, lim.jmax)
 
 
 def build_show(
@@ -293,66 +283,11 @@ def _climb(
 
 
 def _reform(line: _Timeline, targets: FloatArray, script: ShowScript) -> tuple[IntArray, bool]:
-    """Fly to ``targets`` (assigned) straight, or through a curtain when that is faster or safe.
-
-    The curtain is a vertical grid on the plane of the formation the drones
-    leave (or go to), above the pads' columns, spaced at least ``sqrt(2)``
-    times the safety distance: a formation reaches any other on its own plane
-    (delays or depth layers), and a grid at that spacing reaches the pads' air
-    grid in one wave (CAPT). Of the routes that can be kept apart the shorter
-    is flown. Returns each drone's target index, and whether the curtain was flown.
-    """
-    start = line.positions.copy()
-    routes: list[tuple[list[Transition], IntArray]] = []
-    error: InfeasibleError | None = None
-    try:
-        chosen = assign(start, targets)
-        routes.append(([_plan(start, targets[chosen], script)], chosen))
-    except InfeasibleError as exc:
-        error = exc
-    plane = _plane_y(start)
-    plane = _plane_y(targets) if plane is None else plane
-    if plane is not None:
-        bottom = float(min(start[:, 2].min(), targets[:, 2].min()))
-        stage = _curtain(script, plane, bottom)
-        try:
-            staged = stage[assign(start, stage)]
-            first = _plan(start, staged, script)
-            chosen = assign(staged, targets)
-            routes.append(([first, _plan(staged, targets[chosen], script)], chosen))
-        except InfeasibleError:
-            pass
-    if not routes:
-        assert error is not None
-        raise error
-    legs, chosen = min(routes, key=lambda r: sum(t.duration for t in r[0]))
-    for moves in legs:
+    """Fly to ``targets`` (:func:`~skyquill.show.route.route_to`): targets taken, curtain flown."""
+    route = route_to(line.positions, targets, script)
+    for moves in route.legs:
         _append(line, moves)
-    return chosen, len(legs) > 1
-
-
-def _plane_y(points: FloatArray) -> float | None:
-    """The y of the vertical plane facing -y that holds ``points``, if one does."""
-    return float(points[0, 1]) if np.ptp(points[:, 1]) <= PLANE_TOLERANCE_M else None
-
-
-def _curtain(script: ShowScript, plane_y: float, bottom_m: float) -> FloatArray:
-    """A vertical grid on ``y = plane_y`` above the pads' columns, from ``bottom_m`` up."""
-    spacing = max(script.home_spacing_m, math.sqrt(2.0) * script.safety_m)
-    origin = np.array([script.home_origin[0], plane_y, bottom_m])
-    columns = math.ceil(math.sqrt(script.drones))  # as many as the pads have (home_grid)
-    return grid_formation(
-        script.drones,
-        origin=origin,
-        columns=columns,
-        spacing_m=spacing,
-        safety_m=script.safety_m,
-    ).points
-
-
-def _plan(starts: FloatArray, goals: FloatArray, script: ShowScript) -> Transition:
-    names = [f"drone {i}" for i in range(len(goals))]
-    return plan_transition(starts, goals, leg_limits(script), script.safety_m, names)
+    return route.chosen, route.via_curtain
 
 
 def _append(line: _Timeline, moves: Transition) -> None:
@@ -363,7 +298,7 @@ def _append(line: _Timeline, moves: Transition) -> None:
 
 
 def _transition(line: _Timeline, goals: FloatArray, script: ShowScript) -> None:
-    _append(line, _plan(line.positions, goals, script))
+    _append(line, plan_moves(line.positions, goals, script))
 
 
 def _write(scene: WriteScene, script: ShowScript, line: _Timeline, where: _Where) -> dict[str, Any]:
