@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 from scipy.spatial.distance import cdist
@@ -116,3 +118,26 @@ def test_the_curtain_stands_on_the_plane_above_the_pads_columns() -> None:
     assert np.all(stage[:, 1] == 4.0) and stage[:, 2].min() == pytest.approx(7.0)
     assert set(np.round(stage[:, 0], 6)) == set(np.round(pads[:, 0], 6))
     assert pdist(stage).min() >= np.sqrt(2.0) * 1.5  # CAPT to the pads' air grid
+
+
+def test_an_svg_formation_is_read_relative_to_the_script(tmp_path: Path) -> None:
+    from scipy.spatial.distance import pdist
+
+    from skyquill.show.build import make_formation
+    from skyquill.show.script import FormationScene, load_script
+
+    (tmp_path / "art").mkdir()
+    (tmp_path / "art" / "zig.svg").write_text(
+        '<svg xmlns="http://www.w3.org/2000/svg" width="100" height="100">'
+        '<path d="M 0 100 L 50 0 L 100 100"/></svg>'
+    )
+    text = SCRIPT.replace(
+        'shape = "grid"\norigin = [-3.0, 0.0, 6.0]\ncolumns = 3',
+        'shape = "svg"\nsvg = "art/zig.svg"\norigin = [-5.0, 0.0, 6.0]\nsize = 10.0',
+    )
+    (tmp_path / "show.toml").write_text(text)
+    script = load_script(tmp_path / "show.toml")
+    scene = script.scenes[1]
+    assert isinstance(scene, FormationScene) and scene.svg == tmp_path / "art" / "zig.svg"
+    points = make_formation(scene, script).points
+    assert points.shape == (6, 3) and pdist(points).min() >= 1.5

@@ -109,6 +109,8 @@ class ShowScript:
         Sample rate of the CSV files, Hz.
     scenes
         Take-off first, landing last.
+    base
+        The folder the script's file names (an SVG) are relative to.
     """
 
     drones: int
