@@ -47,7 +47,7 @@ def _files_and_summary(small: Path) -> None:
     assert summary["drones"] == 10
     sep = summary["min_separation_m"]
     assert sep["requested"] == 1.5 and sep["guaranteed"] >= 1.5
-    assert {"takeoff", "formation", "write", "land", "check", "skyc"} <= set(
+    assert {"takeoff", "formation", "write", "land", "check", "skyc", "files"} <= set(
         summary["planning_time_s"]
     )
     assert [s["type"] for s in summary["scenes"]] == [

@@ -152,6 +152,6 @@ def _write(
     }
     clock = time.perf_counter()
     full = write_plan(stage, planned, rate=script.rate_hz, guaranteed=True, summary=summary)
-    full["planning_time_s"]["write"] = time.perf_counter() - clock
+    full["planning_time_s"]["files"] = time.perf_counter() - clock
     write_json(stage / "summary.json", full)
     return full
