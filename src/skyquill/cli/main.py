@@ -183,6 +183,7 @@ from skyquill.cli import (  # noqa: E402
     paint_cmd,
     render_cmd,
     reproduce_cmd,
+    show_cmd,
     studio_cmd,
     write_cmd,
 )
@@ -198,6 +199,7 @@ __all__ = [
     "paint_cmd",
     "render_cmd",
     "reproduce_cmd",
+    "show_cmd",
     "studio_cmd",
     "write_cmd",
 ]

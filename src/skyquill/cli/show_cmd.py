@@ -1,0 +1,157 @@
+"""``skyquill show SHOW.toml --out DIR``: plan a show script, prove it, write it and its .skyc."""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+from typing import Annotated, Any
+
+import typer
+from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+
+from skyquill.cli.main import Force, OutDir, app, check_out, console, say_done, user_errors
+from skyquill.errors import InfeasibleError, InputError
+from skyquill.io.atomic import write_json
+from skyquill.io.outputs import staged_output
+from skyquill.io.plan_dir import trajectory_names, write_plan
+from skyquill.show import ShowDrone, ShowLimits, ShowReport, check_show
+from skyquill.show.build import ShowPlan, build_show
+from skyquill.show.script import ShowScript, load_script
+
+#: Relative round-off allowed over the planned limits in the independent check
+#: (Ruckig's profiles touch the limits exactly; the writing QP holds them to its tolerance).
+CHECK_ROUND_OFF = 1e-6
+
+
+@app.command()
+def show(
+    script: Annotated[Path, typer.Argument(metavar="SHOW", help="Show script (TOML).")],
+    out: OutDir,
+    workers: Annotated[
+        int | None, typer.Option(help="Processes planning the writing (default: CPUs).")
+    ] = None,
+    scheduler: Annotated[
+        str | None,
+        typer.Option(help="dask.distributed scheduler address (or 'local') for the writing."),
+    ] = None,
+    force: Force = False,
+) -> None:
+    """Plan a show script: formations, transitions, writing, take-off and landing.
+
+    Every show written passes `skyquill check` at the script's safety distance
+    and limits; one that does not is refused. Writes trajectory_<i>.csv/json,
+    summary.json and show.skyc into --out.
+    """
+    with user_errors():
+        check_out(out)
+        if workers is not None and workers < 1:
+            raise InputError(f"--workers: got {workers}, expected at least 1")
+        show_script = load_script(script)
+        stages: dict[str, float] = {}
+        plan = _plan(show_script, workers, scheduler)
+        clock = time.perf_counter()
+        with console.status(f"checking {len(plan.drones)} drones"):
+            report = _check(plan, show_script)
+        stages["check"] = time.perf_counter() - clock
+        with staged_output(out, "show", force=force, inputs=[script]) as stage:
+            summary = _write(stage, plan, show_script, report, stages)
+    say_done(
+        f"{out}: {summary['drones']} drones, {summary['duration_s']:.1f} s, no two closer than "
+        f"{summary['min_separation_m']['guaranteed']:.3f} m (guaranteed; "
+        f"{show_script.safety_m:g} m asked), in {sum(summary['planning_time_s'].values()):.1f} s"
+    )
+
+
+def _plan(script: ShowScript, workers: int | None, scheduler: str | None) -> ShowPlan:
+    with Progress(
+        TextColumn("{task.description}"),
+        BarColumn(),
+        TimeElapsedColumn(),
+        console=console,
+        transient=True,
+    ) as bar:
+        task = bar.add_task("planning", total=len(script.scenes))
+
+        def progress(done: int, total: int, stage: str) -> None:
+            bar.update(task, completed=done, total=total, description=stage)
+
+        return build_show(script, workers=workers, scheduler=scheduler, progress=progress)
+
+
+def check_limits(script: ShowScript) -> ShowLimits:
+    """What the independent check holds every drone to: the script's limits (norms)."""
+    lim = script.limits
+    assert lim.vmax is not None and lim.amax is not None
+    speed = lim.vmax * (1.0 + CHECK_ROUND_OFF)
+    return ShowLimits(
+        max_speed_xy=speed,
+        max_speed_up=speed,
+        max_speed_down=speed,
+        max_acceleration=lim.amax * (1.0 + CHECK_ROUND_OFF),
+        min_altitude=None,
+        max_altitude=120.0,
+    )
+
+
+def _check(plan: ShowPlan, script: ShowScript) -> ShowReport:
+    """``skyquill check`` on the plan; refused (InfeasibleError) unless it passes."""
+    names = [csv.removesuffix(".csv") for csv, _ in trajectory_names(len(plan.drones))]
+    drones = [ShowDrone(d.planned.trajectory, n) for d, n in zip(plan.drones, names, strict=True)]
+    report = check_show(drones, script.safety_m, check_limits(script))
+    if not report.passed:
+        v = report.violations[0]
+        raise InfeasibleError(
+            f"show: the check refuses the plan: {v.check} of {', '.join(v.drones)} at "
+            f"t = {v.first_time_s:.2f} s is {v.worst:.4g}, expected within {v.limit:g}",
+            (v.check,),
+        )
+    return report
+
+
+def _write(
+    stage: Path,
+    plan: ShowPlan,
+    script: ShowScript,
+    report: ShowReport,
+    stages: dict[str, float],
+) -> dict[str, Any]:
+    from skyquill.export.base import ExportOptions
+    from skyquill.export.skyc import SkycExporter
+
+    planned = [d.planned for d in plan.drones]
+    names = [csv.removesuffix(".csv") for csv, _ in trajectory_names(len(planned))]
+    clock = time.perf_counter()
+    skyc = SkycExporter()(list(zip(names, planned, strict=True)), stage / "show", ExportOptions())
+    stages["skyc"] = time.perf_counter() - clock
+    sep = report.separation
+    summary = {
+        "command": "show",
+        "drones": len(plan.drones),
+        "duration_s": plan.duration_s,
+        "safety_distance_m": script.safety_m,
+        "min_separation_m": {
+            "requested": script.safety_m,
+            "guaranteed": sep.lower_bound_m,
+            "attained": sep.attained_m,
+            "between": [names[k] for k in sep.attained_drones],
+            "at_s": sep.attained_time_s,
+        },
+        "check": report.as_dict(),
+        "planning_time_s": plan.stage_times_s | stages,
+        "scenes": list(plan.scenes),
+        "homes_m": plan.homes.tolist(),
+        "lights": [
+            {
+                "drone": n,
+                "windows_s": [list(w) for w in d.planned.pen_windows_s],
+                "rgb": [list(c) for c in d.colors],
+            }
+            for n, d in zip(names, plan.drones, strict=True)
+        ],
+        "skyc": {"file": "show.skyc", "message": skyc.message, "details": skyc.details},
+    }
+    clock = time.perf_counter()
+    full = write_plan(stage, planned, rate=script.rate_hz, guaranteed=True, summary=summary)
+    full["planning_time_s"]["files"] = time.perf_counter() - clock
+    write_json(stage / "summary.json", full)
+    return full

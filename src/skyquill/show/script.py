@@ -1,0 +1,341 @@
+"""Show scripts: a TOML file of scenes (``docs/show-format.md``), read into typed scenes.
+
+Reading only checks and converts (SI units, frames as documented); planning is
+:mod:`skyquill.show.build`. Every unknown table, key or scene type is an
+:class:`~skyquill.errors.InputError` that names it and lists the known ones.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from skyquill.errors import InputError
+from skyquill.io.skybrush_lights import check_rgb
+from skyquill.limits import VehicleLimits
+from skyquill.validation import FloatArray, as_array, as_float, as_int
+
+RGB = tuple[int, int, int]
+#: Most drones in one show: every pair's transitions are proven apart (n^2 / 2 pairs).
+MAX_DRONES = 500
+#: Largest script read, bytes.
+MAX_BYTES = 1_000_000
+#: Shapes a formation scene can take.
+SHAPES = ("text", "svg", "grid", "circle")
+
+
+@dataclass(frozen=True)
+class Takeoff:
+    """Every drone climbs straight up from its pad, row after row."""
+
+    altitude_m: float = 3.0
+    stagger_s: float = 1.0
+
+
+@dataclass(frozen=True)
+class FormationScene:
+    """Fly into a formation and hold it, lit in ``color``.
+
+    ``origin`` is the bottom-left corner of a text, SVG or grid on the vertical
+    plane facing -y; ``center`` the centre of a circle.
+    """
+
+    shape: str
+    hold_s: float
+    color: RGB
+    origin: FloatArray
+    size_m: float = 20.0
+    text: str = ""
+    font: str = "futural"
+    svg: Path | None = None
+    columns: int = 10
+    spacing_m: float | None = None
+    radius_m: float = 10.0
+
+
+@dataclass(frozen=True)
+class WriteScene:
+    """``drones`` drones write ``text`` on vertical boards, the others hold their place."""
+
+    text: str
+    color: RGB
+    origin: FloatArray
+    size_m: float = 2.0
+    drones: int | None = None
+    columns: int = 5
+    font: str = "futural"
+
+
+@dataclass(frozen=True)
+class Hold:
+    """Everyone holds where they are; lit in ``color`` if one is given."""
+
+    duration_s: float
+    color: RGB | None = None
+
+
+@dataclass(frozen=True)
+class Land:
+    """Fly to the air above the pads, then descend row after row."""
+
+    altitude_m: float = 3.0
+    stagger_s: float = 1.0
+
+
+Scene = Takeoff | FormationScene | WriteScene | Hold | Land
+
+
+@dataclass(frozen=True)
+class ShowScript:
+    """A whole show: its drones, limits, safety distance and scenes.
+
+    Attributes
+    ----------
+    drones
+        Number of drones.
+    safety_m
+        Distance every two drones keep at all times, m.
+    home_spacing_m
+        Spacing of the take-off pads (a square grid on the ground), m.
+    home_origin
+        The first pad's ``(x, y)``, m.
+    limits
+        Speed, acceleration and jerk (norms) of every flight.
+    rate_hz
+        Sample rate of the CSV files, Hz.
+    scenes
+        Take-off first, landing last.
+    base
+        The folder the script's file names (an SVG) are relative to.
+    """
+
+    drones: int
+    safety_m: float
+    home_spacing_m: float
+    home_origin: FloatArray
+    limits: VehicleLimits
+    rate_hz: float
+    scenes: tuple[Scene, ...]
+    base: Path = field(default_factory=Path)
+
+
+def _known(table: Any, where: str, known: tuple[str, ...]) -> dict[str, Any]:
+    if not isinstance(table, dict):
+        raise InputError(f"{where}: got {type(table).__name__}, expected a table")
+    for key in table:
+        if key not in known:
+            raise InputError(
+                f"{where}: got unknown key {key!r}, expected one of {', '.join(known)}"
+            )
+    return table
+
+
+def _color(where: str, value: Any) -> RGB:
+    """``[r, g, b]`` or ``"#rrggbb"``."""
+    if isinstance(value, str):
+        text = value.removeprefix("#")
+        if len(text) == 6 and all(c in "0123456789abcdefABCDEF" for c in text):
+            return (int(text[0:2], 16), int(text[2:4], 16), int(text[4:6], 16))
+        raise InputError(f"{where}: got {value!r:.40}, expected '#rrggbb' or [r, g, b]")
+    return check_rgb(where, value)
+
+
+def _point(where: str, value: Any, n: int = 3) -> FloatArray:
+    return as_array(where, value, shape=(n,))
+
+
+def _number(where: str, value: Any, *, positive: bool = True) -> float:
+    if isinstance(value, bool):
+        raise InputError(f"{where}: got {value!r}, expected a number")
+    return as_float(where, value, positive=positive, nonneg=not positive)
+
+
+def _text(where: str, value: Any) -> str:
+    if not isinstance(value, str) or not value.strip():
+        raise InputError(f"{where}: got {value!r:.40}, expected a non-empty string")
+    return value
+
+
+def _takeoff(t: dict[str, Any], where: str) -> Takeoff:
+    _known(t, where, ("type", "altitude", "stagger"))
+    return Takeoff(
+        _number(f"{where}.altitude", t.get("altitude", 3.0)),
+        _number(f"{where}.stagger", t.get("stagger", 1.0), positive=False),
+    )
+
+
+def _land(t: dict[str, Any], where: str) -> Land:
+    _known(t, where, ("type", "altitude", "stagger"))
+    return Land(
+        _number(f"{where}.altitude", t.get("altitude", 3.0)),
+        _number(f"{where}.stagger", t.get("stagger", 1.0), positive=False),
+    )
+
+
+def _hold(t: dict[str, Any], where: str) -> Hold:
+    _known(t, where, ("type", "duration", "color"))
+    color = t.get("color")
+    return Hold(
+        _number(f"{where}.duration", t.get("duration", 1.0)),
+        None if color is None else _color(f"{where}.color", color),
+    )
+
+
+FORMATION_KEYS = (
+    "type", "shape", "hold", "color", "origin", "center", "size", "text", "font", "svg",
+    "columns", "spacing", "radius",
+)  # fmt: skip
+
+
+def _formation(t: dict[str, Any], where: str, base: Path) -> FormationScene:
+    _known(t, where, FORMATION_KEYS)
+    shape = t.get("shape")
+    if shape not in SHAPES:
+        raise InputError(f"{where}.shape: got {shape!r}, expected one of {', '.join(SHAPES)}")
+    place = "center" if shape == "circle" else "origin"
+    if place not in t:
+        raise InputError(f"{where}: got no {place!r}, expected [x, y, z] in m for a {shape}")
+    text = _text(f"{where}.text", t.get("text")) if shape == "text" else ""
+    svg = base / _text(f"{where}.svg", t.get("svg")) if shape == "svg" else None
+    spacing = t.get("spacing")
+    return FormationScene(
+        shape=shape,
+        hold_s=_number(f"{where}.hold", t.get("hold", 2.0), positive=False),
+        color=_color(f"{where}.color", t.get("color", [255, 255, 255])),
+        origin=_point(f"{where}.{place}", t[place]),
+        size_m=_number(f"{where}.size", t.get("size", 20.0)),
+        text=text,
+        font=str(t.get("font", "futural")),
+        svg=svg,
+        columns=as_int(f"{where}.columns", t.get("columns", 10), low=1),
+        spacing_m=None if spacing is None else _number(f"{where}.spacing", spacing),
+        radius_m=_number(f"{where}.radius", t.get("radius", 10.0)),
+    )
+
+
+def _write(t: dict[str, Any], where: str) -> WriteScene:
+    _known(t, where, ("type", "text", "color", "origin", "size", "drones", "columns", "font"))
+    if "origin" not in t:
+        raise InputError(f"{where}: got no 'origin', expected [x, y, z] in m (first board)")
+    drones = t.get("drones")
+    return WriteScene(
+        text=_text(f"{where}.text", t.get("text")),
+        color=_color(f"{where}.color", t.get("color", [255, 255, 255])),
+        origin=_point(f"{where}.origin", t["origin"]),
+        size_m=_number(f"{where}.size", t.get("size", 2.0)),
+        drones=None if drones is None else as_int(f"{where}.drones", drones, low=1),
+        columns=as_int(f"{where}.columns", t.get("columns", 5), low=1),
+        font=str(t.get("font", "futural")),
+    )
+
+
+_SCENES: dict[str, Callable[[dict[str, Any], str, Path], Scene]] = {
+    "takeoff": lambda t, w, _: _takeoff(t, w),
+    "formation": _formation,
+    "write": lambda t, w, _: _write(t, w),
+    "hold": lambda t, w, _: _hold(t, w),
+    "land": lambda t, w, _: _land(t, w),
+}
+
+
+def _scene(t: Any, where: str, base: Path) -> Scene:
+    if not isinstance(t, dict):
+        raise InputError(f"{where}: got {type(t).__name__}, expected a table")
+    kind = t.get("type")
+    if kind not in _SCENES:
+        raise InputError(f"{where}.type: got {kind!r}, expected one of {', '.join(_SCENES)}")
+    return _SCENES[kind](t, where, base)
+
+
+def parse_script(text: str, base: Path = Path()) -> ShowScript:
+    """A show script from its TOML ``text``; files it names are relative to ``base``.
+
+    Raises
+    ------
+    InputError
+        Malformed TOML, an unknown table, key or scene type (naming it and
+        listing the known ones), a value out of range, no take-off first or no
+        landing last.
+    """
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise InputError(f"show script: got malformed TOML ({exc}), expected TOML") from None
+    _known(data, "show script", ("show", "limits", "scene"))
+    show = _known(data.get("show", {}), "[show]", SHOW_KEYS)
+    limits = _known(data.get("limits", {}), "[limits]", ("vmax", "amax", "jmax"))
+    raw = data.get("scene", [])
+    if not isinstance(raw, list) or not raw:
+        raise InputError("[[scene]]: got none, expected a list of scenes, takeoff first")
+    scenes = tuple(_scene(t, f"scene[{i}]", base) for i, t in enumerate(raw))
+    _check_order(scenes)
+    safety = _number("[show].safety_distance", show.get("safety_distance", 3.0))
+    return ShowScript(
+        drones=as_int("[show].drones", show.get("drones"), low=1, high=MAX_DRONES),
+        safety_m=safety,
+        # CAPT: pads sqrt(2) x the safety distance apart leave for any formation in one wave.
+        home_spacing_m=_number(
+            "[show].home_spacing", show.get("home_spacing", math.sqrt(2.0) * safety)
+        ),
+        home_origin=_point("[show].home_origin", show.get("home_origin", [0.0, -10.0]), 2),
+        limits=VehicleLimits(
+            vmax=_number("[limits].vmax", limits.get("vmax", 3.0)),
+            amax=_number("[limits].amax", limits.get("amax", 2.0)),
+            jmax=_number("[limits].jmax", limits.get("jmax", 10.0)),
+        ),
+        rate_hz=_number("[show].rate", show.get("rate", 20.0)),
+        scenes=scenes,
+        base=base,
+    )
+
+
+SHOW_KEYS = ("drones", "safety_distance", "home_spacing", "home_origin", "rate")
+
+
+def _check_order(scenes: tuple[Scene, ...]) -> None:
+    if not isinstance(scenes[0], Takeoff):
+        raise InputError(f"scene[0].type: got {_name(scenes[0])!r}, expected 'takeoff' first")
+    if not isinstance(scenes[-1], Land):
+        raise InputError(
+            f"scene[{len(scenes) - 1}].type: got {_name(scenes[-1])!r}, expected 'land' last"
+        )
+    for i, s in enumerate(scenes[1:-1], start=1):
+        if isinstance(s, Takeoff | Land):
+            raise InputError(
+                f"scene[{i}].type: got {_name(s)!r}, expected takeoff only first and land only last"
+            )
+
+
+def _name(scene: Scene) -> str:
+    return {v: k for k, v in SCENE_TYPES.items()}[type(scene)]
+
+
+SCENE_TYPES: dict[str, type] = {
+    "takeoff": Takeoff,
+    "formation": FormationScene,
+    "write": WriteScene,
+    "hold": Hold,
+    "land": Land,
+}
+
+
+def load_script(path: Path) -> ShowScript:
+    """Read the show script at ``path`` (:func:`parse_script`, files relative to it)."""
+    file = Path(path)
+    if not file.is_file():
+        raise InputError(f"SHOW: got {str(file)!r}, expected an existing .toml file")
+    size = file.stat().st_size
+    if size > MAX_BYTES:
+        raise InputError(f"SHOW: got {size:,} bytes, expected at most {MAX_BYTES:,}")
+    try:
+        text = file.read_bytes().decode("utf-8")
+    except UnicodeDecodeError:
+        raise InputError(f"SHOW: got {file.name}, which is not UTF-8, expected TOML") from None
+    try:
+        return parse_script(text, file.parent)
+    except InputError as exc:
+        raise InputError(f"{file.name}: {exc}") from None

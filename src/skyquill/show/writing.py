@@ -1,0 +1,114 @@
+"""The writing of a ``write`` scene: parts of a text on vertical boards, planned in parallel.
+
+The text is shared out among the writers (:func:`skyquill.strokes.typed_parts`,
+one scale for all), each part goes on its own board (:func:`writing_boards`:
+the one place the writing surface is chosen), and the flights are planned as
+``skyquill write`` plans them (:func:`skyquill.calligraphy.show.plan_jobs`).
+Each flight starts and ends hovering at its board; where the drones come
+from, and who holds, is the show's business (:mod:`skyquill.show.build`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import cast
+
+import numpy as np
+
+from skyquill.calligraphy.board import Board
+from skyquill.calligraphy.mission import WritingOptions
+from skyquill.calligraphy.show import Job, Progress, plan_jobs
+from skyquill.errors import InputError
+from skyquill.show.script import ShowScript, WriteScene
+from skyquill.trajectory import Trajectory
+from skyquill.validation import FloatArray
+
+#: Brush lift between strokes on the writing boards, m (the light is off then).
+LIFT_M = 0.05
+#: Extra room between writing boards beyond the safety distance, m.
+BOARD_MARGIN_M = 0.5
+
+
+@dataclass(frozen=True)
+class Writing:
+    """The writers' flights, each from 0 on its own clock.
+
+    Attributes
+    ----------
+    flights
+        The vehicles' trajectories, one per board, at rest at both ends.
+    pen_windows
+        Each flight's strokes ``(start, end)``, s.
+    starts
+        Where each flight starts (W, 3), m.
+    """
+
+    flights: tuple[Trajectory, ...]
+    pen_windows: tuple[tuple[tuple[float, float], ...], ...]
+    starts: FloatArray
+
+    @property
+    def duration_s(self) -> float:
+        """The longest flight, s."""
+        return max(f.duration for f in self.flights)
+
+
+def writing_boards(count: int, scene: WriteScene, safety_m: float) -> list[Board]:
+    """The writing boards of a scene: vertical, facing -y, in rows of ``scene.columns``.
+
+    Board ``k`` is at ``origin + pitch (k mod columns, 0, k div columns)``
+    with ``pitch = size + safety_m + BOARD_MARGIN_M``. This is the one place
+    where the writing surface is chosen (a sky board can replace the wall here).
+    """
+    pitch = scene.size_m + safety_m + BOARD_MARGIN_M
+    cells = [np.array([k % scene.columns, 0.0, k // scene.columns]) for k in range(count)]
+    return [Board("wall", scene.origin + pitch * cell, LIFT_M) for cell in cells]
+
+
+def writer_count(scene: WriteScene) -> int:
+    """``scene.drones``, or one writer per word (per character for Chinese)."""
+    from skyquill.strokes import is_cjk
+
+    if scene.drones is not None:
+        return scene.drones
+    text = scene.text
+    return len("".join(text.split())) if is_cjk(text) else len(text.split())
+
+
+def plan_writing_scene(
+    scene: WriteScene,
+    script: ShowScript,
+    *,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    progress: Progress | None = None,
+) -> Writing:
+    """Plan the writers' flights of ``scene`` with the show's limits.
+
+    Raises
+    ------
+    InputError
+        More writers than drones, fewer words (characters) than writers.
+    InfeasibleError
+        A part that cannot be written within the limits and the tolerance.
+    """
+    from skyquill.strokes import typed_parts
+
+    count = writer_count(scene)
+    if count > script.drones:
+        raise InputError(
+            f"write.drones: got {count} writers, expected at most the show's {script.drones}"
+        )
+    parts = typed_parts(scene.text, count, scene.font)
+    options = WritingOptions(size_m=scene.size_m, limits=script.limits)
+    boards = writing_boards(count, scene, script.safety_m)
+    # home=None: each flight starts and ends hovering at its board (plan_writing takes
+    # it; calligraphy.show.Job's annotation says FloatArray).
+    jobs = [cast(Job, (p, b, options, None)) for p, b in zip(parts, boards, strict=True)]
+    missions = plan_jobs(jobs, workers, scheduler, progress)
+    flights = tuple(m.vehicle_trajectory() for m in missions)
+    return Writing(
+        flights,
+        tuple(m.pen_windows for m in missions),
+        np.array([f.evaluate(np.zeros(1))[0] for f in flights]),
+    )

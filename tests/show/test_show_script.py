@@ -1,0 +1,78 @@
+"""Show scripts: the TOML format, and every refusal naming what is wrong."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from skyquill.errors import InputError
+from skyquill.show.script import (
+    FormationScene,
+    Land,
+    Takeoff,
+    WriteScene,
+    load_script,
+    parse_script,
+)
+
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
+
+HEAD = """
+[show]
+drones = 4
+safety_distance = 1.5
+[limits]
+vmax = 2.0
+[[scene]]
+type = "takeoff"
+"""
+TAIL = """
+[[scene]]
+type = "land"
+"""
+
+
+def test_the_examples_parse() -> None:
+    small = load_script(EXAMPLES / "show_small.toml")
+    assert small.drones == 10 and small.safety_m == 1.5
+    assert isinstance(small.scenes[0], Takeoff) and isinstance(small.scenes[-1], Land)
+    assert any(isinstance(s, WriteScene) for s in small.scenes)
+    big = load_script(EXAMPLES / "show_100.toml")
+    assert big.drones == 100
+    assert [type(s).__name__ for s in big.scenes] == [
+        "Takeoff", "FormationScene", "WriteScene", "FormationScene", "Land",
+    ]  # fmt: skip
+
+
+def test_colours_and_defaults() -> None:
+    s = parse_script(HEAD + '[[scene]]\ntype = "formation"\nshape = "circle"\n'
+                     'center = [0, 0, 9]\ncolor = "#ff8000"\n' + TAIL)  # fmt: skip
+    f = s.scenes[1]
+    assert isinstance(f, FormationScene) and f.color == (255, 128, 0)
+    assert s.limits.vmax == 2.0 and s.limits.amax == 2.0
+    assert s.home_spacing_m == pytest.approx(1.5 * 2**0.5)
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        (HEAD + '[[scene]]\ntype = "dance"\n' + TAIL,
+         r"scene\[1\]\.type: got 'dance', expected one of takeoff, formation, write, hold, land"),
+        (HEAD + '[[scene]]\ntype = "hold"\nduraton = 3\n' + TAIL,
+         r"scene\[1\]: got unknown key 'duraton', expected one of type, duration, color"),
+        (HEAD.replace("[limits]", "[limit]"),
+         r"show script: got unknown key 'limit', expected one of show, limits, scene"),
+        (HEAD.replace("1.5", "-1.5") + TAIL,
+         r"\[show\]\.safety_distance: got -1\.5"),
+        (HEAD + "[[scene]\n", r"show script: got malformed TOML"),
+        (HEAD, r"scene\[0\]\.type: got 'takeoff', expected 'land' last"),
+        (HEAD + '[[scene]]\ntype = "formation"\nshape = "star"\norigin = [0, 0, 5]\n' + TAIL,
+         r"scene\[1\]\.shape: got 'star', expected one of text, svg, grid, circle"),
+        (HEAD + '[[scene]]\ntype = "hold"\ncolor = [300, 0, 0]\n' + TAIL,
+         r"scene\[1\]\.color: got \[300, 0, 0\], expected three integers"),
+    ],
+)  # fmt: skip
+def test_bad_scripts_are_refused_naming_what(text: str, message: str) -> None:
+    with pytest.raises(InputError, match=message):
+        parse_script(text)
