@@ -2,13 +2,15 @@
 
 from __future__ import annotations
 
+from itertools import pairwise
+
 import numpy as np
 import pytest
 
 from skyquill.errors import InputError
 from skyquill.io.skybrush_keyframes import SEGMENT_MS, encode, skybrush_keyframes
 from skyquill.io.skybrush_playback import played_trajectory, quantize
-from skyquill.trajectory import SplineTrajectory
+from skyquill.trajectory import PiecewisePolynomial, RestToRestSequence, SplineTrajectory
 
 
 def spline(
@@ -74,3 +76,28 @@ def test_bad_arguments_are_named() -> None:
         skybrush_keyframes(flat)
     with pytest.raises(InputError, match=r"tolerance: got 0"):
         skybrush_keyframes(spline(3), tolerance=0.0)
+
+
+def _time_optimal_move() -> RestToRestSequence:
+    """A 6 m rest-to-rest move in Ruckig's phases (cubic pieces), then a 3 s hold."""
+    from skyquill.optimize.legs import LegLimits, leg_pieces
+
+    limits = LegLimits(vmax=3.0, amax=2.0, jmax=10.0)
+    durations, coeffs = leg_pieces(np.zeros(3), np.array([6.0, 0.0, 0.0]), limits)
+    move = PiecewisePolynomial(np.concatenate([[0.0], np.cumsum(durations)]), coeffs)
+    hold = PiecewisePolynomial(np.array([0.0, 3.0]), np.array([[[6.0, 0.0, 0.0]]]))
+    return RestToRestSequence((move, hold))
+
+
+def test_cubic_pieces_become_exact_segments_and_keep_the_rounding_small() -> None:
+    """A time-optimal move is cubic piece by piece: its phases are segments of their own (no
+    bisection), so the mm rounding moves the acceleration by far less than on 125 ms ones."""
+    traj = _time_optimal_move()
+    keys = skybrush_keyframes(traj)
+    assert keys.fit_error_m < 1e-6
+    long_phases = [b for a, b in pairwise(traj.breakpoints) if b - a >= 0.1]
+    assert set(np.round(np.array(long_phases) * 1000).astype(int)) <= set(keys.times_ms.tolist())
+    played = played_trajectory("d", {"points": keys.points()}).trajectory()
+    t = np.linspace(0.0, traj.duration, 20_001)
+    accel = np.linalg.norm(played.evaluate(t, 2), axis=1)
+    assert accel.max() <= 2.0 * 1.05

@@ -57,7 +57,7 @@ def plan() -> ShowPlan:
 
 
 def _at(plan: ShowPlan, t: float) -> np.ndarray:
-    return np.array([d.planned.trajectory.evaluate(np.array([t]))[0] for d in plan.drones])
+    return np.array([d.trajectory.evaluate(np.array([t]))[0] for d in plan.drones])
 
 
 def test_scenes_follow_one_another_on_one_clock(plan: ShowPlan) -> None:
@@ -66,7 +66,7 @@ def test_scenes_follow_one_another_on_one_clock(plan: ShowPlan) -> None:
     for before, after in zip(plan.scenes, plan.scenes[1:], strict=False):
         assert after["start_s"] == pytest.approx(before["end_s"])
     for d in plan.drones:
-        assert d.planned.trajectory.duration == pytest.approx(plan.duration_s)
+        assert d.trajectory.duration == pytest.approx(plan.duration_s)
 
 
 def test_every_drone_takes_off_from_its_pad_and_lands_on_one(plan: ShowPlan) -> None:
@@ -89,19 +89,17 @@ def test_formations_are_held_with_their_lights(plan: ShowPlan) -> None:
     expected = np.array([[-3.0 + 2.1213 * (k % 3), 0.0, 6.0 + 2.1213 * (k // 3)] for k in range(6)])
     assert cdist(p, expected).min(axis=0).max() < 1e-3  # every grid point is taken
     for d in plan.drones:
-        assert len(d.colors) == len(d.planned.pen_windows_s) == 3
-        assert d.colors == ((255, 0, 0), (0, 255, 0), (0, 0, 255))
-        start, end = d.planned.pen_windows_s[0]
+        assert len(d.pen_rgb) == len(d.pen_windows_s) == 3
+        assert d.pen_rgb == ((255, 0, 0), (0, 255, 0), (0, 0, 255))
+        start, end = d.pen_windows_s[0]
         assert end == pytest.approx(grid["end_s"]) and end - start == pytest.approx(2.0)
 
 
 def test_limits_and_separation_hold_on_the_composed_flights(plan: ShowPlan) -> None:
     for d in plan.drones:
-        check = verify(d.planned.trajectory, d.planned.limits, guaranteed=True)
+        check = verify(d.trajectory, d.limits, guaranteed=True)
         assert check.max_excess <= 1e-9
-    report = check_show(
-        [ShowDrone(d.planned.trajectory, str(i)) for i, d in enumerate(plan.drones)], 1.5
-    )
+    report = check_show([ShowDrone(d.trajectory, str(i)) for i, d in enumerate(plan.drones)], 1.5)
     assert report.separation.passed and report.separation.lower_bound_m >= 1.5
     assert plan.min_separation_m >= 1.5
 

@@ -14,7 +14,7 @@ from skyquill.errors import InfeasibleError, InputError
 from skyquill.io.atomic import write_json
 from skyquill.io.outputs import staged_output
 from skyquill.io.plan_dir import trajectory_names, write_plan
-from skyquill.show import ShowDrone, ShowLimits, ShowReport, check_show
+from skyquill.show import ShowDrone, ShowLimits, ShowReport, check_show, load_show
 from skyquill.show.build import ShowPlan, build_show
 from skyquill.show.script import ShowScript, load_script
 
@@ -96,7 +96,7 @@ def check_limits(script: ShowScript) -> ShowLimits:
 def _check(plan: ShowPlan, script: ShowScript) -> ShowReport:
     """``skyquill check`` on the plan; refused (InfeasibleError) unless it passes."""
     names = [csv.removesuffix(".csv") for csv, _ in trajectory_names(len(plan.drones))]
-    drones = [ShowDrone(d.planned.trajectory, n) for d, n in zip(plan.drones, names, strict=True)]
+    drones = [ShowDrone(d.trajectory, n) for d, n in zip(plan.drones, names, strict=True)]
     report = check_show(drones, script.safety_m, check_limits(script))
     if not report.passed:
         v = report.violations[0]
@@ -115,14 +115,15 @@ def _write(
     report: ShowReport,
     stages: dict[str, float],
 ) -> dict[str, Any]:
-    from skyquill.export.base import ExportOptions
-    from skyquill.export.skyc import SkycExporter
+    from skyquill.viz.light_painting import write_pictures
 
-    planned = [d.planned for d in plan.drones]
-    names = [csv.removesuffix(".csv") for csv, _ in trajectory_names(len(planned))]
+    names = [csv.removesuffix(".csv") for csv, _ in trajectory_names(len(plan.drones))]
     clock = time.perf_counter()
-    skyc = SkycExporter()(list(zip(names, planned, strict=True)), stage / "show", ExportOptions())
+    skyc = _skyc(stage, plan, names, script)
     stages["skyc"] = time.perf_counter() - clock
+    clock = time.perf_counter()
+    pictures = write_pictures(plan.drones, stage)
+    stages["pictures"] = time.perf_counter() - clock
     sep = report.separation
     summary = {
         "command": "show",
@@ -143,15 +144,53 @@ def _write(
         "lights": [
             {
                 "drone": n,
-                "windows_s": [list(w) for w in d.planned.pen_windows_s],
-                "rgb": [list(c) for c in d.colors],
+                "windows_s": [list(w) for w in d.pen_windows_s],
+                "rgb": [list(c) for c in d.pen_rgb],
             }
             for n, d in zip(names, plan.drones, strict=True)
         ],
-        "skyc": {"file": "show.skyc", "message": skyc.message, "details": skyc.details},
+        "skyc": skyc,
+        "pictures": pictures,
     }
     clock = time.perf_counter()
-    full = write_plan(stage, planned, rate=script.rate_hz, guaranteed=True, summary=summary)
+    full = write_plan(stage, plan.drones, rate=script.rate_hz, guaranteed=True, summary=summary)
     full["planning_time_s"]["files"] = time.perf_counter() - clock
     write_json(stage / "summary.json", full)
     return full
+
+
+def _skyc(stage: Path, plan: ShowPlan, names: list[str], script: ShowScript) -> dict[str, Any]:
+    """Write ``show.skyc``, load it back as the drones play it and check it again.
+
+    Skybrush stores whole millimetres and milliseconds, so the show as played is up to
+    the export's ``max_error_m`` from the plan: its guaranteed separation is checked
+    against the safety distance less twice that (two drones), and the show is refused
+    below it. Its speeds and acceleration are reported, not refused: the rounding can
+    cross a limit the plan touches (``limits`` says by how much).
+    """
+    from skyquill.export.base import ExportOptions
+    from skyquill.export.skyc import SkycExporter
+
+    plans = list(zip(names, plan.drones, strict=True))
+    exported = SkycExporter()(plans, stage / "show", ExportOptions())
+    played = load_show([stage / "show.skyc"])
+    allowed = max(0.0, script.safety_m - 2.0 * exported.max_error_m)
+    back = check_show(played, allowed, check_limits(script))
+    if not back.separation.passed:
+        e = back.separation.encounters[0]
+        raise InfeasibleError(
+            f"show.skyc: as Skybrush plays it, {played[e.drones[0]].name} and "
+            f"{played[e.drones[1]].name} come within {e.closest_m:.4f} m at "
+            f"t = {e.closest_time_s:.2f} s, expected at least {allowed:.4f} m",
+            ("separation",),
+        )
+    return {
+        "file": "show.skyc",
+        "message": exported.message,
+        "details": exported.details,
+        "played_back": {
+            "guaranteed_separation_m": back.separation.lower_bound_m,
+            "checked_against_m": allowed,
+            "check": back.as_dict(),
+        },
+    }

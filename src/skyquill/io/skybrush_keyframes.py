@@ -35,11 +35,16 @@ from numpy.typing import NDArray
 
 from skyquill.errors import InputError
 from skyquill.io.skybrush_playback import quantize, scaling_factor
-from skyquill.trajectory import Trajectory
+from skyquill.trajectory import PiecewisePolynomial, RestToRestSequence, Trajectory
 from skyquill.validation import FloatArray, as_float
 
 #: Length of a segment before bisection, ms.
 SEGMENT_MS = 250
+#: Longest segment over one of the trajectory's own cubic pieces (exact there), ms.
+CUBIC_SEGMENT_MS = 1000
+#: Shortest cubic piece given its own segment, ms: a shorter one (a time-optimal move's
+#: brief jerk phase) would amplify the mm rounding (``unit / h^2``); it joins the next span.
+MIN_CUBIC_MS = 100
 #: Shortest segment bisection makes, ms.
 MIN_SEGMENT_MS = 10
 #: Default largest distance of the cubics from the trajectory before rounding, m (the
@@ -128,21 +133,72 @@ def _errors(traj: Trajectory, times_ms: NDArray[np.int64], ctrl: FloatArray) -> 
     return np.asarray(np.linalg.norm(bez - exact, axis=2).max(axis=1))
 
 
-def _boundaries(duration_s: float) -> NDArray[np.int64]:
-    """Boundaries of :data:`SEGMENT_MS` segments over the duration, ms (the end rounded up)."""
-    total = max(1, math.ceil(duration_s * 1000 - 1e-6))
-    n = math.ceil(total / SEGMENT_MS)
-    if n > MAX_SEGMENTS:
+def _boundaries(traj: Trajectory) -> NDArray[np.int64]:
+    """First segment boundaries over the duration, ms (the end rounded up).
+
+    Segments of :data:`SEGMENT_MS`, except over the trajectory's own cubic pieces
+    (:func:`_cubic_spans`): a cubic Bézier is such a piece exactly, so it is one segment
+    of up to :data:`CUBIC_SEGMENT_MS` with no fit error and no bisection, and the longer
+    segment shrinks the ms/mm rounding's effect on acceleration and jerk (``unit / h^2``,
+    ``unit / h^3``).
+    """
+    total = max(1, math.ceil(traj.duration * 1000 - 1e-6))
+    out: list[NDArray[np.int64]] = []
+    for start, end, cubic in _cubic_spans(traj, total):
+        n = math.ceil((end - start) / (CUBIC_SEGMENT_MS if cubic else SEGMENT_MS))
+        out.append(np.round(np.linspace(start, end, n + 1)).astype(np.int64)[:-1])
+    times = np.append(np.concatenate(out), total)
+    if times.size - 1 > MAX_SEGMENTS:
         raise InputError(
-            f"trajectory: got {duration_s:.6g} s, expected at most "
+            f"trajectory: got {traj.duration:.6g} s, expected at most "
             f"{MAX_SEGMENTS * SEGMENT_MS / 3.6e6:g} h for one Skybrush drone"
         )
-    return np.round(np.linspace(0, total, n + 1)).astype(np.int64)
+    return times
+
+
+def _cubic_spans(traj: Trajectory, total_ms: int) -> list[tuple[int, int, bool]]:
+    """``(start, end, cubic)`` spans covering ``[0, total_ms]``, ms.
+
+    ``cubic``: the trajectory is one polynomial of degree <= 3 there (a time-optimal move's
+    phase, a hold). Piece ends are rounded to the ms (a cubic Hermite across a break at
+    most 0.5 ms off is within nanometres); pieces shorter than :data:`MIN_CUBIC_MS` are
+    merged into the span after them, which is then not exact (and bisected if needed).
+    """
+    breaks, cubic = _cubic_breaks(traj)
+    ms = np.round(np.asarray(breaks) * 1000).astype(np.int64)
+    spans: list[tuple[int, int, bool]] = []
+    start = 0
+    for k in range(len(cubic)):
+        end = int(min(ms[k + 1], total_ms))
+        if end - start < MIN_CUBIC_MS and k + 1 < len(cubic):
+            continue  # too short for its own segment: joins the next span
+        exact = cubic[k] and end - start == int(ms[k + 1] - ms[k])
+        spans.append((start, end, exact))
+        start = end
+    if start < total_ms:  # the end rounded up: held
+        spans.append((start, total_ms, False))
+    return [span for span in spans if span[1] > span[0]]
+
+
+def _cubic_breaks(traj: Trajectory) -> tuple[list[float], list[bool]]:
+    """Break times (s) and, per span between them, whether it is one cubic polynomial."""
+    if isinstance(traj, PiecewisePolynomial):
+        cubic = traj.coeffs.shape[1] <= 4
+        breaks = list(np.asarray(traj.breaks, dtype=float)) if cubic else [0.0, traj.duration]
+        return breaks, [cubic] * (len(breaks) - 1)
+    if isinstance(traj, RestToRestSequence):
+        breaks, flags = [0.0], []
+        for offset, piece in zip(traj.starts, traj.pieces, strict=False):
+            inner, inner_flags = _cubic_breaks(piece)
+            breaks.extend(float(offset) + b for b in inner[1:])
+            flags.extend(inner_flags)
+        return breaks, flags
+    return [0.0, traj.duration], [False]
 
 
 def _fit(traj: Trajectory, tolerance: float) -> tuple[NDArray[np.int64], FloatArray, float]:
     """Boundaries (ms), unrounded Bézier points (m) and largest error (m), bisected to fit."""
-    times = _boundaries(traj.duration)
+    times = _boundaries(traj)
     while True:
         ctrl = _hermite(traj, times)
         err = _errors(traj, times, ctrl)

@@ -9,8 +9,8 @@ cubic pieces, writing flights as splines), at rest where the pieces meet.
 
 Lights: on while a drone holds a formation (the scene's colour), while it
 writes (the pen windows of its writing flight), and in a ``hold`` that names a
-colour; off otherwise. :attr:`DroneShow.colors` holds one RGB per window of
-``pen_windows_s``.
+colour; off otherwise. Each drone's ``pen_rgb`` holds one RGB per window of
+``pen_windows_s`` (what the ``.skyc`` lights show).
 """
 
 from __future__ import annotations
@@ -64,22 +64,6 @@ Progress = Callable[[int, int, str], None]
 
 
 @dataclass(frozen=True)
-class DroneShow:
-    """One drone's flight and light program.
-
-    Attributes
-    ----------
-    planned
-        Its trajectory on the show clock, the windows its light is on, the limits.
-    colors
-        One RGB per window of ``planned.pen_windows_s``, 0..255 each.
-    """
-
-    planned: PlannedTrajectory
-    colors: tuple[RGB, ...]
-
-
-@dataclass(frozen=True)
 class ShowPlan:
     """A planned show.
 
@@ -97,7 +81,7 @@ class ShowPlan:
         Smallest guaranteed distance over the transitions and writing, m.
     """
 
-    drones: tuple[DroneShow, ...]
+    drones: tuple[PlannedTrajectory, ...]
     homes: FloatArray
     scenes: tuple[dict[str, Any], ...]
     stage_times_s: dict[str, float]
@@ -106,7 +90,7 @@ class ShowPlan:
     @property
     def duration_s(self) -> float:
         """Length of the show, s."""
-        return max(d.planned.trajectory.duration for d in self.drones)
+        return max(d.trajectory.duration for d in self.drones)
 
 
 @dataclass
@@ -340,7 +324,7 @@ def _prove(flights: list[Trajectory], horizon: float, safety: float) -> float:
     return separation.lower_bound_m
 
 
-def _compose(drone: _Drone, script: ShowScript) -> DroneShow:
+def _compose(drone: _Drone, script: ShowScript) -> PlannedTrajectory:
     """One trajectory of the drone's pieces: runs of polynomials merged, splines kept."""
     runs: list[Trajectory] = []
     batch: list[PiecewisePolynomial] = []
@@ -354,12 +338,12 @@ def _compose(drone: _Drone, script: ShowScript) -> DroneShow:
         runs.append(piece)
     if batch:
         runs.append(_merged(batch))
-    planned = PlannedTrajectory(
+    return PlannedTrajectory(
         concatenate(runs),
         tuple(drone.windows),
         script.limits.derivative_limits(3),
+        tuple(drone.colors),
     )
-    return DroneShow(planned, tuple(drone.colors))
 
 
 def _merged(pieces: list[PiecewisePolynomial]) -> PiecewisePolynomial:

@@ -15,7 +15,7 @@ from typing import cast
 
 import numpy as np
 
-from skyquill.calligraphy.board import Board
+from skyquill.calligraphy.board import Board, sky_board
 from skyquill.calligraphy.mission import WritingOptions
 from skyquill.calligraphy.show import Job, Progress, plan_jobs
 from skyquill.errors import InputError
@@ -23,8 +23,6 @@ from skyquill.show.script import ShowScript, WriteScene
 from skyquill.trajectory import Trajectory
 from skyquill.validation import FloatArray
 
-#: Brush lift between strokes on the writing boards, m (the light is off then).
-LIFT_M = 0.05
 #: Extra room between writing boards beyond the safety distance, m.
 BOARD_MARGIN_M = 0.5
 
@@ -54,15 +52,16 @@ class Writing:
 
 
 def writing_boards(count: int, scene: WriteScene, safety_m: float) -> list[Board]:
-    """The writing boards of a scene: vertical, facing -y, in rows of ``scene.columns``.
+    """The writing boards of a scene: sky boards facing -y, in rows of ``scene.columns``.
 
     Board ``k`` is at ``origin + pitch (k mod columns, 0, k div columns)``
-    with ``pitch = size + safety_m + BOARD_MARGIN_M``. This is the one place
-    where the writing surface is chosen (a sky board can replace the wall here).
+    with ``pitch = size + safety_m + BOARD_MARGIN_M``. Light painting: no contact,
+    the transits stay in the plane, and paper 003's plane cost keeps the drawing
+    on it (:func:`skyquill.calligraphy.board.sky_board`).
     """
     pitch = scene.size_m + safety_m + BOARD_MARGIN_M
     cells = [np.array([k % scene.columns, 0.0, k // scene.columns]) for k in range(count)]
-    return [Board("wall", scene.origin + pitch * cell, LIFT_M) for cell in cells]
+    return [sky_board(scene.origin + pitch * cell) for cell in cells]
 
 
 def writer_count(scene: WriteScene) -> int:
