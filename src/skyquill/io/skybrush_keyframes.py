@@ -217,7 +217,8 @@ def skybrush_keyframes(traj: Trajectory, tolerance: float = FIT_TOLERANCE_M) -> 
     traj
         Any 3-D trajectory, z-up world frame (Skybrush's show frame), m, from 0 s.
     tolerance
-        Largest distance of the cubics from ``traj`` before rounding to the grid, m.
+        Largest distance of the cubics from ``traj`` before rounding to the grid, m, for
+        Skybrush's millimetre unit; times its unit where that is coarser.
 
     Returns
     -------
@@ -233,7 +234,11 @@ def skybrush_keyframes(traj: Trajectory, tolerance: float = FIT_TOLERANCE_M) -> 
     tolerance = as_float("tolerance", tolerance, positive=True)
     if traj.dim != 3:
         raise InputError(f"traj: got a {traj.dim}-D trajectory, expected 3-D (x, y, z up)")
-    times, ctrl, fit_error = _fit(traj, tolerance)
+    # Far from the origin Skybrush's unit is ``scale`` mm (3 mm for a 100 m show): a fit
+    # finer than half a unit buys nothing after rounding, and the bisection it would need
+    # makes short segments, where the rounding moves the acceleration most.
+    coarse = scaling_factor(traj.evaluate(np.linspace(0.0, traj.duration, 1001)))
+    times, ctrl, fit_error = _fit(traj, tolerance * coarse)
     # A keyframe is the same number in both its segments, so it rounds to the same unit.
     scale = 1
     for _ in range(SCALE_ROUNDS):
