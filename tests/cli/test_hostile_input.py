@@ -285,7 +285,7 @@ OPTION_CASES = [
     ("cover --width 50", _cover("--width", "50"), "width"),
     ("cover --epsilon 2", _cover("--epsilon", "2"), "epsilon"),
     ("cover --delta 0", _cover("--delta", "0"), "delta"),
-    ("cover --min-coverage 1.5", _cover("--min-coverage", "1.5"), "min_coverage"),
+    ("cover --min-coverage 1.5", _cover("--min-coverage", "1.5"), "--min-coverage"),
     ("cover --contours wavy", _cover("--contours", "wavy"), "contours"),
     ("cover --drift sideways", _cover("--drift", "sideways"), "drift"),
     ("cover norms and axes", _cover("--amax", "5", "--amax-axis", "5"), "got both"),
@@ -383,6 +383,47 @@ CASES.append(
         setup=_plan,
     )
 )
+# -- Show scripts, pictures and light painting -------------------------------------------------
+SMALL_SHOW = (EXAMPLES / "show_small.toml").read_text()
+
+
+def _show(edit: tuple[str, str] | None = None, raw: bytes | None = None) -> Callable[[Path], None]:
+    """A show script in {tmp}/s.toml: the small example edited, or raw bytes."""
+    text = SMALL_SHOW if edit is None else SMALL_SHOW.replace(*edit, 1)
+    return _write("s.toml", raw if raw is not None else text)
+
+
+SHOW = ["show", "{tmp}/s.toml", "--out", "{out}"]
+SHOW_CASES = [
+    ("binary", _show(raw=bytes(range(256)) * 8), "TOML"),
+    ("utf-16", _show(raw=SMALL_SHOW.encode("utf-16")), "not UTF-8"),
+    ("500 drones", _show(("drones = 10", "drones = 500")), "expected an integer from 1 to 200"),
+    ("hold a day", _show(("hold = 3.0", "hold = 86400")), "holding"),
+    ("stagger 1e9", _show(("stagger = 1.0", "stagger = 1e9")), "holding"),
+    ("altitude 1e4", _show(("altitude = 3.0", "altitude = 1e4")), "altitude: got 10000 m"),
+    ("radius 1e6", _show(("radius = 4.0", "radius = 1e6")), "radius: got 1e+06 m"),
+    ("far origin", _show(("[-3.0, -6.0, 6.0]", "[1e300, 0, 6.0]")), "within 10000 m"),
+    ("rate 1e9", _show(("rate = 20", "rate = 1e9")), "rate: got 1e+09 Hz"),
+    ("scene type a list", _show(('type = "write"', 'type = ["write"]')), "type"),
+    ("nan size", _show(("size = 1.5", "size = nan")), "size"),
+    ("unknown key", _show(("hold = 3.0", "hold = 3.0\nsparkle = true")), "sparkle"),
+]
+for label, setup, message in SHOW_CASES:
+    CASES.append(Case(f"show {label}", SHOW, message, setup=setup))
+RENDER = ["render", "{tmp}/traj.csv", "--out", "{out}"]
+CASES.extend(
+    [
+        Case("render --trail nan", [*RENDER, "--trail", "nan"], "--trail", setup=WITH_TRAJ),
+        Case("render --fov 180", [*RENDER, "--fov", "180"], "fov_deg", setup=WITH_TRAJ),
+        Case("render --light 1,2", [*RENDER, "--light", "1,2"], "--light", setup=WITH_TRAJ),
+        Case("render absent", ["render", "{tmp}/none", "--out", "{out}"], "none"),
+        Case("write --board-tilt 90", _write_cmd("--board", "sky", "--board-tilt", "90"), "tilt"),
+        Case("write --grid 0x3", _write_cmd("--board", "sky", "--grid", "0x3"), "--grid"),
+        Case("write --light-color red", _write_cmd("--light-color", "red"), "--light-color"),
+        Case("write --split words", _write_cmd("--split", "words"), "--split"),
+    ]
+)
+
 OVER_INPUT = ["export", "{tmp}/traj.csv", "--out", "{tmp}/traj.csv"]
 CASES.append(Case("export over its own input", OVER_INPUT, "inputs", setup=WITH_TRAJ))
 

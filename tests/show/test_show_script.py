@@ -2,9 +2,13 @@
 
 from __future__ import annotations
 
+import contextlib
 from pathlib import Path
 
 import pytest
+import tomli_w
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from skyquill.errors import InputError
 from skyquill.show.script import (
@@ -75,4 +79,46 @@ def test_colours_and_defaults() -> None:
 )  # fmt: skip
 def test_bad_scripts_are_refused_naming_what(text: str, message: str) -> None:
     with pytest.raises(InputError, match=message):
+        parse_script(text)
+
+
+_VALUES = st.recursive(
+    st.none()
+    | st.booleans()
+    | st.integers(-(10**12), 10**12)
+    | st.floats(allow_nan=True, allow_infinity=True)
+    | st.text(max_size=8),
+    lambda inner: (
+        st.lists(inner, max_size=4) | st.dictionaries(st.text(max_size=6), inner, max_size=4)
+    ),
+    max_leaves=12,
+)
+_KEYS = st.sampled_from(
+    ["type", "shape", "hold", "color", "origin", "center", "size", "text", "radius", "columns",
+     "spacing", "duration", "altitude", "stagger", "drones", "font"]
+)  # fmt: skip
+
+
+@settings(max_examples=150, deadline=None)
+@given(
+    scene=st.dictionaries(_KEYS, _VALUES, max_size=6),
+    show=st.dictionaries(
+        st.sampled_from(["drones", "safety_distance", "home_spacing", "rate", "home_origin"]),
+        _VALUES,
+        max_size=4,
+    ),
+)
+def test_random_scripts_give_a_script_or_an_input_error(
+    scene: dict[str, object], show: dict[str, object]
+) -> None:
+    """Hostile values anywhere in a script: parsed, or refused with an InputError, nothing else."""
+    data = {
+        "show": show,
+        "scene": [{"type": "takeoff"}, scene, {"type": "land"}],
+    }
+    try:
+        text = tomli_w.dumps(data)
+    except (TypeError, ValueError):
+        return  # not representable in TOML (None, NaN keys...)
+    with contextlib.suppress(InputError):
         parse_script(text)

@@ -14,6 +14,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from skyquill.errors import InputError
 from skyquill.io.skybrush_lights import check_rgb
 from skyquill.limits import VehicleLimits
@@ -21,7 +23,22 @@ from skyquill.validation import FloatArray, as_array, as_float, as_int
 
 RGB = tuple[int, int, int]
 #: Most drones in one show: every pair's transitions are proven apart (n^2 / 2 pairs).
-MAX_DRONES = 500
+#: Measured (bench/show.py): 100 drones plan, prove and write in 43 s, growing about
+#: linearly; 200 is the ceiling a user waits a few minutes for.
+MAX_DRONES = 200
+#: Most scenes, and the longest a show may hold still in all (holds, formations' holds,
+#: take-off and landing staggers), s: the CSVs and the check grow with the show's length.
+MAX_SCENES = 64
+MAX_HOLDING_S = 3600.0
+#: Largest size, radius or spacing of a formation or writing, m, and highest altitude,
+#: m (the show's check refuses a drone above 120 m; it is refused before planning here).
+MAX_EXTENT_M = 1000.0
+MAX_ALTITUDE_M = 120.0
+#: Farthest a point of the script may be from the show's origin, m (Skybrush's units
+#: stay within a few mm up to here).
+MAX_COORDINATE_M = 10_000.0
+#: Highest CSV rate, Hz.
+MAX_RATE_HZ = 100.0
 #: Largest script read, bytes.
 MAX_BYTES = 1_000_000
 #: Shapes a formation scene can take.
@@ -145,7 +162,13 @@ def _color(where: str, value: Any) -> RGB:
 
 
 def _point(where: str, value: Any, n: int = 3) -> FloatArray:
-    return as_array(where, value, shape=(n,))
+    point = as_array(where, value, shape=(n,))
+    if np.abs(point).max() > MAX_COORDINATE_M:
+        raise InputError(
+            f"{where}: got {point.tolist()}, expected coordinates within "
+            f"{MAX_COORDINATE_M:g} m of the show's origin"
+        )
+    return point
 
 
 def _number(where: str, value: Any, *, positive: bool = True) -> float:
@@ -163,7 +186,7 @@ def _text(where: str, value: Any) -> str:
 def _takeoff(t: dict[str, Any], where: str) -> Takeoff:
     _known(t, where, ("type", "altitude", "stagger"))
     return Takeoff(
-        _number(f"{where}.altitude", t.get("altitude", 3.0)),
+        _at_most(f"{where}.altitude", t.get("altitude", 3.0), MAX_ALTITUDE_M, "m"),
         _number(f"{where}.stagger", t.get("stagger", 1.0), positive=False),
     )
 
@@ -171,7 +194,7 @@ def _takeoff(t: dict[str, Any], where: str) -> Takeoff:
 def _land(t: dict[str, Any], where: str) -> Land:
     _known(t, where, ("type", "altitude", "stagger"))
     return Land(
-        _number(f"{where}.altitude", t.get("altitude", 3.0)),
+        _at_most(f"{where}.altitude", t.get("altitude", 3.0), MAX_ALTITUDE_M, "m"),
         _number(f"{where}.stagger", t.get("stagger", 1.0), positive=False),
     )
 
@@ -194,7 +217,7 @@ FORMATION_KEYS = (
 def _formation(t: dict[str, Any], where: str, base: Path) -> FormationScene:
     _known(t, where, FORMATION_KEYS)
     shape = t.get("shape")
-    if shape not in SHAPES:
+    if not isinstance(shape, str) or shape not in SHAPES:
         raise InputError(f"{where}.shape: got {shape!r}, expected one of {', '.join(SHAPES)}")
     place = "center" if shape == "circle" else "origin"
     if place not in t:
@@ -207,13 +230,15 @@ def _formation(t: dict[str, Any], where: str, base: Path) -> FormationScene:
         hold_s=_number(f"{where}.hold", t.get("hold", 2.0), positive=False),
         color=_color(f"{where}.color", t.get("color", [255, 255, 255])),
         origin=_point(f"{where}.{place}", t[place]),
-        size_m=_number(f"{where}.size", t.get("size", 20.0)),
+        size_m=_at_most(f"{where}.size", t.get("size", 20.0), MAX_EXTENT_M, "m"),
         text=text,
         font=str(t.get("font", "futural")),
         svg=svg,
         columns=as_int(f"{where}.columns", t.get("columns", 10), low=1),
-        spacing_m=None if spacing is None else _number(f"{where}.spacing", spacing),
-        radius_m=_number(f"{where}.radius", t.get("radius", 10.0)),
+        spacing_m=None
+        if spacing is None
+        else _at_most(f"{where}.spacing", spacing, MAX_EXTENT_M, "m"),
+        radius_m=_at_most(f"{where}.radius", t.get("radius", 10.0), MAX_EXTENT_M, "m"),
     )
 
 
@@ -226,7 +251,7 @@ def _write(t: dict[str, Any], where: str) -> WriteScene:
         text=_text(f"{where}.text", t.get("text")),
         color=_color(f"{where}.color", t.get("color", [255, 255, 255])),
         origin=_point(f"{where}.origin", t["origin"]),
-        size_m=_number(f"{where}.size", t.get("size", 2.0)),
+        size_m=_at_most(f"{where}.size", t.get("size", 2.0), MAX_EXTENT_M, "m"),
         drones=None if drones is None else as_int(f"{where}.drones", drones, low=1),
         columns=as_int(f"{where}.columns", t.get("columns", 5), low=1),
         font=str(t.get("font", "futural")),
@@ -246,7 +271,7 @@ def _scene(t: Any, where: str, base: Path) -> Scene:
     if not isinstance(t, dict):
         raise InputError(f"{where}: got {type(t).__name__}, expected a table")
     kind = t.get("type")
-    if kind not in _SCENES:
+    if not isinstance(kind, str) or kind not in _SCENES:
         raise InputError(f"{where}.type: got {kind!r}, expected one of {', '.join(_SCENES)}")
     return _SCENES[kind](t, where, base)
 
@@ -271,8 +296,11 @@ def parse_script(text: str, base: Path = Path()) -> ShowScript:
     raw = data.get("scene", [])
     if not isinstance(raw, list) or not raw:
         raise InputError("[[scene]]: got none, expected a list of scenes, takeoff first")
+    if len(raw) > MAX_SCENES:
+        raise InputError(f"[[scene]]: got {len(raw)} scenes, expected at most {MAX_SCENES}")
     scenes = tuple(_scene(t, f"scene[{i}]", base) for i, t in enumerate(raw))
     _check_order(scenes)
+    _check_work(scenes, show.get("drones"))
     safety = _number("[show].safety_distance", show.get("safety_distance", 3.0))
     return ShowScript(
         drones=as_int("[show].drones", show.get("drones"), low=1, high=MAX_DRONES),
@@ -287,13 +315,46 @@ def parse_script(text: str, base: Path = Path()) -> ShowScript:
             amax=_number("[limits].amax", limits.get("amax", 2.0)),
             jmax=_number("[limits].jmax", limits.get("jmax", 10.0)),
         ),
-        rate_hz=_number("[show].rate", show.get("rate", 20.0)),
+        rate_hz=_at_most("[show].rate", show.get("rate", 20.0), MAX_RATE_HZ, "Hz"),
         scenes=scenes,
         base=base,
     )
 
 
 SHOW_KEYS = ("drones", "safety_distance", "home_spacing", "home_origin", "rate")
+
+
+def _at_most(where: str, value: Any, high: float, unit: str) -> float:
+    """A positive number at most ``high`` (``unit``); :class:`InputError` otherwise."""
+    number = _number(where, value)
+    if number > high:
+        raise InputError(f"{where}: got {number:g} {unit}, expected at most {high:g} {unit}")
+    return number
+
+
+def _extent(where: str, value: Any) -> float:
+    return _at_most(where, value, MAX_EXTENT_M, "m")
+
+
+def _check_work(scenes: tuple[Scene, ...], drones: Any) -> None:
+    """Refuse, before planning, a show that would hold still longer than :data:`MAX_HOLDING_S`.
+
+    Take-off and landing hold each row of pads ``stagger`` s after the one before.
+    """
+    rows = math.isqrt(max(1, drones if isinstance(drones, int) else 1)) + 1
+    holding = 0.0
+    for scene in scenes:
+        if isinstance(scene, Takeoff | Land):
+            holding += scene.stagger_s * rows
+        elif isinstance(scene, FormationScene):
+            holding += scene.hold_s
+        elif isinstance(scene, Hold):
+            holding += scene.duration_s
+    if holding > MAX_HOLDING_S:
+        raise InputError(
+            f"show script: got {holding:g} s of holding (holds, staggers), expected at most "
+            f"{MAX_HOLDING_S:g} s in one show"
+        )
 
 
 def _check_order(scenes: tuple[Scene, ...]) -> None:
