@@ -118,7 +118,9 @@ def test_polytope_norm_limits() -> None:
 def test_separation_violation_is_an_error() -> None:
     a = SplineTrajectory(np.zeros((6, 3)), 5, 1.0)
     b = SplineTrajectory(np.tile([0.5, 0.0, 0.0], (6, 1)), 5, 2.0)
-    with pytest.raises(InfeasibleError, match=r"drones 0 and 1 come within 0\.500 m"):
+    with pytest.raises(
+        InfeasibleError, match=r"separation: drone 0 and drone 1 come within 0\.500 m"
+    ):
         check_separation([a, b], 1.0)
     assert check_separation([a, b], 0.4) == pytest.approx(0.5)
 

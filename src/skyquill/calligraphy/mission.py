@@ -1097,20 +1097,12 @@ def check_separation(
     Drones that finish early hold their last position (landed at home).
     ``rate_hz`` is kept for callers and no longer used.
     """
-    from skyquill.show import ShowDrone, separation_of
+    from skyquill.show import ShowDrone, require_separation
 
     minimum = as_float("minimum_m", minimum_m, positive=True)
     as_float("rate_hz", rate_hz, positive=True)
     drones = [ShowDrone(tr, f"drone {i}") for i, tr in enumerate(trajectories)]
-    result = separation_of(drones, minimum)
-    if not result.passed:
-        e = result.encounters[0]
-        raise InfeasibleError(
-            f"separation: drones {e.drones[0]} and {e.drones[1]} come within {e.closest_m:.3f} m "
-            f"at t = {e.first_time_s:.2f} s, expected at least {minimum:g} m",
-            ("separation",),
-        )
-    return result.lower_bound_m
+    return require_separation(drones, minimum, "separation").lower_bound_m
 
 
 #: How far the simulated board is raised into the planned tip's path when the

@@ -9,7 +9,7 @@
 * :mod:`.check` -- all of it on one show.
 """
 
-from skyquill.show.check import MIN_DISTANCE_M, check_show, separation_of
+from skyquill.show.check import MIN_DISTANCE_M, check_show, require_separation, separation_of
 from skyquill.show.geofence import Geofence, read_geofence
 from skyquill.show.limits import ShowLimits
 from skyquill.show.load import ShowDrone, load_show
@@ -30,5 +30,6 @@ __all__ = [
     "guaranteed_separation",
     "load_show",
     "read_geofence",
+    "require_separation",
     "separation_of",
 ]

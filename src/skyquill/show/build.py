@@ -26,8 +26,8 @@ from numpy.typing import NDArray
 from scipy.optimize import linear_sum_assignment
 from scipy.spatial.distance import cdist
 
-from skyquill.errors import InfeasibleError
 from skyquill.io.trajectory_json import PlannedTrajectory
+from skyquill.show.check import require_separation
 from skyquill.show.formation import (
     Formation,
     circle_formation,
@@ -35,7 +35,7 @@ from skyquill.show.formation import (
     home_grid,
     shape_formation,
 )
-from skyquill.show.motion import motion_of
+from skyquill.show.load import ShowDrone
 from skyquill.show.moves import hold, staggered
 from skyquill.show.route import leg_limits, plan_moves, route_to
 from skyquill.show.script import (
@@ -48,7 +48,6 @@ from skyquill.show.script import (
     Takeoff,
     WriteScene,
 )
-from skyquill.show.separation import guaranteed_separation
 from skyquill.show.transition import Transition
 from skyquill.show.writing import plan_writing_scene
 from skyquill.trajectory import PiecewisePolynomial, Trajectory, concatenate
@@ -301,7 +300,7 @@ def _write(scene: WriteScene, script: ShowScript, line: _Timeline, where: _Where
         flights[i] = writing.flights[k]
         for a, b in writing.pen_windows[k]:
             line.light(int(i), begin + a, begin + b, scene.color)
-    line.closest = min(line.closest, _prove(flights, duration, script.safety_m))
+    line.closest = min(line.closest, _prove(flights, script.safety_m))
     line.append(flights, duration)
     # Back to their places: the formation is whole again, and the next transition
     # starts from it (formations on one plane always transition: delays or layers).
@@ -309,19 +308,11 @@ def _write(scene: WriteScene, script: ShowScript, line: _Timeline, where: _Where
     return {"text": scene.text, "writers": len(writing.flights), "duration_s": duration}
 
 
-def _prove(flights: list[Trajectory], horizon: float, safety: float) -> float:
+def _prove(flights: list[Trajectory], safety: float) -> float:
     """The guaranteed closest approach of ``flights`` (all from 0); refused below ``safety``."""
-    motions = [motion_of(f"drone {i}", f, horizon) for i, f in enumerate(flights)]
-    separation = guaranteed_separation(motions, safety)
-    if not separation.passed:
-        e = separation.encounters[0]
-        raise InfeasibleError(
-            f"write: drone {e.drones[0]} and drone {e.drones[1]} come within "
-            f"{e.closest_m:.3f} m at t = {e.closest_time_s:.2f} s of the writing, expected at "
-            f"least {safety:g} m (move the boards away from the drones that hold)",
-            ("separation",),
-        )
-    return separation.lower_bound_m
+    drones = [ShowDrone(f, f"drone {i}") for i, f in enumerate(flights)]
+    hint = " (move the boards away from the drones that hold)"
+    return require_separation(drones, safety, "write", hint).lower_bound_m
 
 
 def _compose(drone: _Drone, script: ShowScript) -> PlannedTrajectory:

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-from skyquill.errors import InputError
+from skyquill.errors import InfeasibleError, InputError
 from skyquill.show.limits import ShowLimits, check_limits, check_start
 from skyquill.show.load import ShowDrone
 from skyquill.show.motion import motion_of
@@ -25,6 +25,29 @@ def separation_of(drones: Sequence[ShowDrone], min_distance_m: float) -> Separat
     horizon = max(d.end_s for d in drones)
     motions = [motion_of(d.name, d.trajectory, horizon, d.start_s) for d in drones]
     return guaranteed_separation(motions, min_distance_m)
+
+
+def require_separation(
+    drones: Sequence[ShowDrone], minimum_m: float, what: str, hint: str = ""
+) -> Separation:
+    """:func:`separation_of`, refused below ``minimum_m``.
+
+    Raises
+    ------
+    InfeasibleError
+        Naming ``what`` (the stage: ``"transition"``, ``"write"``...), the closest pair
+        by their names, how close and when, and ``hint`` (what to change), if any.
+    """
+    result = separation_of(drones, minimum_m)
+    if not result.passed:
+        e = result.encounters[0]
+        first, second = (drones[k].name for k in e.drones)
+        raise InfeasibleError(
+            f"{what}: {first} and {second} come within {e.closest_m:.3f} m at "
+            f"t = {e.closest_time_s:.2f} s, expected at least {minimum_m:g} m{hint}",
+            ("separation",),
+        )
+    return result
 
 
 def check_show(

@@ -38,9 +38,9 @@ from scipy.spatial.distance import cdist
 
 from skyquill.errors import InfeasibleError, InputError
 from skyquill.optimize.legs import LegLimits
-from skyquill.show.motion import motion_of
+from skyquill.show.check import require_separation
+from skyquill.show.load import ShowDrone
 from skyquill.show.moves import STILL_M, Moves, flight, profile, scheduled
-from skyquill.show.separation import guaranteed_separation
 from skyquill.show.waves import Allowed, allowed, closest_on_segments, colours, order_waves
 from skyquill.trajectory import PiecewisePolynomial
 from skyquill.validation import FloatArray, as_array, as_float
@@ -223,19 +223,8 @@ def _layered(
 
 def _proven(planned: Transition, d: float, label: Sequence[str]) -> Transition:
     """``planned`` with its guaranteed closest approach; refused if below ``d``."""
-    horizon = planned.duration
-    motions = [
-        motion_of(label[k], planned.trajectory(k), horizon) for k in range(len(planned.starts))
-    ]
-    separation = guaranteed_separation(motions, d)
-    if not separation.passed:
-        e = separation.encounters[0]
-        raise InfeasibleError(
-            f"transition: {label[e.drones[0]]} and {label[e.drones[1]]} come within "
-            f"{e.closest_m:.3f} m at t = {e.closest_time_s:.2f} s of the transition, "
-            f"expected at least {d:g} m",
-            ("separation",),
-        )
+    drones = [ShowDrone(planned.trajectory(k), label[k]) for k in range(len(planned.starts))]
+    separation = require_separation(drones, d, "transition")
     return Transition(
         planned.starts, planned.goals, planned.legs, planned.layers, separation.lower_bound_m
     )
