@@ -87,3 +87,12 @@ def test_no_drone_and_a_negative_trail_are_refused(tmp_path: Path) -> None:
         long_exposure([], CAMERA, tmp_path / "x.png")
     with pytest.raises(InputError, match="trail_s"):
         animate_show(_drones(), CAMERA, tmp_path / "x.gif", trail_s=-1.0)
+
+
+def test_a_light_held_still_is_a_dot(tmp_path: Path) -> None:
+    """A drone lit while it holds a formation place leaves a dot, not nothing."""
+    still = PlannedTrajectory(_line([0.5, 0.0, 2.0], [0.5, 0.0, 2.0]), ((0.0, 4.0),), (), (RED,))
+    long_exposure([still], CAMERA, tmp_path / "dot.png")
+    image = np.asarray(Image.open(tmp_path / "dot.png").convert("RGB")).astype(int)
+    u, v = _pixel([0.5, 0.0, 2.0])
+    assert image[v - 1 : v + 2, u - 1 : u + 2, 0].max() > 150

@@ -117,6 +117,14 @@ def _segments(camera: Camera, points: FloatArray) -> FloatArray:
     return np.stack([uv[:-1], uv[1:]], axis=1)[keep]
 
 
+def _extent_px(segs: FloatArray) -> float:
+    """Largest side of the image box of ``segs`` (M, 2, 2), px; inf when none is visible."""
+    if segs.size == 0:
+        return math.inf
+    points = segs.reshape(-1, 2)
+    return float(np.max(points.max(axis=0) - points.min(axis=0)))
+
+
 def _black_figure(camera: Camera) -> tuple[Figure, Axes]:
     fig = plt.figure(figsize=(camera.width_px / DPI, camera.height_px / DPI), dpi=DPI)
     fig.patch.set_facecolor("black")
@@ -164,6 +172,9 @@ def long_exposure(
             ax.add_collection(
                 LineCollection(list(segs), colors=[core], linewidths=width, alpha=alpha)
             )
+            if _extent_px(segs) < width:  # a light held still (a formation): a dot
+                u, v = segs.reshape(-1, 2).mean(axis=0)
+                ax.scatter(u, v, s=(1.6 * width) ** 2, color=[core], alpha=alpha, lw=0)
     fig.savefig(path, dpi=DPI, facecolor="black")
     plt.close(fig)
     length = sum(float(np.linalg.norm(np.diff(p, axis=0), axis=1).sum()) for p, _ in lines)
