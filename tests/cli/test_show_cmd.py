@@ -11,6 +11,7 @@ from typer.testing import CliRunner
 
 from skyquill.cli.main import app
 from skyquill.io.plan_dir import read_plan
+from skyquill.io.skybrush_csv import read_csv_zip
 from skyquill.io.skybrush_lights import light_colors, light_slices, program_bytes
 from skyquill.io.skyc import read_show_json
 from skyquill.show import ShowDrone, check_show
@@ -57,6 +58,13 @@ def _files_and_summary(small: Path) -> None:
     assert summary["plan"]["max_excess"] <= 1e-6
     lights = summary["lights"][0]
     assert len(lights["rgb"]) == len(lights["windows_s"]) > 0
+    # Skybrush Studio's CSVs, read back as Studio reads them: the colours on their rows
+    studio = {d.name: d for d in read_csv_zip(small / "show.zip")}
+    assert len(studio) == 10 and summary["skybrush_csv"]["lights_exact_to_ms"]
+    rows = studio["trajectory_0"]
+    for (a, b), rgb in zip(lights["windows_s"], lights["rgb"], strict=True):
+        inside = (rows.t_ms > round(a * 1000)) & (rows.t_ms < round(b * 1000))
+        assert np.all(rows.colors[inside] == rgb)
 
 
 def _passes_the_independent_check(small: Path) -> None:

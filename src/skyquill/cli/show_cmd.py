@@ -122,6 +122,9 @@ def _write(
     skyc = _skyc(stage, plan, names, script)
     stages["skyc"] = time.perf_counter() - clock
     clock = time.perf_counter()
+    studio = _studio_csv(stage, plan, names, script)
+    stages["skybrush_csv"] = time.perf_counter() - clock
+    clock = time.perf_counter()
     pictures = write_pictures(plan.drones, stage)
     stages["pictures"] = time.perf_counter() - clock
     sep = report.separation
@@ -150,6 +153,7 @@ def _write(
             for n, d in zip(names, plan.drones, strict=True)
         ],
         "skyc": skyc,
+        "skybrush_csv": studio,
         "pictures": pictures,
     }
     clock = time.perf_counter()
@@ -157,6 +161,23 @@ def _write(
     full["planning_time_s"]["files"] = time.perf_counter() - clock
     write_json(stage / "summary.json", full)
     return full
+
+
+def _studio_csv(
+    stage: Path, plan: ShowPlan, names: list[str], script: ShowScript
+) -> dict[str, Any]:
+    """Write ``show.zip``, Skybrush Studio's per-drone CSVs, read back as Studio reads them."""
+    from skyquill.export.base import ExportOptions
+    from skyquill.export.skybrush_csv import SkybrushCsvExporter
+
+    plans = list(zip(names, plan.drones, strict=True))
+    exported = SkybrushCsvExporter()(plans, stage / "show", ExportOptions(script.rate_hz))
+    return {
+        "file": "show.zip",
+        "max_error_m": exported.max_error_m,
+        "lights_exact_to_ms": exported.details["lights_exact_to_ms"],
+        "rows": exported.details["rows"],
+    }
 
 
 def _skyc(stage: Path, plan: ShowPlan, names: list[str], script: ShowScript) -> dict[str, Any]:
