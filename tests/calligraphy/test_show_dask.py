@@ -35,16 +35,18 @@ def reference(parts: list[Strokes]) -> Show:
 
 
 def _assert_same(show: Show, reference: Show) -> None:
+    # Worker processes do not inherit this process's BLAS thread limit, so sums may be
+    # ordered differently: the same plan to 1e-9 m, not to the last bit.
     assert len(show.missions) == len(reference.missions)
     for got, want in zip(show.missions, reference.missions, strict=True):
-        assert got.trajectory.duration == pytest.approx(want.trajectory.duration, abs=1e-12)
+        assert got.trajectory.duration == pytest.approx(want.trajectory.duration, abs=1e-9)
         np.testing.assert_allclose(
-            got.trajectory.control_points, want.trajectory.control_points, rtol=0, atol=1e-12
+            got.trajectory.control_points, want.trajectory.control_points, rtol=0, atol=1e-9
         )
-        np.testing.assert_allclose(got.pen_windows, want.pen_windows, rtol=0, atol=1e-12)
+        np.testing.assert_allclose(got.pen_windows, want.pen_windows, rtol=0, atol=1e-9)
     for got_home, want_home in zip(show.homes, reference.homes, strict=True):
         np.testing.assert_array_equal(got_home, want_home)
-    assert show.min_separation_m == pytest.approx(reference.min_separation_m, abs=1e-12)
+    assert show.min_separation_m == pytest.approx(reference.min_separation_m, abs=1e-9)
     assert show.min_separation_m >= SEPARATION_M
 
 
