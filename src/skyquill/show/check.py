@@ -9,22 +9,25 @@ from skyquill.show.limits import ShowLimits, check_limits, check_start
 from skyquill.show.load import ShowDrone
 from skyquill.show.motion import motion_of
 from skyquill.show.report import ShowReport, Violation
-from skyquill.show.separation import Separation, guaranteed_separation
+from skyquill.show.separation import TOLERANCE_M, Separation, guaranteed_separation
 from skyquill.validation import as_float
 
 #: Skybrush's default distance between drones outdoors, m.
 MIN_DISTANCE_M = 3.0
 
 
-def separation_of(drones: Sequence[ShowDrone], min_distance_m: float) -> Separation:
+def separation_of(
+    drones: Sequence[ShowDrone], min_distance_m: float, tolerance_m: float = TOLERANCE_M
+) -> Separation:
     """The guaranteed closest approach of ``drones`` on the show clock.
 
     Drones wait at their start before their ``start_s`` and hold their last
-    position after they finish, until the last one has finished.
+    position after they finish, until the last one has finished. The bound is
+    refined to within ``tolerance_m`` of the closest distance seen (m).
     """
     horizon = max(d.end_s for d in drones)
     motions = [motion_of(d.name, d.trajectory, horizon, d.start_s) for d in drones]
-    return guaranteed_separation(motions, min_distance_m)
+    return guaranteed_separation(motions, min_distance_m, tolerance_m=tolerance_m)
 
 
 def require_separation(

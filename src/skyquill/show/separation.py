@@ -162,7 +162,11 @@ class _Closest:
 
 
 def guaranteed_separation(
-    motions: Sequence[Motion], minimum_m: float, *, step_s: float = STEP_S
+    motions: Sequence[Motion],
+    minimum_m: float,
+    *,
+    step_s: float = STEP_S,
+    tolerance_m: float = TOLERANCE_M,
 ) -> Separation:
     """The guaranteed closest approach of ``motions`` (all on one clock), against ``minimum_m``.
 
@@ -174,6 +178,8 @@ def guaranteed_separation(
         The distance two drones must keep, m, >= 0.
     step_s
         Grid step of the first pass, s.
+    tolerance_m
+        The bound is refined until it is this close to the closest distance seen, m.
 
     Raises
     ------
@@ -184,6 +190,7 @@ def guaranteed_separation(
     """
     minimum = as_float("minimum_m", minimum_m, nonneg=True)
     step = as_float("step_s", step_s, positive=True)
+    tolerance = as_float("tolerance_m", tolerance_m, positive=True)
     n = len(motions)
     first, second = np.triu_indices(n, 1)
     if n < 2:
@@ -201,7 +208,7 @@ def guaranteed_separation(
     )
     closest.record(grid.pair, grid.a, grid.da)
     closest.record(grid.pair, grid.b, grid.db)
-    lower, count = _refine(grid, motions, first, second, closest)
+    lower, count = _refine(grid, motions, (first, second), closest, tolerance)
     examined = np.unique(candidates[0]).size
     return _result(
         minimum=minimum,
@@ -305,9 +312,9 @@ def _relative(one: LocalMotion, two: LocalMotion, half_width: FloatArray) -> Flo
 def _refine(
     items: _Intervals,
     motions: Sequence[Motion],
-    first: IntArray,
-    second: IntArray,
+    pairs: tuple[IntArray, IntArray],
     closest: _Closest,
+    tolerance: float,
 ) -> tuple[tuple[float, int, float], int]:
     """Bisect until every interval is proven.
 
@@ -316,7 +323,6 @@ def _refine(
     """
     lower = (math.inf, -1, math.nan)
     count = items.a.size
-    tolerance = TOLERANCE_M
     while items.a.size:
         lb = items.lower()
         target = max(closest.minimum, closest.best - tolerance)
@@ -339,7 +345,7 @@ def _refine(
             # Stop tightening the bound: only what decides pass or fail is bisected.
             tolerance = math.inf
             continue
-        items = _split(items, motions, first, second, closest)
+        items = _split(items, motions, *pairs, closest)
         count += items.a.size
     return lower, count
 
