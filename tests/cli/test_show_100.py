@@ -1,7 +1,7 @@
 """Issue 18's must-show: the 100-drone show planned, proven, exported with lights, loaded back.
 
 ``examples/show_100.toml`` (take-off, the word SKY as a formation, five drones writing QUILL on
-sky boards while 95 hold, a transition to a grid, landing) through ``skyquill show``; then,
+sky boards while 95 hold, a transition to a circle, landing) through ``skyquill show``; then,
 from the files only: the minimum distance proven again by ``show.check_show`` (the code of
 ``skyquill check``, not the planner's) at or above the 3 m asked for over the whole show, the
 ``.skyc`` read back as Skybrush plays it with every drone's lights in the scenes' colours.
