@@ -21,13 +21,19 @@ from skyquill.calligraphy.mission import plan_writing
 from skyquill.export import EXPORTERS, ExportOptions
 from skyquill.export.base import NamedPlan
 from skyquill.io.skybrush_csv import read_csv_zip
-from skyquill.io.skybrush_lights import frame_windows, light_colors, light_slices, program_bytes
+from skyquill.io.skybrush_lights import colored_frames, light_colors, light_slices, program_bytes
 from skyquill.io.skyc import read_show_json, show_trajectories
 from skyquill.io.trajectory_json import PlannedTrajectory, pen_down
 from skyquill.limits import VehicleLimits
 from skyquill.strokes import hanzi_strokes
 from skyquill.trajectory import SplineTrajectory, dense_times
 from skyquill.verify import verify
+
+
+def frame_windows(windows: list[tuple[float, float]]) -> list[tuple[int, int]]:
+    """The light windows (20 ms frames) of pen windows of one colour."""
+    return [(a, b) for a, b, _ in colored_frames(windows, [(1, 1, 1)] * len(windows))]
+
 
 RGB = (255, 40, 0)
 #: The second drone writes the same character this far to the side, m.

@@ -9,13 +9,19 @@ from skyquill.errors import InputError
 from skyquill.io import skybrush_lights as lights
 from skyquill.io.skybrush_lights import (
     check_rgb,
+    colored_frames,
     encode_light_program,
-    frame_windows,
     light_colors,
     light_slices,
     lights_json,
     program_bytes,
 )
+
+
+def frame_windows(windows: list[tuple[float, float]]) -> list[tuple[int, int]]:
+    """The light windows (20 ms frames) of pen windows of one colour."""
+    return [(a, b) for a, b, _ in colored_frames(windows, [(1, 1, 1)] * len(windows))]
+
 
 RGB = (255, 40, 0)
 

@@ -99,12 +99,6 @@ def colored_frames(
     return out
 
 
-def frame_windows(windows_s: Sequence[tuple[float, float]]) -> list[tuple[int, int]]:
-    """Pen windows (s) of one colour as light windows on the 20 ms frame clock (merged)."""
-    white = ((255, 255, 255),) * len(windows_s)
-    return [(a, b) for a, b, _ in colored_frames(windows_s, white)]
-
-
 def _varuint(value: int) -> bytes:
     out = bytearray()
     while value >= 0x80:
