@@ -407,6 +407,7 @@ SHOW_CASES = [
     ("scene type a list", _show(('type = "write"', 'type = ["write"]')), "type"),
     ("nan size", _show(("size = 1.5", "size = nan")), "size"),
     ("unknown key", _show(("hold = 3.0", "hold = 3.0\nsparkle = true")), "sparkle"),
+    ("absent geofence", _show(("rate = 20", 'rate = 20\ngeofence = "none.wkt"')), "geofence"),
 ]
 for label, setup, message in SHOW_CASES:
     CASES.append(Case(f"show {label}", SHOW, message, setup=setup))

@@ -140,3 +140,24 @@ def test_a_missing_script_is_refused(tmp_path: Path) -> None:
     result = runner.invoke(app, ["show", str(tmp_path / "nope.toml"), "--out", str(tmp_path)])
     assert result.exit_code == 2
     assert "SHOW: got" in _one_error_line(result.output)
+
+
+@pytest.mark.parametrize(
+    ("fence", "status", "message"),
+    [
+        ("POLYGON ((-50 0, 50 0, 50 50, -50 50, -50 0))", 2,
+         "[show].geofence: got a fence that excludes the take-off pad of drone 0"),
+        ("POLYGON ((-10 -20, 10 -20, 10 -7, -10 -7, -10 -20))", 2,
+         "the check refuses the plan: geofence"),
+        ("POLYGON ((-50 -50, 50 -50, 50 50, -50 50, -50 -50))", 0, "no two closer than"),
+    ],
+)  # fmt: skip
+def test_a_geofence_in_the_script(tmp_path: Path, fence: str, status: int, message: str) -> None:
+    """Pads outside the fence: bad input before planning; a show that leaves it: refused."""
+    (tmp_path / "fence.wkt").write_text(fence)
+    text = (EXAMPLES / "show_small.toml").read_text()
+    script = tmp_path / "show.toml"
+    script.write_text(text.replace("[show]\n", '[show]\ngeofence = "fence.wkt"\n', 1))
+    result = runner.invoke(app, ["show", str(script), "--out", str(tmp_path / "out")])
+    assert result.exit_code == status, result.output
+    assert message in " ".join(result.output.split())

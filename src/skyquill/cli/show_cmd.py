@@ -90,6 +90,7 @@ def check_limits(script: ShowScript) -> ShowLimits:
         max_acceleration=lim.amax * (1.0 + CHECK_ROUND_OFF),
         min_altitude=None,
         max_altitude=120.0,
+        geofence=script.geofence,
     )
 
 

@@ -26,6 +26,7 @@ from numpy.typing import NDArray
 from scipy.optimize import linear_sum_assignment
 from scipy.spatial.distance import cdist
 
+from skyquill.errors import InputError
 from skyquill.io.trajectory_json import PlannedTrajectory
 from skyquill.show.check import require_separation
 from skyquill.show.formation import (
@@ -169,6 +170,7 @@ def build_show(
         spacing_m=script.home_spacing_m,
         safety_m=script.safety_m,
     )
+    _check_pads(homes, script)
     line = _Timeline(homes)
     times: dict[str, float] = {}
     records: list[dict[str, Any]] = []
@@ -306,6 +308,20 @@ def _write(scene: WriteScene, script: ShowScript, line: _Timeline, where: _Where
     # starts from it (formations on one plane always transition: delays or layers).
     _transition(line, places, script)
     return {"text": scene.text, "writers": len(writing.flights), "duration_s": duration}
+
+
+def _check_pads(homes: FloatArray, script: ShowScript) -> None:
+    """Refuse, before planning, a geofence that leaves a take-off pad outside (bad input)."""
+    if script.geofence is None:
+        return
+    outside = np.flatnonzero(script.geofence.margin(homes[:, :2]) < 0.0)
+    if outside.size:
+        x, y = homes[outside[0], :2]
+        raise InputError(
+            f"[show].geofence: got a fence that excludes the take-off pad of drone "
+            f"{outside[0]} at ({x:.3f}, {y:.3f}) m ({outside.size} pad(s) outside), expected "
+            "one around every pad (move [show].home_origin or the fence)"
+        )
 
 
 def _prove(flights: list[Trajectory], safety: float) -> float:

@@ -49,79 +49,81 @@ class Geofence:
         return np.asarray(np.where(inside, distance, -distance), dtype=float)
 
 
-def read_geofence(path: Path) -> Geofence:
+def read_geofence(path: Path, name: str = "--geofence") -> Geofence:
     """The geofence in ``path`` (GeoJSON, or WKT text); see the module docstring.
 
     Raises
     ------
     InputError
-        Naming ``--geofence``: a missing or unreadable file, malformed GeoJSON or
-        WKT, a geometry that is not one valid, non-empty polygon (or multipolygon),
-        a ceiling that is not a finite number.
+        Naming ``name`` (the option or key that gave the file): a missing or
+        unreadable file, malformed GeoJSON or WKT, a geometry that is not one valid,
+        non-empty polygon (or multipolygon), a ceiling that is not a finite number.
     """
     if not path.is_file():
-        raise InputError(f"--geofence: got {str(path)!r}, expected an existing GeoJSON or WKT file")
+        raise InputError(f"{name}: got {str(path)!r}, expected an existing GeoJSON or WKT file")
     raw = path.read_bytes()
     if len(raw) > MAX_BYTES:
-        raise InputError(f"--geofence: got {len(raw):,} bytes, expected at most {MAX_BYTES:,}")
+        raise InputError(f"{name}: got {len(raw):,} bytes, expected at most {MAX_BYTES:,}")
     text = raw.lstrip()
     if text.startswith(b"{"):
-        area, ceiling = _from_geojson(parse_json(raw, "--geofence", "a GeoJSON polygon"))
+        area, ceiling = _from_geojson(parse_json(raw, name, "a GeoJSON polygon"), name)
     else:
-        area, ceiling = _from_wkt(raw.decode("utf-8", errors="replace")), None
-    return Geofence(_checked(area), ceiling)
+        area, ceiling = _from_wkt(raw.decode("utf-8", errors="replace"), name), None
+    return Geofence(_checked(area, name), ceiling)
 
 
-def _from_geojson(data: Any) -> tuple[Any, float | None]:
+def _from_geojson(data: Any, name: str) -> tuple[Any, float | None]:
     if not isinstance(data, dict):
-        raise InputError(f"--geofence: got {type(data).__name__}, expected a GeoJSON object")
+        raise InputError(f"{name}: got {type(data).__name__}, expected a GeoJSON object")
     if data.get("type") == "FeatureCollection":
         features = data.get("features")
         if not isinstance(features, list) or len(features) != 1:
             count = len(features) if isinstance(features, list) else features
             raise InputError(
-                f"--geofence: got a FeatureCollection of {count!r} features, expected exactly one"
+                f"{name}: got a FeatureCollection of {count!r} features, expected exactly one"
             )
         data = features[0]
     ceiling = None
     if isinstance(data, dict) and data.get("type") == "Feature":
         properties = data.get("properties") or {}
-        ceiling = _ceiling(properties.get("ceiling_m") if isinstance(properties, dict) else None)
+        ceiling = _ceiling(
+            properties.get("ceiling_m") if isinstance(properties, dict) else None, name
+        )
         data = data.get("geometry")
     try:
         return shape(data), ceiling
     except (AttributeError, KeyError, TypeError, ValueError, IndexError) as exc:
         raise InputError(
-            f"--geofence: got a geometry shapely cannot read ({exc}), expected a GeoJSON Polygon"
+            f"{name}: got a geometry shapely cannot read ({exc}), expected a GeoJSON Polygon"
         ) from None
 
 
-def _ceiling(value: Any) -> float | None:
+def _ceiling(value: Any, name: str) -> float | None:
     if value is None:
         return None
     if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
-        raise InputError(f"--geofence: properties.ceiling_m: got {value!r:.40}, expected metres")
+        raise InputError(f"{name}: properties.ceiling_m: got {value!r:.40}, expected metres")
     return float(value)
 
 
-def _from_wkt(text: str) -> Any:
+def _from_wkt(text: str, name: str) -> Any:
     try:
         return shapely.from_wkt(text.strip())
     except shapely.errors.ShapelyError as exc:
         raise InputError(
-            f"--geofence: got text that is neither GeoJSON nor WKT ({exc}), expected a polygon"
+            f"{name}: got text that is neither GeoJSON nor WKT ({exc}), expected a polygon"
         ) from None
 
 
-def _checked(area: Any) -> Polygon | MultiPolygon:
+def _checked(area: Any, name: str) -> Polygon | MultiPolygon:
     if not isinstance(area, Polygon | MultiPolygon):
         raise InputError(
-            f"--geofence: got a {getattr(area, 'geom_type', type(area).__name__)}, expected a "
+            f"{name}: got a {getattr(area, 'geom_type', type(area).__name__)}, expected a "
             "Polygon or MultiPolygon"
         )
     if not area.is_empty and not area.is_valid:
         reason = shapely.is_valid_reason(area)
-        raise InputError(f"--geofence: got an invalid polygon ({reason}), expected a valid one")
+        raise InputError(f"{name}: got an invalid polygon ({reason}), expected a valid one")
     if area.is_empty or area.area <= 0.0:
-        raise InputError("--geofence: got an empty polygon, expected one enclosing an area")
+        raise InputError(f"{name}: got an empty polygon, expected one enclosing an area")
     return area

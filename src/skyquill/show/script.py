@@ -19,6 +19,7 @@ import numpy as np
 from skyquill.errors import InputError
 from skyquill.io.skybrush_lights import check_rgb
 from skyquill.limits import VehicleLimits
+from skyquill.show.geofence import Geofence, read_geofence
 from skyquill.validation import FloatArray, as_array, as_float, as_int
 
 RGB = tuple[int, int, int]
@@ -128,6 +129,9 @@ class ShowScript:
         Take-off first, landing last.
     base
         The folder the script's file names (an SVG) are relative to.
+    geofence
+        Where the drones may fly (``[show].geofence``: a GeoJSON or WKT file in the
+        show's metres, :func:`~skyquill.show.geofence.read_geofence`), or ``None``.
     """
 
     drones: int
@@ -138,6 +142,7 @@ class ShowScript:
     rate_hz: float
     scenes: tuple[Scene, ...]
     base: Path = field(default_factory=Path)
+    geofence: Geofence | None = None
 
 
 def _known(table: Any, where: str, known: tuple[str, ...]) -> dict[str, Any]:
@@ -318,10 +323,18 @@ def parse_script(text: str, base: Path = Path()) -> ShowScript:
         rate_hz=_at_most("[show].rate", show.get("rate", 20.0), MAX_RATE_HZ, "Hz"),
         scenes=scenes,
         base=base,
+        geofence=_geofence(show.get("geofence"), base),
     )
 
 
-SHOW_KEYS = ("drones", "safety_distance", "home_spacing", "home_origin", "rate")
+SHOW_KEYS = ("drones", "safety_distance", "home_spacing", "home_origin", "rate", "geofence")
+
+
+def _geofence(value: Any, base: Path) -> Geofence | None:
+    """``[show].geofence``: a file name relative to the script, read; ``None`` when absent."""
+    if value is None:
+        return None
+    return read_geofence(base / _text("[show].geofence", value), "[show].geofence")
 
 
 def _at_most(where: str, value: Any, high: float, unit: str) -> float:
