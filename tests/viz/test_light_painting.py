@@ -3,10 +3,13 @@
 from __future__ import annotations
 
 import math
+import tempfile
 from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from PIL import Image
 
 from skyquill.errors import InputError
@@ -96,3 +99,25 @@ def test_a_light_held_still_is_a_dot(tmp_path: Path) -> None:
     image = np.asarray(Image.open(tmp_path / "dot.png").convert("RGB")).astype(int)
     u, v = _pixel([0.5, 0.0, 2.0])
     assert image[v - 1 : v + 2, u - 1 : u + 2, 0].max() > 150
+
+
+@settings(max_examples=25, deadline=None)
+@given(
+    azimuth=st.floats(allow_nan=True, allow_infinity=True),
+    elevation=st.floats(-200, 200) | st.just(math.nan),
+    fov=st.floats(-10, 400) | st.just(math.nan),
+)
+def test_any_view_gives_a_picture_or_an_input_error(
+    azimuth: float, elevation: float, fov: float
+) -> None:
+    """Hostile views: a photograph with every lit point in front of the camera, or InputError."""
+    drones = _drones()
+    points = np.concatenate([d.trajectory.evaluate(np.linspace(0, 4, 50)) for d in drones])
+    try:
+        camera = Camera.framing(points, azimuth, elevation, fov_deg=fov, width_px=160, height_px=90)
+    except InputError:
+        return
+    with tempfile.TemporaryDirectory() as tmp:
+        exposure = long_exposure(drones, camera, Path(tmp) / "p.png")
+        assert Image.open(exposure.path).size == (160, 90)
+    assert camera.project(points)[1].all()
