@@ -11,8 +11,7 @@ from __future__ import annotations
 
 import logging
 import math
-import string
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Annotated, NoReturn
@@ -24,6 +23,7 @@ from rich.text import Text
 
 from skyquill.errors import InputError, SkyquillError
 from skyquill.io.outputs import check_folder
+from skyquill.io.skybrush_lights import hex_rgb
 from skyquill.targets import TARGETS, UploadTarget
 from skyquill.validation import FloatArray
 
@@ -127,6 +127,31 @@ def fail(message: str, status: int = 2) -> NoReturn:
     raise typer.Exit(status)
 
 
+@contextmanager
+def stage_progress() -> Iterator[Callable[[int, int, str], None]]:
+    """A rich bar fed by a planner's ``progress(done, total, stage)`` callback.
+
+    The planners of several drones (``write``, ``show``) report each step as it is done;
+    the bar shows the stage, how many of how many, and the time so far.
+    """
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+
+    with Progress(
+        TextColumn("{task.description}"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        TimeElapsedColumn(),
+        console=console,
+        transient=True,
+    ) as bar:
+        task = bar.add_task("planning", total=None)
+
+        def report(done: int, total: int, stage: str) -> None:
+            bar.update(task, completed=done, total=total, description=stage)
+
+        yield report
+
+
 def say_done(message: str) -> None:
     """``done message`` on stderr, the message printed literally (it holds user paths)."""
     console.print(Text("done ", style="green") + Text(message), soft_wrap=True)
@@ -164,9 +189,9 @@ def parse_color(flag: str, text: str) -> tuple[int, int, int]:
     parts = text.split(",")
     if len(parts) == 3 and all(p.strip().isdigit() and int(p) <= 255 for p in parts):
         return (int(parts[0]), int(parts[1]), int(parts[2]))
-    digits = text[1:]
-    if text.startswith("#") and len(digits) == 6 and all(c in string.hexdigits for c in digits):
-        return (int(digits[0:2], 16), int(digits[2:4], 16), int(digits[4:6], 16))
+    rgb = hex_rgb(text[1:]) if text.startswith("#") else None
+    if rgb is not None:
+        return rgb
     raise InputError(
         f"{flag}: got {text!r}, expected R,G,B with three integers in 0..255 or #RRGGBB"
     )

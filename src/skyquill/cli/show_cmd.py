@@ -7,13 +7,22 @@ from pathlib import Path
 from typing import Annotated, Any
 
 import typer
-from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
-from skyquill.cli.main import Force, OutDir, app, check_out, console, say_done, user_errors
+from skyquill.cli.main import (
+    Force,
+    OutDir,
+    app,
+    check_out,
+    console,
+    say_done,
+    stage_progress,
+    user_errors,
+)
 from skyquill.errors import InfeasibleError, InputError
 from skyquill.io.atomic import write_json
 from skyquill.io.outputs import staged_output
 from skyquill.io.plan_dir import trajectory_names, write_plan
+from skyquill.io.trajectory_json import PlannedTrajectory
 from skyquill.show import ShowDrone, ShowLimits, ShowReport, check_show, load_show
 from skyquill.show.build import ShowPlan, build_show
 from skyquill.show.script import ShowScript, load_script
@@ -63,18 +72,7 @@ def show(
 
 
 def _plan(script: ShowScript, workers: int | None, scheduler: str | None) -> ShowPlan:
-    with Progress(
-        TextColumn("{task.description}"),
-        BarColumn(),
-        TimeElapsedColumn(),
-        console=console,
-        transient=True,
-    ) as bar:
-        task = bar.add_task("planning", total=len(script.scenes))
-
-        def progress(done: int, total: int, stage: str) -> None:
-            bar.update(task, completed=done, total=total, description=stage)
-
+    with stage_progress() as progress:
         return build_show(script, workers=workers, scheduler=scheduler, progress=progress)
 
 
@@ -94,10 +92,15 @@ def check_limits(script: ShowScript) -> ShowLimits:
     )
 
 
+def _named(plan: ShowPlan) -> list[tuple[str, PlannedTrajectory]]:
+    """Each drone with the name of its files (``trajectory_<i>``)."""
+    names = [csv.removesuffix(".csv") for csv, _ in trajectory_names(len(plan.drones))]
+    return list(zip(names, plan.drones, strict=True))
+
+
 def _check(plan: ShowPlan, script: ShowScript) -> ShowReport:
     """``skyquill check`` on the plan; refused (InfeasibleError) unless it passes."""
-    names = [csv.removesuffix(".csv") for csv, _ in trajectory_names(len(plan.drones))]
-    drones = [ShowDrone(d.trajectory, n) for d, n in zip(plan.drones, names, strict=True)]
+    drones = [ShowDrone(d.trajectory, n) for n, d in _named(plan)]
     report = check_show(drones, script.safety_m, check_limits(script))
     if not report.passed:
         v = report.violations[0]
@@ -118,12 +121,13 @@ def _write(
 ) -> dict[str, Any]:
     from skyquill.viz.light_painting import write_pictures
 
-    names = [csv.removesuffix(".csv") for csv, _ in trajectory_names(len(plan.drones))]
+    plans = _named(plan)
+    names = [name for name, _ in plans]
     clock = time.perf_counter()
-    skyc = _skyc(stage, plan, names, script)
+    skyc = _skyc(stage, plans, script)
     stages["skyc"] = time.perf_counter() - clock
     clock = time.perf_counter()
-    studio = _studio_csv(stage, plan, names, script)
+    studio = _studio_csv(stage, plans, script)
     stages["skybrush_csv"] = time.perf_counter() - clock
     clock = time.perf_counter()
     pictures = write_pictures(plan.drones, stage)
@@ -151,7 +155,7 @@ def _write(
                 "windows_s": [list(w) for w in d.pen_windows_s],
                 "rgb": [list(c) for c in d.pen_rgb],
             }
-            for n, d in zip(names, plan.drones, strict=True)
+            for n, d in plans
         ],
         "skyc": skyc,
         "skybrush_csv": studio,
@@ -165,13 +169,12 @@ def _write(
 
 
 def _studio_csv(
-    stage: Path, plan: ShowPlan, names: list[str], script: ShowScript
+    stage: Path, plans: list[tuple[str, PlannedTrajectory]], script: ShowScript
 ) -> dict[str, Any]:
     """Write ``show.zip``, Skybrush Studio's per-drone CSVs, read back as Studio reads them."""
     from skyquill.export.base import ExportOptions
     from skyquill.export.skybrush_csv import SkybrushCsvExporter
 
-    plans = list(zip(names, plan.drones, strict=True))
     exported = SkybrushCsvExporter()(plans, stage / "show", ExportOptions(script.rate_hz))
     return {
         "file": "show.zip",
@@ -181,7 +184,9 @@ def _studio_csv(
     }
 
 
-def _skyc(stage: Path, plan: ShowPlan, names: list[str], script: ShowScript) -> dict[str, Any]:
+def _skyc(
+    stage: Path, plans: list[tuple[str, PlannedTrajectory]], script: ShowScript
+) -> dict[str, Any]:
     """Write ``show.skyc``, load it back as the drones play it and check it again.
 
     Skybrush stores whole millimetres and milliseconds, so the show as played is up to
@@ -193,7 +198,6 @@ def _skyc(stage: Path, plan: ShowPlan, names: list[str], script: ShowScript) -> 
     from skyquill.export.base import ExportOptions
     from skyquill.export.skyc import SkycExporter
 
-    plans = list(zip(names, plan.drones, strict=True))
     exported = SkycExporter()(plans, stage / "show", ExportOptions())
     played = load_show([stage / "show.skyc"])
     allowed = max(0.0, script.safety_m - 2.0 * exported.max_error_m)

@@ -5,8 +5,7 @@ from __future__ import annotations
 import dataclasses
 import inspect
 import math
-from collections.abc import Callable, Iterator, Sequence
-from contextlib import contextmanager
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any
 
@@ -30,6 +29,7 @@ from skyquill.cli.main import (
     parse_color,
     positive_rate,
     say_done,
+    stage_progress,
     upload_target,
     user_errors,
 )
@@ -257,7 +257,7 @@ def write(
         places, extra = sharing.places(parts, drones, options)
         if sharing.split:
             parts = places.parts
-        with _progress_bar() as progress:
+        with stage_progress() as progress:
             show = plan_show(
                 parts,
                 options,
@@ -454,26 +454,6 @@ class _Sharing:
 
         rows, columns = grid_shape(n, self.pose.grid)
         return {"grid": {"rows": rows, "columns": columns}}
-
-
-@contextmanager
-def _progress_bar() -> Iterator[Callable[[int, int, str], None]]:
-    """A rich bar of the drones planned (and flown), fed by ``plan_show``'s ``progress``."""
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn
-
-    with Progress(
-        TextColumn("{task.description}"),
-        BarColumn(),
-        MofNCompleteColumn(),
-        console=console,
-        transient=True,
-    ) as bar:
-        task = bar.add_task("planning", total=None)
-
-        def report(done: int, total: int, stage: str) -> None:
-            bar.update(task, completed=done, total=total, description=stage)
-
-        yield report
 
 
 def write_outputs(

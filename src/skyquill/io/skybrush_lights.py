@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import base64
 import binascii
+import string
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -38,6 +39,13 @@ MAX_STEPS = 1_000_000
 MAX_PROGRAM_BYTES = 65_535
 
 RGB = tuple[int, int, int]
+
+
+def hex_rgb(digits: str) -> RGB | None:
+    """``"rrggbb"`` (six hexadecimal digits) as a colour; ``None`` when it is not that."""
+    if len(digits) != 6 or any(c not in string.hexdigits for c in digits):
+        return None
+    return (int(digits[0:2], 16), int(digits[2:4], 16), int(digits[4:6], 16))
 
 
 def check_rgb(name: str, rgb: Any) -> RGB:

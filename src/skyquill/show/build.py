@@ -26,7 +26,6 @@ from numpy.typing import NDArray
 from scipy.optimize import linear_sum_assignment
 from scipy.spatial.distance import cdist
 
-from skyquill.errors import InputError
 from skyquill.io.trajectory_json import PlannedTrajectory
 from skyquill.show.check import require_separation
 from skyquill.show.formation import (
@@ -36,6 +35,7 @@ from skyquill.show.formation import (
     home_grid,
     shape_formation,
 )
+from skyquill.show.limits import check_inside
 from skyquill.show.load import ShowDrone
 from skyquill.show.moves import hold, staggered
 from skyquill.show.route import leg_limits, plan_moves, route_to
@@ -312,16 +312,10 @@ def _write(scene: WriteScene, script: ShowScript, line: _Timeline, where: _Where
 
 def _check_pads(homes: FloatArray, script: ShowScript) -> None:
     """Refuse, before planning, a geofence that leaves a take-off pad outside (bad input)."""
-    if script.geofence is None:
-        return
-    outside = np.flatnonzero(script.geofence.margin(homes[:, :2]) < 0.0)
-    if outside.size:
-        x, y = homes[outside[0], :2]
-        raise InputError(
-            f"[show].geofence: got a fence that excludes the take-off pad of drone "
-            f"{outside[0]} at ({x:.3f}, {y:.3f}) m ({outside.size} pad(s) outside), expected "
-            "one around every pad (move [show].home_origin or the fence)"
-        )
+    if script.geofence is not None:
+        labels = [f"the take-off pad of drone {i} at" for i in range(len(homes))]
+        hint = " (move [show].home_origin or the fence)"
+        check_inside(homes, labels, script.geofence, "[show].geofence", hint)
 
 
 def _prove(flights: list[Trajectory], safety: float) -> float:

@@ -87,15 +87,31 @@ def check_start(drones: Sequence[ShowDrone], geofence: Geofence) -> None:
         Naming ``--geofence``, the drone and its start.
     """
     starts = np.array([d.trajectory.evaluate(np.zeros(1))[0] for d in drones])
-    margin = geofence.margin(starts[:, :2])
+    check_inside(starts, [f"{d.name}'s start" for d in drones], geofence, "--geofence")
+
+
+def check_inside(
+    points: FloatArray, labels: Sequence[str], geofence: Geofence, key: str, hint: str = ""
+) -> None:
+    """Refuse a geofence that leaves one of ``points`` (N, 3), m, outside or above it.
+
+    Raises
+    ------
+    InputError
+        Naming ``key`` (the option or script key that gave the fence), the first
+        point outside by its label, how many are, and ``hint`` (what to change).
+    """
+    margin = geofence.margin(points[:, :2])
     ceiling = geofence.ceiling_m
-    for drone, start, m in zip(drones, starts, margin, strict=True):
-        if m < 0.0 or (ceiling is not None and start[2] > ceiling):
-            raise InputError(
-                f"--geofence: got a fence that excludes {drone.name}'s start "
-                f"({start[0]:.3f}, {start[1]:.3f}, {start[2]:.3f}) m, expected one around "
-                "every drone's start"
-            )
+    above = points[:, 2] > ceiling if ceiling is not None else np.zeros(len(points), bool)
+    outside = np.flatnonzero((margin < 0.0) | above)
+    if outside.size:
+        k = int(outside[0])
+        x, y, z = points[k]
+        raise InputError(
+            f"{key}: got a fence that excludes {labels[k]} ({x:.3f}, {y:.3f}, {z:.3f}) m "
+            f"({outside.size} point(s) outside), expected one around every start{hint}"
+        )
 
 
 def check_limits(

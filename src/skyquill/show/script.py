@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 
 from skyquill.errors import InputError
-from skyquill.io.skybrush_lights import check_rgb
+from skyquill.io.skybrush_lights import check_rgb, hex_rgb
 from skyquill.limits import VehicleLimits
 from skyquill.show.geofence import Geofence, read_geofence
 from skyquill.validation import FloatArray, as_array, as_float, as_int
@@ -159,10 +159,10 @@ def _known(table: Any, where: str, known: tuple[str, ...]) -> dict[str, Any]:
 def _color(where: str, value: Any) -> RGB:
     """``[r, g, b]`` or ``"#rrggbb"``."""
     if isinstance(value, str):
-        text = value.removeprefix("#")
-        if len(text) == 6 and all(c in "0123456789abcdefABCDEF" for c in text):
-            return (int(text[0:2], 16), int(text[2:4], 16), int(text[4:6], 16))
-        raise InputError(f"{where}: got {value!r:.40}, expected '#rrggbb' or [r, g, b]")
+        rgb = hex_rgb(value.removeprefix("#"))
+        if rgb is None:
+            raise InputError(f"{where}: got {value!r:.40}, expected '#rrggbb' or [r, g, b]")
+        return rgb
     return check_rgb(where, value)
 
 
