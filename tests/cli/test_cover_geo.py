@@ -11,7 +11,7 @@ from typer.testing import CliRunner
 
 from skyquill.cli.main import app
 from skyquill.coverage.geo import GeoFrame
-from skyquill.io.skyc import read_show_json
+from skyquill.export.skybrush.skyc_file import read_show_json
 
 #: A 30 m x 20 m field centred on 47.37 N, 8.54 E.
 FRAME = GeoFrame(8.54, 47.37)

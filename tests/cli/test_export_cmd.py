@@ -140,7 +140,7 @@ def test_bad_input(tmp_path: Path, fitted: Path) -> None:
 
 def test_crazyswarm_round_trip_flies_in_the_simulator(targeted: Path, tmp_path: Path) -> None:
     """Read the uploads back as the Crazyflie flies them (float32) and fly that."""
-    from skyquill.export.crazyswarm import read_export
+    from skyquill.export.crazyflie.exporter import read_export
     from skyquill.io.trajectory_json import read_trajectory_json
     from skyquill.sim import simulate
 

@@ -20,11 +20,11 @@ from typer.testing import CliRunner
 
 from skyquill.cli.main import app
 from skyquill.export import EXPORTERS
-from skyquill.export.crazyswarm import read_export
-from skyquill.io.px4 import read_px4_csv
+from skyquill.export.crazyflie.exporter import read_export
+from skyquill.export.px4.setpoints import read_px4_csv
+from skyquill.export.skybrush.csv_file import read_csv_zip
+from skyquill.export.skybrush.skyc_file import read_show_json, show_trajectories
 from skyquill.io.setpoints_json import read_setpoints_json
-from skyquill.io.skybrush_csv import read_csv_zip
-from skyquill.io.skyc import read_show_json, show_trajectories
 from skyquill.io.trajectory_csv import read_trajectory_csv
 from skyquill.io.trajectory_json import read_trajectory_json
 from skyquill.trajectory import Trajectory

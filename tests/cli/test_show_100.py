@@ -17,9 +17,9 @@ import pytest
 from typer.testing import CliRunner
 
 from skyquill.cli.main import app
+from skyquill.export.skybrush.lights import light_colors, light_slices, program_bytes
+from skyquill.export.skybrush.skyc_file import read_show_json
 from skyquill.io.plan_dir import read_plan
-from skyquill.io.skybrush_lights import light_colors, light_slices, program_bytes
-from skyquill.io.skyc import read_show_json
 from skyquill.show import ShowDrone, check_show, load_show
 
 EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "show_100.toml"

@@ -10,10 +10,10 @@ import pytest
 from typer.testing import CliRunner
 
 from skyquill.cli.main import app
+from skyquill.export.skybrush.csv_file import read_csv_zip
+from skyquill.export.skybrush.lights import light_colors, light_slices, program_bytes
+from skyquill.export.skybrush.skyc_file import read_show_json
 from skyquill.io.plan_dir import read_plan
-from skyquill.io.skybrush_csv import read_csv_zip
-from skyquill.io.skybrush_lights import light_colors, light_slices, program_bytes
-from skyquill.io.skyc import read_show_json
 from skyquill.show import ShowDrone, check_show
 from skyquill.show.script import load_script
 

@@ -11,8 +11,8 @@ from typer.testing import CliRunner
 
 from skyquill.calligraphy.board import sky_board
 from skyquill.cli.main import app, parse_color
-from skyquill.io.skybrush_lights import light_slices, program_bytes
-from skyquill.io.skyc import read_show_json
+from skyquill.export.skybrush.lights import light_slices, program_bytes
+from skyquill.export.skybrush.skyc_file import read_show_json
 
 runner = CliRunner()
 

@@ -24,8 +24,8 @@ from skyquill.coverage.regions import swept
 from skyquill.errors import InputError
 from skyquill.export import EXPORTERS, ExportOptions
 from skyquill.export.geojson import SIMPLIFY_M, write_path_geojson
-from skyquill.export.px4_global import DEG_E7, read_px4_global
-from skyquill.io.skyc import read_show_json, read_show_location
+from skyquill.export.px4.global_exporter import DEG_E7, read_px4_global
+from skyquill.export.skybrush.skyc_file import read_show_json, read_show_location
 from skyquill.io.trajectory_json import PlannedTrajectory
 from skyquill.limits import VehicleLimits
 from skyquill.trajectory import SplineTrajectory, dense_times

@@ -22,9 +22,9 @@ import pytest
 from fastapi.testclient import TestClient
 from studio_fakes import crashing_planner, refusing_planner, slow_planner
 
-from skyquill.io.crazyswarm import read_crazyswarm
+from skyquill.export.crazyflie.csv_file import read_crazyswarm
+from skyquill.export.skybrush.skyc_file import read_show_json
 from skyquill.io.points import TRAJECTORY_COLUMNS
-from skyquill.io.skyc import read_show_json
 from skyquill.studio import JobManager, create_app
 from skyquill.studio.app import MAX_BODY_BYTES
 from skyquill.studio.models import MAX_POINTS

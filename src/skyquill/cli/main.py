@@ -21,9 +21,9 @@ import typer
 from rich.console import Console
 from rich.text import Text
 
+from skyquill.colors import hex_rgb
 from skyquill.errors import InputError, SkyquillError
 from skyquill.io.outputs import check_folder
-from skyquill.io.skybrush_lights import hex_rgb
 from skyquill.targets import TARGETS, UploadTarget
 from skyquill.validation import FloatArray
 

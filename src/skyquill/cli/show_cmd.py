@@ -173,7 +173,7 @@ def _studio_csv(
 ) -> dict[str, Any]:
     """Write ``show.zip``, Skybrush Studio's per-drone CSVs, read back as Studio reads them."""
     from skyquill.export.base import ExportOptions
-    from skyquill.export.skybrush_csv import SkybrushCsvExporter
+    from skyquill.export.skybrush.csv_exporter import SkybrushCsvExporter
 
     exported = SkybrushCsvExporter()(plans, stage / "show", ExportOptions(script.rate_hz))
     return {
@@ -196,7 +196,7 @@ def _skyc(
     cross a limit the plan touches (``limits`` says by how much).
     """
     from skyquill.export.base import ExportOptions
-    from skyquill.export.skyc import SkycExporter
+    from skyquill.export.skybrush.skyc_exporter import SkycExporter
 
     exported = SkycExporter()(plans, stage / "show", ExportOptions())
     played = load_show([stage / "show.skyc"])

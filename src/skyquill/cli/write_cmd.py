@@ -33,11 +33,11 @@ from skyquill.cli.main import (
     upload_target,
     user_errors,
 )
+from skyquill.colors import RGB
 from skyquill.errors import InputError
 from skyquill.io.atomic import atomic_path, write_json
 from skyquill.io.outputs import staged_output
 from skyquill.io.plan_dir import trajectory_names, write_plan
-from skyquill.io.skybrush_lights import RGB
 from skyquill.io.trajectory_json import PlannedTrajectory
 from skyquill.limits import VehicleLimits
 from skyquill.show.lights import COLOR_BY, window_palette

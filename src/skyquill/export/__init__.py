@@ -1,18 +1,21 @@
 """Exporters behind one protocol, chosen from one registry (the CLI and the studio read it).
 
-A new format is one file defining an :class:`~skyquill.export.base.Exporter`
-and one entry in :data:`EXPORTERS`.
+A consumer is one package (``crazyflie/``, ``skybrush/``, ``px4/``): its encoding, its
+model of what the vehicle plays, its exporter and its fly script. A new format is one
+:class:`~skyquill.export.base.Exporter` there and one entry in :data:`EXPORTERS`; the
+generic sampled formats (``samples.py``) and GeoJSON (``geojson.py``) sit beside them.
 """
 
 from __future__ import annotations
 
 from skyquill.errors import InputError
 from skyquill.export.base import Exporter, ExportOptions, ExportReport, NamedPlan
-from skyquill.export.crazyswarm import EXPORTER as CRAZYSWARM
-from skyquill.export.px4_global import EXPORTER as PX4_GLOBAL
-from skyquill.export.samples import CSV, JSON, PX4
-from skyquill.export.skybrush_csv import EXPORTER as SKYBRUSH_CSV
-from skyquill.export.skyc import EXPORTER as SKYC
+from skyquill.export.crazyflie.exporter import EXPORTER as CRAZYSWARM
+from skyquill.export.px4.global_exporter import EXPORTER as PX4_GLOBAL
+from skyquill.export.px4.local_exporter import EXPORTER as PX4
+from skyquill.export.samples import CSV, JSON
+from skyquill.export.skybrush.csv_exporter import EXPORTER as SKYBRUSH_CSV
+from skyquill.export.skybrush.skyc_exporter import EXPORTER as SKYC
 
 EXPORTERS: dict[str, Exporter] = {
     e.name: e for e in (CRAZYSWARM, SKYC, SKYBRUSH_CSV, PX4, PX4_GLOBAL, CSV, JSON)

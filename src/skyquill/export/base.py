@@ -15,9 +15,9 @@ from typing import Any, Protocol
 
 import numpy as np
 
+from skyquill.colors import check_rgb
 from skyquill.coverage.geo import GeoFrame
 from skyquill.errors import InputError
-from skyquill.io.skybrush_lights import check_rgb
 from skyquill.io.trajectory_json import PlannedTrajectory, pen_down
 from skyquill.trajectory import Trajectory, dense_times
 from skyquill.validation import as_float

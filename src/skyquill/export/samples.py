@@ -1,7 +1,10 @@
-"""The sampled formats: ``trajectory.csv`` columns, setpoints JSON, PX4 NED setpoints.
+"""The sampled formats: ``trajectory.csv`` columns and setpoints JSON.
+
+PX4's NED setpoints use the same :class:`SampledExporter`
+(:mod:`skyquill.export.px4.local_exporter`).
 
 Each samples the trajectory at the requested rate, writes, reads the file back
-with its reader (for PX4 with the NED-to-ENU conversion a consumer applies)
+with its reader
 and measures the distance of that read-back from the plan.
 """
 
@@ -19,7 +22,6 @@ from skyquill.export.base import (
     target,
 )
 from skyquill.io.points import write_trajectory_csv
-from skyquill.io.px4 import px4_setpoints, read_px4_csv
 from skyquill.io.setpoints_json import read_setpoints_json, write_setpoints_json
 from skyquill.io.trajectory_csv import read_trajectory_csv
 from skyquill.trajectory import SampledTrajectory, Trajectory
@@ -33,11 +35,6 @@ def _write_csv(traj: Trajectory, path: Path, rate: float) -> SampledTrajectory:
 def _write_json(traj: Trajectory, path: Path, rate: float) -> SampledTrajectory:
     write_setpoints_json(traj, path, rate)
     return read_setpoints_json(path).trajectory
-
-
-def _write_px4(traj: Trajectory, path: Path, rate: float) -> SampledTrajectory:
-    px4_setpoints(traj, rate_hz=rate).to_csv(path)
-    return read_px4_csv(path)
 
 
 @dataclass(frozen=True)
@@ -73,6 +70,3 @@ class SampledExporter:
 
 CSV = SampledExporter("csv", ".csv", "trajectory.csv columns (t, x..jz), z-up, SI", _write_csv)
 JSON = SampledExporter("json", ".json", "setpoints JSON (rows of t, x..jz), z-up, SI", _write_json)
-PX4 = SampledExporter(
-    "px4", ".csv", "PX4 offboard setpoints CSV in NED, yaw in degrees", _write_px4
-)

@@ -28,10 +28,10 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from skyquill.colors import RGB, window_colors
 from skyquill.errors import InputError
 from skyquill.io.atomic import write_text
 from skyquill.io.json_read import parse_json
-from skyquill.io.skybrush_lights import RGB, window_colors
 from skyquill.limits import BoxLimit, CylinderLimit, DerivativeLimit, NormLimit
 from skyquill.trajectory import Trajectory
 from skyquill.trajectory.codec import decode, encode

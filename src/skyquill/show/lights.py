@@ -12,8 +12,8 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import Literal
 
+from skyquill.colors import RGB, check_rgb
 from skyquill.errors import InputError
-from skyquill.io.skybrush_lights import RGB, check_rgb
 
 ColorBy = Literal["drone", "stroke"]
 COLOR_BY: tuple[ColorBy, ...] = ("drone", "stroke")

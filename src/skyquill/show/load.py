@@ -1,7 +1,7 @@
 """The drones of a show, read from plan directories, trajectory files and ``.skyc`` archives.
 
 Every path is read by the reader that already exists for it
-(:func:`skyquill.io.plan_dir.read_plan`, :func:`skyquill.io.skyc.read_show_json`);
+(:func:`skyquill.io.plan_dir.read_plan`, :func:`skyquill.export.skybrush.skyc_file.read_show_json`);
 several paths are one show on one clock.
 """
 
@@ -13,8 +13,8 @@ from pathlib import Path
 from typing import Any
 
 from skyquill.errors import InputError
+from skyquill.export.skybrush.skyc_file import read_show_json, show_trajectories
 from skyquill.io.plan_dir import read_plan
-from skyquill.io.skyc import read_show_json, show_trajectories
 from skyquill.trajectory import Trajectory
 
 #: File types read, by suffix.
@@ -102,7 +102,7 @@ def _firmware_zero(trajectory: dict[str, Any]) -> float:
     """Show time of the firmware's 0, s.
 
     The first keyframe; with a ``takeoffTime`` Skybrush puts a still segment from
-    ``-takeoffTime`` in front of it (:mod:`skyquill.io.skybrush_playback`).
+    ``-takeoffTime`` in front of it (:mod:`skyquill.export.skybrush.playback`).
     """
     takeoff = float(trajectory.get("takeoffTime", 0.0))
     return -takeoff if takeoff > 0 else float(trajectory["points"][0][0])

@@ -16,8 +16,8 @@ from typing import Any
 
 import numpy as np
 
+from skyquill.colors import check_rgb, hex_rgb
 from skyquill.errors import InputError
-from skyquill.io.skybrush_lights import check_rgb, hex_rgb
 from skyquill.limits import VehicleLimits
 from skyquill.show.geofence import Geofence, read_geofence
 from skyquill.validation import FloatArray, as_array, as_float, as_int

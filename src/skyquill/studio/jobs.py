@@ -50,7 +50,12 @@ class BusyError(Exception):
 
 
 #: Modules the forkserver imports once, so that each child starts warm.
-PRELOAD = ("skyquill.studio.planner", "skyquill.cli.main", "skyquill.sim", "skyquill.io.skyc")
+PRELOAD = (
+    "skyquill.studio.planner",
+    "skyquill.cli.main",
+    "skyquill.sim",
+    "skyquill.export.skybrush.skyc_file",
+)
 #: How often a supervisor checks its child's messages, liveness and time, s.
 POLL_S = 0.05
 #: Hex digits of the job id that make the plan id (in file names): 48 bits, so two

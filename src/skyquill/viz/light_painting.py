@@ -31,8 +31,8 @@ from matplotlib.axes import Axes
 from matplotlib.collections import LineCollection
 from matplotlib.figure import Figure
 
+from skyquill.colors import RGB
 from skyquill.errors import InputError
-from skyquill.io.skybrush_lights import RGB
 from skyquill.io.trajectory_json import PlannedTrajectory
 from skyquill.validation import FloatArray, as_float, as_int
 from skyquill.viz.camera import Camera

@@ -22,13 +22,13 @@ import numpy as np
 import pytest
 from packaging.requirements import Requirement
 
-from skyquill.io.px4 import MAVSDK_REQUIREMENT, px4_setpoints, send_mavsdk
+from skyquill.export.px4.setpoints import MAVSDK_REQUIREMENT, px4_setpoints, send_mavsdk
 from skyquill.trajectory import SplineTrajectory
 
 mavutil = pytest.importorskip("pymavlink.mavutil")
 pytest.importorskip("mavsdk.asyncio")
 
-PYPROJECT = Path(__file__).parents[2] / "pyproject.toml"
+PYPROJECT = Path(__file__).parents[3] / "pyproject.toml"
 MAV_CMD_DO_SET_MODE = 176
 MAV_FRAME_LOCAL_NED = 1
 

@@ -3,7 +3,7 @@
 Rows every ``1 / rate_hz`` s on the millisecond grid, plus rows one millisecond either side
 of every pen-window end (rounded to the ms), so the light switches on the millisecond the
 pen does even though Studio fades colours linearly between rows. Read back as Studio reads
-it (:mod:`skyquill.io.skybrush_csv`: positions interpolated linearly), then checked: the
+it (:mod:`skyquill.export.skybrush.csv_file`: positions interpolated linearly), then checked: the
 distance from the plan, the speed limit (a linear interpolation has no acceleration between
 rows and an impulse at each, so only the speed check means something), the lights.
 """
@@ -19,9 +19,9 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from skyquill.colors import RGB
 from skyquill.export.base import ExportOptions, ExportReport, NamedPlan, check_delivered
-from skyquill.io.skybrush_csv import CsvDrone, read_csv_zip, write_csv_zip
-from skyquill.io.skybrush_lights import RGB
+from skyquill.export.skybrush.csv_file import CsvDrone, read_csv_zip, write_csv_zip
 from skyquill.io.trajectory_json import PlannedTrajectory, light_at
 
 

@@ -5,7 +5,7 @@ The columns are the fields of MAVLink's ``SET_POSITION_TARGET_GLOBAL_INT`` in
 PX4's offboard mode take): ``lat_int``/``lon_int`` in integer 1e-7 degrees
 (about 1.1 cm: the link's own resolution), the altitude relative to home in m,
 and velocity, acceleration (NED, m/s, m/s^2) and yaw (degrees clockwise from
-north) as in :mod:`skyquill.io.px4`. The plan's x east, y north (m) are mapped to
+north) as in :mod:`skyquill.export.px4.setpoints`. The plan's x east, y north (m) are mapped to
 WGS84 through the plan's :class:`~skyquill.coverage.geo.GeoFrame`; its z is the
 height above the take-off point, which PX4 calls home.
 
@@ -27,9 +27,14 @@ import numpy as np
 from skyquill.coverage.geo import GeoFrame
 from skyquill.errors import InputError
 from skyquill.export.base import ExportOptions, ExportReport, NamedPlan
+from skyquill.export.px4.setpoints import (
+    PX4_COLUMNS,
+    check_stream_rate,
+    enu_to_ned,
+    yaw_enu_to_ned_deg,
+)
 from skyquill.export.samples import SampledExporter
 from skyquill.io.points import trajectory_table
-from skyquill.io.px4 import PX4_COLUMNS, check_stream_rate, enu_to_ned, yaw_enu_to_ned_deg
 from skyquill.io.table import read_table
 from skyquill.trajectory import SampledTrajectory, Trajectory
 

@@ -13,7 +13,7 @@ import pytest
 from cflib.crazyflie.mem import Poly4D
 
 from skyquill.errors import InputError
-from skyquill.io.crazyflie_memory import (
+from skyquill.export.crazyflie.memory import (
     MEMORY_BYTES,
     PIECE_BYTES,
     FirmwareTrajectory,

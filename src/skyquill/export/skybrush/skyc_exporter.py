@@ -1,11 +1,11 @@
 """Skybrush ``.skyc`` show: keyframes on Skybrush's ms and mm grid, lights, yaw, validation.
 
 Each drone's plan becomes cubic Bézier keyframes on the grid Skybrush's server stores
-(:mod:`skyquill.io.skybrush_keyframes`), a light program that is on in the chosen colour
-while the pen is down (:mod:`skyquill.io.skybrush_lights`), a constant yaw of 0, and the
+(:mod:`skyquill.export.skybrush.keyframes`), a light program that is on in the chosen colour
+while the pen is down (:mod:`skyquill.export.skybrush.lights`), a constant yaw of 0, and the
 show gets the validation settings its plan implies (:mod:`.skybrush_validation`). The
 written file is then read back and played with Skybrush's own arithmetic
-(:mod:`skyquill.io.skybrush_playback`): the distance from the plan and the dense limit check
+(:mod:`skyquill.export.skybrush.playback`): the distance from the plan and the dense limit check
 are measured on what the drones will fly, and the lights on what they will show.
 """
 
@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from skyquill.colors import RGB
 from skyquill.coverage.geo import GeoFrame
 from skyquill.errors import InputError
 from skyquill.export.base import (
@@ -27,24 +28,23 @@ from skyquill.export.base import (
     NamedPlan,
     check_delivered,
 )
-from skyquill.export.skybrush_validation import validation_settings
-from skyquill.io.skybrush_keyframes import skybrush_keyframes
-from skyquill.io.skybrush_lights import (
-    RGB,
+from skyquill.export.skybrush.keyframes import skybrush_keyframes
+from skyquill.export.skybrush.lights import (
     colored_frames,
     encode_light_program,
     light_colors,
     light_slices,
     program_bytes,
 )
-from skyquill.io.skybrush_playback import played_show, played_trajectory
-from skyquill.io.skyc import (
+from skyquill.export.skybrush.playback import played_show, played_trajectory
+from skyquill.export.skybrush.skyc_file import (
     SkycDrone,
     read_show_json,
     read_show_location,
     show_location,
     write_skyc,
 )
+from skyquill.export.skybrush.validation import validation_settings
 from skyquill.io.trajectory_json import PlannedTrajectory
 
 #: A limit excess below this counts as none (float rounding of the read-back), relative.

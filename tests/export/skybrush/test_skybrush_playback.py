@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from skyquill.errors import InputError
-from skyquill.io.skybrush_playback import played_trajectory, quantize, scaling_factor
+from skyquill.export.skybrush.playback import played_trajectory, quantize, scaling_factor
 
 
 def reference_segments(traj: dict[str, Any]) -> tuple[list[int], list[list[list[int]]]]:

@@ -2,10 +2,10 @@
 
 The must-show of issue 14: 永 planned by ``plan_writing``, exported to ``.skyc`` and played
 back with Skybrush's own arithmetic (the server's ms and mm rounding, the firmware's float32
-Bézier evaluation; ``skyquill.io.skybrush_playback``, checked against a literal copy of that
-code in ``tests/io/test_skybrush_playback.py``): within 2 mm of the plan over the whole show
-(28 mm before), lit exactly in the pen windows rounded to the 20 ms light frame, validation
-settings consistent with the plan.
+Bézier evaluation; ``skyquill.export.skybrush.playback``, checked against a literal copy of
+that code in ``tests/export/skybrush/test_skybrush_playback.py``): within 2 mm of the plan over
+the whole show (28 mm before), lit exactly in the pen windows rounded to the 20 ms light frame,
+validation settings consistent with the plan.
 """
 
 from __future__ import annotations
@@ -20,9 +20,14 @@ import pytest
 from skyquill.calligraphy.mission import plan_writing
 from skyquill.export import EXPORTERS, ExportOptions
 from skyquill.export.base import NamedPlan
-from skyquill.io.skybrush_csv import read_csv_zip
-from skyquill.io.skybrush_lights import colored_frames, light_colors, light_slices, program_bytes
-from skyquill.io.skyc import read_show_json, show_trajectories
+from skyquill.export.skybrush.csv_file import read_csv_zip
+from skyquill.export.skybrush.lights import (
+    colored_frames,
+    light_colors,
+    light_slices,
+    program_bytes,
+)
+from skyquill.export.skybrush.skyc_file import read_show_json, show_trajectories
 from skyquill.io.trajectory_json import PlannedTrajectory, pen_down
 from skyquill.limits import VehicleLimits
 from skyquill.strokes import hanzi_strokes

@@ -12,7 +12,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from skyquill.errors import InputError
-from skyquill.io.crazyswarm import (
+from skyquill.export.crazyflie.csv_file import (
     COLUMNS,
     HEADER,
     crazyswarm_pieces,

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from skyquill.errors import InputError
-from skyquill.io.skybrush_keyframes import SEGMENT_MS, encode, skybrush_keyframes
-from skyquill.io.skybrush_playback import played_trajectory, quantize
+from skyquill.export.skybrush.keyframes import SEGMENT_MS, encode, skybrush_keyframes
+from skyquill.export.skybrush.playback import played_trajectory, quantize
 from skyquill.trajectory import PiecewisePolynomial, RestToRestSequence, SplineTrajectory
 
 

@@ -16,13 +16,13 @@ from __future__ import annotations
 
 import base64
 import binascii
-import string
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
+from skyquill.colors import RGB, check_rgb, is_rgb, window_colors
 from skyquill.errors import InputError
 from skyquill.validation import FloatArray
 
@@ -37,49 +37,6 @@ LOOP_BEGIN, LOOP_END, NOP, SET_PYRO, SET_PYRO_ALL = 12, 13, 1, 20, 21
 MAX_STEPS = 1_000_000
 #: Largest program read back, bytes (Skybrush's binary block holds 65535).
 MAX_PROGRAM_BYTES = 65_535
-
-RGB = tuple[int, int, int]
-
-
-def hex_rgb(digits: str) -> RGB | None:
-    """``"rrggbb"`` (six hexadecimal digits) as a colour; ``None`` when it is not that."""
-    if len(digits) != 6 or any(c not in string.hexdigits for c in digits):
-        return None
-    return (int(digits[0:2], 16), int(digits[2:4], 16), int(digits[4:6], 16))
-
-
-def check_rgb(name: str, rgb: Any) -> RGB:
-    """``rgb`` as three integers in 0..255; :class:`InputError` naming ``name`` otherwise."""
-    if not (_is_rgb(rgb) and all(0 <= int(c) <= 255 for c in rgb)):
-        raise InputError(f"{name}: got {rgb!r:.60}, expected three integers in 0..255 (R, G, B)")
-    return (int(rgb[0]), int(rgb[1]), int(rgb[2]))
-
-
-def window_colors(name: str, windows: Sequence[Any], colors: Any) -> tuple[RGB, ...]:
-    """``colors`` checked to be one R, G, B triple per window.
-
-    Raises
-    ------
-    InputError
-        Naming ``name``: not a sequence of triples, a colour that is not three integers
-        in 0..255, or a count that is not the number of windows.
-    """
-    if isinstance(colors, str | bytes) or not isinstance(colors, Sequence) or _is_rgb(colors):
-        raise InputError(f"{name}: got {colors!r:.60}, expected one R, G, B triple per pen window")
-    if len(colors) != len(windows):
-        raise InputError(
-            f"{name}: got {len(colors)} colours, expected one per pen window ({len(windows)})"
-        )
-    return tuple(check_rgb(f"{name}[{i}]", c) for i, c in enumerate(colors))
-
-
-def _is_rgb(value: Any) -> bool:
-    return (
-        isinstance(value, Sequence)
-        and not isinstance(value, str)
-        and len(value) == 3
-        and all(isinstance(c, int | np.integer) and not isinstance(c, bool) for c in value)
-    )
 
 
 def colored_frames(
@@ -133,7 +90,7 @@ def encode_light_program(
     """
     per_window = (
         (check_rgb("rgb", colors),) * len(windows_s)
-        if _is_rgb(colors)
+        if is_rgb(colors)
         else window_colors("rgb", windows_s, colors)
     )
     program = bytearray()

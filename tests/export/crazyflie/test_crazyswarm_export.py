@@ -24,11 +24,11 @@ from scipy.interpolate import make_interp_spline
 from skyquill.errors import InputError
 from skyquill.export import EXPORTERS, ExportOptions
 from skyquill.export.base import check_delivered
-from skyquill.export.crazyswarm import (
+from skyquill.export.crazyflie.csv_file import read_crazyswarm
+from skyquill.export.crazyflie.exporter import (
     FLOAT32_LIMIT_TOLERANCE,
     read_export,
 )
-from skyquill.io.crazyswarm import read_crazyswarm
 from skyquill.io.trajectory_json import PlannedTrajectory
 from skyquill.limits import vehicle_limits
 from skyquill.optimize import Boundary, PointDeviation, SmoothingProblem, solve

@@ -21,9 +21,9 @@ Trajectory convention (Skybrush's ``TrajectorySpecification.iter_segments``):
 ``points[i] = [t_i, p(t_i), controls_i]`` is a keyframe at show time ``t_i`` (s) and
 ``controls_i`` are the inner Bézier control points of the segment that **ends** there; the
 first keyframe has none, an empty list elsewhere is a straight segment, Skybrush Live plays
-at most two (cubic). What a drone plays from it is :mod:`skyquill.io.skybrush_playback`;
-:mod:`skyquill.io.skybrush_keyframes` builds keyframes on its ms and mm grid and
-:mod:`skyquill.io.skybrush_lights` the light programs.
+at most two (cubic). What a drone plays from it is :mod:`skyquill.export.skybrush.playback`;
+:mod:`skyquill.export.skybrush.keyframes` builds keyframes on its ms and mm grid and
+:mod:`skyquill.export.skybrush.lights` the light programs.
 
 An outdoor show may propose where it is flown: ``"environment": {"type": "outdoor",
 "location": {"origin": [lat_e7, lon_e7, amsl_mm], "orientation": deg}}`` (skybrush.js
@@ -50,11 +50,11 @@ from pathlib import Path
 from typing import Any
 
 from skyquill.errors import InputError
+from skyquill.export.skybrush.keyframes import Keyframes
+from skyquill.export.skybrush.lights import lights_json, program_bytes
+from skyquill.export.skybrush.playback import MAX_SEGMENT_S, played_show
 from skyquill.io.atomic import atomic_path
 from skyquill.io.json_read import parse_json
-from skyquill.io.skybrush_keyframes import Keyframes
-from skyquill.io.skybrush_lights import lights_json, program_bytes
-from skyquill.io.skybrush_playback import MAX_SEGMENT_S, played_show
 from skyquill.trajectory import PiecewisePolynomial
 
 #: Largest ``show.json`` read from an archive, bytes (checked before inflating it).
@@ -87,7 +87,7 @@ class SkycDrone:
         Its name in the show.
     keyframes
         Its trajectory on Skybrush's grid
-        (:func:`~skyquill.io.skybrush_keyframes.skybrush_keyframes`).
+        (:func:`~skyquill.export.skybrush.keyframes.skybrush_keyframes`).
     lights
         Its light program (bytecode), or ``None`` for none (Skybrush Live shows white).
     yaw_deg
@@ -396,7 +396,7 @@ def show_trajectories(show: dict[str, Any]) -> list[PiecewisePolynomial]:
     """The drones' trajectories of a validated ``show.json`` as their firmware plays them.
 
     Skybrush's upload encoding and its firmware's evaluation
-    (:mod:`skyquill.io.skybrush_playback`), on the firmware's clock (0 at the first segment).
+    (:mod:`skyquill.export.skybrush.playback`), on the firmware's clock (0 at the first segment).
 
     Returns
     -------

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from skyquill.errors import InputError, SolverError
-from skyquill.io.px4 import (
+from skyquill.export.px4.setpoints import (
     PX4_COLUMNS,
     MavsdkSystem,
     Px4Setpoints,

@@ -6,7 +6,7 @@ its message, never split mid-motion. Each upload is written exactly (one row
 per knot span or polynomial piece), then read back the way it will fly: the
 CSV parsed, packed with cflib's ``Poly4D`` arithmetic, at most 4096 B per
 upload, and evaluated in float32 as the firmware's ``pptraj.c`` does
-(:mod:`skyquill.io.crazyflie_memory`). That read-back, flown on the plan's
+(:mod:`skyquill.export.crazyflie.memory`). That read-back, flown on the plan's
 clock with the hovers between uploads, is what the dense limit check and the
 distance check of :func:`~skyquill.export.base.check_delivered` see.
 """
@@ -22,7 +22,6 @@ from typing import Any
 import numpy as np
 
 from skyquill.errors import InputError
-from skyquill.export import crazyflie_fly
 from skyquill.export.base import (
     DeliveredCheck,
     ExportOptions,
@@ -31,7 +30,13 @@ from skyquill.export.base import (
     check_delivered,
     target,
 )
-from skyquill.io.crazyflie_memory import (
+from skyquill.export.crazyflie import fly_script
+from skyquill.export.crazyflie.csv_file import (
+    read_crazyswarm_table,
+    upload_pieces,
+    write_crazyswarm,
+)
+from skyquill.export.crazyflie.memory import (
     MEMORY_BYTES,
     PIECE_BYTES,
     FlownUploads,
@@ -39,7 +44,6 @@ from skyquill.io.crazyflie_memory import (
     flown_uploads,
     pack_pieces,
 )
-from skyquill.io.crazyswarm import read_crazyswarm_table, upload_pieces, write_crazyswarm
 from skyquill.io.trajectory_json import PlannedTrajectory
 from skyquill.targets import CRAZYFLIE, Upload, plan_uploads
 from skyquill.trajectory import Trajectory
@@ -231,7 +235,7 @@ def read_upload(path: Path) -> bytes:
     Raises
     ------
     InputError
-        A file :func:`~skyquill.io.crazyswarm.read_crazyswarm_table` refuses, or one
+        A file :func:`~skyquill.export.crazyflie.csv_file.read_crazyswarm_table` refuses, or one
         that does not fit the trajectory memory.
     """
     data = pack_pieces(read_crazyswarm_table(path))
@@ -298,7 +302,7 @@ def _schedule(summary: Path) -> _Schedule:
 
 
 def write_fly_script(path: Path, drones: Sequence[DroneExport], several: bool) -> Path:
-    """``path``: :mod:`skyquill.export.crazyflie_fly` with the drones' upload schedule."""
+    """``path``: :mod:`skyquill.export.crazyflie.fly_script` with the drones' upload schedule."""
     schedule = {
         (d.drone if several else SINGLE): [
             {
@@ -312,10 +316,10 @@ def write_fly_script(path: Path, drones: Sequence[DroneExport], several: bool) -
         ]
         for d in drones
     }
-    source = Path(crazyflie_fly.__file__).read_text(encoding="utf-8")
+    source = Path(fly_script.__file__).read_text(encoding="utf-8")
     marker = "SCHEDULE: dict[str, list[dict[str, Any]]] = {}\n"
     if marker not in source:  # pragma: no cover - the template and this line go together
-        raise RuntimeError("crazyflie_fly.py: the SCHEDULE line is missing")
+        raise RuntimeError("fly_script.py: the SCHEDULE line is missing")
     literal = json.dumps(schedule, indent=4)  # strings, numbers, lists: also a Python literal
     path.write_text(
         source.replace(marker, f"SCHEDULE: dict[str, list[dict[str, Any]]] = {literal}\n"),

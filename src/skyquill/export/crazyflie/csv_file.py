@@ -21,7 +21,7 @@ on each knot span, so the export is exact: one piece per span, coefficients of
 is written piece by piece. One file is one upload: deciding the uploads
 (at most 31 pieces each, changing only where the vehicle is at rest) is
 :func:`skyquill.targets.plan_uploads`' job, and what the Crazyflie does with
-the numbers is :mod:`skyquill.io.crazyflie_memory`'s.
+the numbers is :mod:`skyquill.export.crazyflie.memory`'s.
 """
 
 from __future__ import annotations

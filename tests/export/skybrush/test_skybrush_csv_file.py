@@ -12,8 +12,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from skyquill.errors import InputError
-from skyquill.io import skybrush_csv
-from skyquill.io.skybrush_csv import HEADER, CsvDrone, read_csv_zip, write_csv_zip
+from skyquill.export.skybrush import csv_file as skybrush_csv
+from skyquill.export.skybrush.csv_file import HEADER, CsvDrone, read_csv_zip, write_csv_zip
 
 
 def drone(name: str = "d1", n: int = 50) -> CsvDrone:

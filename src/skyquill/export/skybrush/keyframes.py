@@ -1,7 +1,7 @@
 """A trajectory as Skybrush keyframes: cubic Bézier segments on Skybrush's ms and mm grid.
 
 Skybrush's server stores segment durations in whole milliseconds and coordinates in units
-of ``scale`` mm (:mod:`skyquill.io.skybrush_playback`). Keyframes off that grid drift: the
+of ``scale`` mm (:mod:`skyquill.export.skybrush.playback`). Keyframes off that grid drift: the
 old 0.0999 s spacing played 28 mm and 30 ms off on 永. Here every segment boundary is an
 integer millisecond and every Bézier point is written as a number that the server's
 truncation maps to the intended integer, so what the drone plays is exactly what is built
@@ -34,7 +34,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from skyquill.errors import InputError
-from skyquill.io.skybrush_playback import quantize, scaling_factor
+from skyquill.export.skybrush.playback import quantize, scaling_factor
 from skyquill.trajectory import PiecewisePolynomial, RestToRestSequence, Trajectory
 from skyquill.validation import FloatArray, as_float
 

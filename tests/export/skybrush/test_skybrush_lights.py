@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from skyquill.colors import check_rgb
 from skyquill.errors import InputError
-from skyquill.io import skybrush_lights as lights
-from skyquill.io.skybrush_lights import (
-    check_rgb,
+from skyquill.export.skybrush import lights
+from skyquill.export.skybrush.lights import (
     colored_frames,
     encode_light_program,
     light_colors,

@@ -17,10 +17,16 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from skyquill.errors import InputError
-from skyquill.io import skyc
-from skyquill.io.skybrush_keyframes import skybrush_keyframes
-from skyquill.io.skybrush_lights import encode_light_program, program_bytes
-from skyquill.io.skyc import SkycDrone, read_show_json, show_trajectories, validate_show, write_skyc
+from skyquill.export.skybrush import skyc_file as skyc
+from skyquill.export.skybrush.keyframes import skybrush_keyframes
+from skyquill.export.skybrush.lights import encode_light_program, program_bytes
+from skyquill.export.skybrush.skyc_file import (
+    SkycDrone,
+    read_show_json,
+    show_trajectories,
+    validate_show,
+    write_skyc,
+)
 from skyquill.trajectory import SplineTrajectory
 
 

@@ -1,0 +1,23 @@
+"""PX4 offboard setpoints in PX4's local NED frame: a CSV of samples, read back as ENU.
+
+The frame conversion is :mod:`skyquill.export.px4.setpoints`; the file is checked as a
+consumer reads it, with the NED-to-ENU conversion applied.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from skyquill.export.px4.setpoints import px4_setpoints, read_px4_csv
+from skyquill.export.samples import SampledExporter
+from skyquill.trajectory import SampledTrajectory, Trajectory
+
+
+def _write_px4(traj: Trajectory, path: Path, rate: float) -> SampledTrajectory:
+    px4_setpoints(traj, rate_hz=rate).to_csv(path)
+    return read_px4_csv(path)
+
+
+EXPORTER = SampledExporter(
+    "px4", ".csv", "PX4 offboard setpoints CSV in NED, yaw in degrees", _write_px4
+)
