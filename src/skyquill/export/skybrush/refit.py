@@ -1,0 +1,111 @@
+"""Keyframes Skybrush plays inside the plan's limits: built, played, checked, refitted or refused.
+
+Each drone's keyframes (:func:`~.keyframes.skybrush_keyframes`) are played with Skybrush's own
+arithmetic (:mod:`.playback`) and checked densely against the plan's limits
+(:func:`~skyquill.export.base.check_delivered`). Played speed and acceleration may be at most
+1 % over a limit and the jerk 5 % (:data:`~skyquill.export.base.ALLOWED_EXCESS`: what the
+millimetre grid cannot avoid where the plan touches a limit). Beyond that the keyframes are
+made again, each time further from the limits: :data:`ATTEMPTS` (a planning margin on the fit,
+longer fit segments, and at last every segment fitted, none copied from the plan); if even the
+last plays over a limit, the export is refused with the numbers.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+from skyquill.errors import InfeasibleError
+from skyquill.export.base import ALLOWED_EXCESS, ORDER_NAMES, DeliveredCheck, check_delivered
+from skyquill.export.skybrush.keyframes import Keyframes, skybrush_keyframes
+from skyquill.export.skybrush.playback import played_trajectory
+from skyquill.io.trajectory_json import PlannedTrajectory
+from skyquill.verify import verify
+
+#: ``(margin, exact pieces kept, fit segment scale)`` tried in order.
+ATTEMPTS = ((0.0, True, 1.0), (0.02, True, 1.5), (0.05, False, 2.0))
+
+
+@dataclass(frozen=True)
+class PlayedKeyframes:
+    """A drone's keyframes, their check as played, and the attempt that made them."""
+
+    keyframes: Keyframes
+    delivered: DeliveredCheck
+    attempt: int
+
+    def report(self) -> dict[str, Any]:
+        """JSON-ready: how the keyframes were made and refitted."""
+        margin, exact, scale = ATTEMPTS[self.attempt]
+        return self.keyframes.report() | {
+            "refit": {
+                "attempt": self.attempt + 1,
+                "of": len(ATTEMPTS),
+                "margin": margin,
+                "exact_pieces": exact,
+                "segment_scale": scale,
+            }
+        }
+
+
+def played_keyframes(name: str, planned: PlannedTrajectory) -> PlayedKeyframes:
+    """Keyframes of ``planned`` that play within the allowed excess of its limits.
+
+    Raises
+    ------
+    InfeasibleError
+        When the last attempt still plays over a limit: naming the drone, the limit, how
+        far over, and what to do.
+    """
+    last: PlayedKeyframes | None = None
+    infeasible: InfeasibleError | None = None
+    for i, (margin, exact, scale) in enumerate(ATTEMPTS):
+        try:
+            frames = skybrush_keyframes(
+                planned.trajectory, planned.limits, margin=margin, exact=exact, segment_scale=scale
+            )
+        except InfeasibleError as exc:  # a fit region that cannot keep the limits
+            infeasible = exc
+            continue
+        back = played_trajectory(name, {"points": frames.points()}).trajectory()
+        last = PlayedKeyframes(frames, check_delivered(name, planned, back), i)
+        if last.delivered.within_allowed or not planned.limits:
+            return last
+    if last is not None:
+        raise _refusal(name, last.delivered)
+    raise _unfittable(name, planned, infeasible)
+
+
+def _unfittable(
+    name: str, planned: PlannedTrajectory, cause: InfeasibleError | None
+) -> InfeasibleError:
+    """The refusal of a drone no keyframes keep inside its limits, with the plan's own excess."""
+    own = verify(planned.trajectory, planned.limits, guaranteed=False)
+    orders = [(n, own.excess(n)) for n in ORDER_NAMES]
+    order, excess = max(orders, key=lambda item: item[1])
+    itself = (
+        f"the plan itself is {100 * excess:.2f} % over its {ORDER_NAMES[order]} limit"
+        if excess > 0
+        else "the plan keeps its limits, but not on Skybrush's grid"
+    )
+    where = f" ({cause})" if cause is not None else ""
+    return InfeasibleError(
+        f"plan: got drone {name}, which no C2 cubic keyframes on Skybrush's ms and mm grid "
+        f"keep inside its limits: {itself}{where}; expected a plan inside its limits",
+        ("limits",),
+    )
+
+
+def _refusal(name: str, check: DeliveredCheck) -> InfeasibleError:
+    """The refusal of a drone whose keyframes play over a limit, with the numbers."""
+    order, excess = max(
+        enumerate(check.excess_by_order, start=1),
+        key=lambda item: item[1] - ALLOWED_EXCESS[item[0]],
+    )
+    what = ORDER_NAMES[order]
+    return InfeasibleError(
+        f"plan: got drone {name}'s {what} {100 * excess:.2f} % over its limit as Skybrush "
+        f"plays it (after {len(ATTEMPTS)} fits on Skybrush's ms and mm grid), expected at "
+        f"most {100 * ALLOWED_EXCESS[order]:g} % over; plan it with a lower {what} limit",
+        ("limits",),
+    )
