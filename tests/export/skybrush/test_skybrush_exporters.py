@@ -106,9 +106,18 @@ def test_limits_the_plan_touches_are_kept_as_played(tmp_path: Path) -> None:
     played = report.as_played
     assert played.within_allowed and report.details["limits_hold"]
     assert ("every limit met" in report.message) == played.exact
-    back = show_trajectories(read_show_json(report.files[0]))[0]
+    show = read_show_json(report.files[0])
+    back = show_trajectories(show)[0]
     check = verify(back, tight, guaranteed=False)
     assert max(check.excess(1), check.excess(2)) <= 0.01 and check.excess(3) <= 0.05
+    # the validation settings written are ones the played curve meets
+    validation = show["settings"]["validation"]
+    t = dense_times(back.breakpoints)
+    for order, keys in ((1, "maxVelocity"), (2, "maxAcceleration")):
+        d = back.evaluate(t, order)
+        assert np.hypot(d[:, 0], d[:, 1]).max() <= validation[f"{keys}XY"]
+        assert d[:, 2].max() <= validation[f"{keys}ZUp"]
+        assert -d[:, 2].min() <= validation[f"{keys}Z"]
 
 
 def test_a_plan_that_cannot_be_played_in_its_limits_is_refused(tmp_path: Path) -> None:

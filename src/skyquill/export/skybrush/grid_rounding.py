@@ -8,7 +8,7 @@ units plays at 2.0 m/s^2 with 13 and at 2.1 m/s^2 with 14.
 
 So every segment is first rounded to the nearest units; each one whose hull (the Bézier
 points of its velocity, acceleration and jerk, which contain the whole curve's) then crosses a
-limit by more than :data:`SEARCH_SHARE` of the allowed excess is searched again. Its start is
+limit by more than :data:`TARGETS` is searched again. Its start is
 the previous segment's end; per axis the options are its forward differences (the start
 velocity ``D1``, acceleration ``D2`` and jerk ``D3`` on the grid) rounded down, up and one
 more either way, which moves its end point by a few units where the curve must be held back
@@ -34,8 +34,12 @@ from skyquill.export.skybrush.keyframe_fit import hull_excess, hull_points
 from skyquill.limits import BoxLimit, CylinderLimit, DerivativeLimit, NormLimit
 from skyquill.validation import FloatArray
 
-#: Share of the allowed excess the rounding aims for on the hull (the rest is for float32).
-SEARCH_SHARE = 0.8
+#: What the rounding aims for on the hull, relative excess per order (speed, acceleration,
+#: jerk): 80 % of :data:`~skyquill.export.base.ALLOWED_EXCESS` (the rest is for the player's
+#: float32 arithmetic). Aiming inside the limits instead (tried: the 10-drone show) holds the
+#: curve back where the plan cruises at its speed limit, 5 mm behind the plan instead of 1.5,
+#: and cannot always be had.
+TARGETS = (tuple(0.8 * ALLOWED_EXCESS[n] for n in (1, 2, 3)),)
 #: Offsets tried for a segment's first difference (round(d1) + ...) and its second and third
 #: (floor(d) + ...), units: rounding down, up, and one more either way.
 #: Tried in this order: second and third differences down or up (12 options per axis), then
@@ -106,7 +110,7 @@ class _Grid:
         self.h = np.asarray(durations_s, dtype=float)
         self.limits = [lim for lim in limits if lim.order in ALLOWED_EXCESS]
         self.unit_m = unit_m
-        self.allowed = np.array([np.inf, *(SEARCH_SHARE * ALLOWED_EXCESS[n] for n in (1, 2, 3))])
+        self.targets = [np.array([np.inf, *target]) for target in TARGETS]
 
     def excess(self, units: FloatArray, h: FloatArray) -> FloatArray:
         """Relative hull excess per segment and order (..., 4) of ``units`` (..., 4, 3)."""
@@ -114,7 +118,8 @@ class _Grid:
 
     def over(self, k: slice) -> NDArray[np.bool_]:
         """Whether each segment of ``k`` crosses a limit by more than the search aims for."""
-        return np.asarray((self.excess(self.units[k], self.h[k]) > self.allowed).any(axis=-1))
+        excess = self.excess(self.units[k], self.h[k])
+        return np.asarray((excess > self.targets[0]).any(axis=-1))
 
     def worst(self) -> tuple[float, float, float]:
         """The largest hull excess per order (1..3) over all segments."""
@@ -131,26 +136,36 @@ class _Grid:
         join steps) adds over the axes, and the limits are evaluated on every combination of
         the three axes by broadcasting, so 48^3 combinations cost a few milliseconds.
         """
-        for steps in SEARCH_STEPS:  # a few options first; all of them only when needed
-            options = [self._axis_options(k, ax, *steps) for ax in range(3)]
-            worst = self._combined_excess(options, self.h[k])
-            if (worst <= 0).any():
-                break
+        tried: dict[int, tuple[list[_AxisOptions], FloatArray]] = {}
+        for target in self.targets:
+            for i, steps in enumerate(SEARCH_STEPS):  # a few options first, then all of them
+                if i not in tried:
+                    options = [self._axis_options(k, ax, *steps) for ax in range(3)]
+                    tried[i] = (options, self._combined_excess(options, self.h[k]))
+                options, excess = tried[i]
+                worst = (excess - target).max(axis=-1)
+                if (worst <= 0).any():
+                    self._take(k, options, worst)
+                    return True
+        self._take(k, options, worst)
+        return False
+
+    def _take(self, k: int, options: list[_AxisOptions], worst: FloatArray) -> None:
+        """Set segment ``k`` to the cheapest combination inside (``worst <= 0``), else to the
+        one with the least excess."""
         cost = sum(
             o.cost.reshape([-1 if a == ax else 1 for a in range(3)]) for ax, o in enumerate(options)
         )
-        inside = worst <= 0
-        flat = (
-            int(np.flatnonzero(inside.ravel())[np.argmin(np.asarray(cost).ravel()[inside.ravel()])])
-            if inside.any()
-            else int(np.argmin(worst.ravel()))
-        )
+        inside = (worst <= 0).ravel()
+        if inside.any():
+            flat = int(np.flatnonzero(inside)[np.argmin(np.asarray(cost).ravel()[inside])])
+        else:
+            flat = int(np.argmin(worst.ravel()))
         pick = np.unravel_index(flat, worst.shape)
         for ax, o in enumerate(options):
             self.units[k, :, ax] = o.points[pick[ax]]
         if k + 1 < self.h.size:
             self.units[k + 1, 0] = self.units[k, 3]
-        return bool(inside.any())
 
     def _axis_options(
         self, k: int, ax: int, d1_steps: tuple[float, ...], d23_steps: tuple[float, ...]
@@ -164,7 +179,8 @@ class _Grid:
         drift = start - exact[0]
         grid = np.stack(
             np.meshgrid(
-                np.rint(d1 - drift / 3.0) + np.array(d1_steps),
+                # with the drift taken back, or left (where taking it back is too fast)
+                np.unique([*(np.rint(d1 - drift / 3.0) + np.array(d1_steps)), np.floor(d1)]),
                 np.floor(d2) + np.array(d23_steps),
                 np.floor(d3) + np.array(d23_steps),
                 indexing="ij",
@@ -183,13 +199,13 @@ class _Grid:
         return _AxisOptions(points, cost)
 
     def _combined_excess(self, options: list[_AxisOptions], h: float) -> FloatArray:
-        """The largest excess over the allowed, of every combination (nx, ny, nz)."""
+        """The relative excess per order (column 1..3) of every combination (nx, ny, nz, 4)."""
         parts = [
             hull_points(o.points[:, :, None] * self.unit_m, np.full(len(o.points), h))
             for o in options
         ]
         shape = [len(o.points) for o in options]
-        worst = np.full(shape, -np.inf)
+        worst = np.full([*shape, 4], -np.inf)
         for lim in self.limits:
             comps = [
                 parts[ax][lim.order][..., 0].reshape(
@@ -197,8 +213,8 @@ class _Grid:
                 )
                 for ax in range(3)
             ]
-            excess = _limit_excess(lim, comps)
-            worst = np.maximum(worst, excess - self.allowed[lim.order])
+            order = worst[..., lim.order]
+            worst[..., lim.order] = np.maximum(order, _limit_excess(lim, comps))
         return worst
 
     def _join_steps(self, k: int, points: FloatArray, ax: int) -> FloatArray:

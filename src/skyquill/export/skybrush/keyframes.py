@@ -35,6 +35,7 @@ spline has continuous acceleration, which is what the joins need.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -101,7 +102,8 @@ class Keyframes:
             out["rounding"] = {
                 "adjusted_segments": self.rounding.adjusted,
                 "unresolved_segments": len(self.rounding.unresolved),
-                "hull_excess": list(self.rounding.hull_excess),
+                # None for an order without a limit
+                "hull_excess": [e if math.isfinite(e) else None for e in self.rounding.hull_excess],
             }
         return out
 
