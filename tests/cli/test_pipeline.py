@@ -91,7 +91,7 @@ PLANS: list[tuple[str, Callable[[Path], list[str]], float]] = [
 READERS: dict[str, Callable[[list[Path]], list[Trajectory]]] = {
     # Each drone's uploads on the plan's clock, as the Crazyflie evaluates them (float32).
     "crazyswarm": lambda files: list(
-        read_export(files[0].with_name(f"{files[0].stem.split('_')[0]}.summary.json")).values()
+        read_export(files[0].with_name(f"{files[0].stem.split('_')[0]}.csv.summary.json")).values()
     ),
     "skyc": lambda files: show_trajectories(read_show_json(files[0])),
     "skybrush-csv": lambda files: [d.trajectory() for d in read_csv_zip(files[0])],
@@ -167,7 +167,7 @@ def test_plan_flies_exports_and_reads_back(
             assert done.exit_code == 2 and "origin: got none" in done.output
             continue
         assert done.exit_code == 0, done.output
-        report = json.loads(out.with_name(f"{out.stem}.summary.json").read_text())
+        report = json.loads(out.with_name(f"{out.name}.summary.json").read_text())
         files = [Path(f) for f in report["files"]]
         backs = _by_drone(name, files, len(drones))
         for reference, back in zip(exact, backs, strict=True):
