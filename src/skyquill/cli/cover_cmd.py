@@ -10,12 +10,14 @@ import typer
 
 from skyquill.cli.main import (
     Force,
+    MinAltitude,
     OutDir,
     Target,
     Vmax,
     app,
     check_out,
     console,
+    min_altitude,
     say_done,
     upload_target,
     user_errors,
@@ -23,6 +25,7 @@ from skyquill.cli.main import (
 from skyquill.coverage import DEFAULT_MIN_COVERAGE
 from skyquill.errors import InputError
 from skyquill.limits import VehicleLimits
+from skyquill.phases import MIN_ALTITUDE_M, check_altitude
 
 if TYPE_CHECKING:
     from rich.progress import Progress, TaskID
@@ -86,7 +89,9 @@ def cover(
         ),
     ] = DEFAULT_MIN_COVERAGE,
     rate: Annotated[float, typer.Option(help="Setpoint rate, Hz.")] = 50.0,
-    altitude: Annotated[float, typer.Option(help="Flight height, m.")] = 2.0,
+    altitude: Annotated[
+        float, typer.Option(help="Flight height above the ground, m (--min-altitude to 120).")
+    ] = 2.0,
     time_limit: Annotated[
         float,
         typer.Option(
@@ -110,6 +115,7 @@ def cover(
         ),
     ] = None,
     target: Target = None,
+    min_altitude_m: MinAltitude = MIN_ALTITUDE_M,
     force: Force = False,
 ) -> None:
     """Plan a coverage flight of REGION; write summary.json, trajectory.csv and plot.png.
@@ -135,6 +141,8 @@ def cover(
 
     with user_errors():
         check_out(out)
+        floor = min_altitude(min_altitude_m)
+        altitude = check_altitude("--altitude", altitude, floor)
         geo = load_geo_region(region, crs, origin_alt)
         shape = geo.region
         options = CoverageOptions(
@@ -185,6 +193,7 @@ def cover(
                 guaranteed=plan.delivered is not None,
                 summary=fields,
                 plot=lambda path: plot_coverage(plan, path),
+                min_altitude_m=floor,
             )
     uploads = "" if plan.delivered is None else f", {len(plan.delivered.budget.uploads)} upload(s)"
     say_done(

@@ -23,6 +23,7 @@ from skyquill.io.atomic import write_json
 from skyquill.io.outputs import staged_output
 from skyquill.io.plan_dir import plan_files, read_plan
 
+
 def summary_name(out: Path) -> str:
     """The export's summary beside ``out``: ``<file name>.summary.json``, extension included."""
     return f"{out.name}.summary.json"

@@ -16,15 +16,18 @@ import typer
 
 from skyquill.cli.main import (
     Force,
+    MinAltitude,
     OutDir,
     app,
     check_out,
     console,
+    min_altitude,
     parse_vector3,
     say_done,
     user_errors,
 )
 from skyquill.errors import InputError
+from skyquill.phases import MIN_ALTITUDE_M
 
 if TYPE_CHECKING:  # the painting package is imported lazily
     from rich.progress import Progress
@@ -71,6 +74,7 @@ def paint(
         float, typer.Option(help="Probability of a missed contact per approach.")
     ] = 0.0,
     seed: Annotated[int, typer.Option(help="Seed of the random generator.")] = 0,
+    min_altitude_m: MinAltitude = MIN_ALTITUDE_M,
     force: Force = False,
 ) -> None:
     """Paint DOTS.csv (or a stippled --image) on a wall; write summary.json, painted.csv, plot."""
@@ -89,6 +93,7 @@ def paint(
 
     with user_errors():
         check_out(out)
+        floor = min_altitude(min_altitude_m)
         seed = as_seed("--seed", seed)
         if estimator not in ESTIMATORS:
             raise InputError(
@@ -156,6 +161,7 @@ def paint(
                     "trajectory_duration_s": flown.trajectory.duration,
                 },
                 plot=lambda path: plot_mission(result, path, (dots_csv or image or Path("")).name),
+                min_altitude_m=floor,
             )
     say_done(
         f"{out}: {result.painted.sum()} of {len(result.reference)} dots, RMSE "

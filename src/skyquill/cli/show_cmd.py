@@ -11,10 +11,12 @@ import typer
 
 from skyquill.cli.main import (
     Force,
+    MinAltitude,
     OutDir,
     app,
     check_out,
     console,
+    min_altitude,
     say_done,
     stage_progress,
     user_errors,
@@ -24,6 +26,7 @@ from skyquill.io.atomic import write_json
 from skyquill.io.outputs import staged_output
 from skyquill.io.plan_dir import trajectory_names, write_plan
 from skyquill.io.trajectory_json import PlannedTrajectory
+from skyquill.phases import MIN_ALTITUDE_M
 from skyquill.show import ShowDrone, ShowLimits, ShowReport, check_show, load_show
 from skyquill.show.build import ShowPlan, build_show
 from skyquill.show.script import ShowScript, load_script
@@ -44,6 +47,7 @@ def show(
         str | None,
         typer.Option(help="dask.distributed scheduler address (or 'local') for the writing."),
     ] = None,
+    min_altitude_m: MinAltitude = MIN_ALTITUDE_M,
     force: Force = False,
 ) -> None:
     """Plan a show script: formations, transitions, writing, take-off and landing.
@@ -54,6 +58,7 @@ def show(
     """
     with user_errors():
         check_out(out)
+        floor = min_altitude(min_altitude_m)
         if workers is not None and workers < 1:
             raise InputError(f"--workers: got {workers}, expected at least 1")
         show_script = load_script(script)
@@ -64,7 +69,7 @@ def show(
             report = _check(plan, show_script)
         stages["check"] = time.perf_counter() - clock
         with staged_output(out, "show", force=force, inputs=[script]) as stage:
-            summary = _write(stage, plan, show_script, report, stages)
+            summary = _write(stage, plan, show_script, report, stages, floor)
     say_done(
         f"{out}: {summary['drones']} drones, {summary['duration_s']:.1f} s, no two closer than "
         f"{summary['min_separation_m']['guaranteed']:.3f} m (guaranteed; "
@@ -121,6 +126,7 @@ def _write(
     script: ShowScript,
     report: ShowReport,
     stages: dict[str, float],
+    min_altitude_m: float,
 ) -> dict[str, Any]:
     from skyquill.viz.light_painting import write_pictures
 
@@ -165,7 +171,14 @@ def _write(
         "pictures": pictures,
     }
     clock = time.perf_counter()
-    full = write_plan(stage, plan.drones, rate=script.rate_hz, guaranteed=True, summary=summary)
+    full = write_plan(
+        stage,
+        plan.drones,
+        rate=script.rate_hz,
+        guaranteed=True,
+        summary=summary,
+        min_altitude_m=min_altitude_m,
+    )
     full["planning_time_s"]["files"] = time.perf_counter() - clock
     write_json(stage / "summary.json", full)
     return full

@@ -18,6 +18,7 @@ from skyquill.cli.main import (
     Force,
     Jmax,
     JmaxAxis,
+    MinAltitude,
     NormSides,
     OutDir,
     Target,
@@ -26,6 +27,7 @@ from skyquill.cli.main import (
     app,
     check_out,
     console,
+    min_altitude,
     parse_color,
     positive_rate,
     say_done,
@@ -40,6 +42,7 @@ from skyquill.io.outputs import staged_output
 from skyquill.io.plan_dir import trajectory_names, write_plan
 from skyquill.io.trajectory_json import PlannedTrajectory
 from skyquill.limits import VehicleLimits
+from skyquill.phases import MIN_ALTITUDE_M
 from skyquill.show.lights import COLOR_BY, window_palette
 
 if TYPE_CHECKING:
@@ -219,9 +222,13 @@ def write(
         str, typer.Option(help="drone (each drone the next colour) or stroke (each stroke).")
     ] = "drone",
     target: Target = None,
+    min_altitude_m: MinAltitude = MIN_ALTITUDE_M,
     force: Force = False,
 ) -> None:
     """Plan pen-up / pen-down writing flights; write CSVs, input_strokes.json, plot, summary.
+
+    Each drone's mission starts and ends hovering at --min-altitude above its home (the
+    vehicle takes off to it and lands from it); nothing between is planned below it.
 
     On a sky board (light painting) also long_exposure.png, the photograph of the lights
     from in front, and preview.gif (``skyquill render`` shows them from any view).
@@ -231,6 +238,7 @@ def write(
     with user_errors():
         check_out(out)
         rate = positive_rate(rate)
+        floor = min_altitude(min_altitude_m)
         palette = _palette(light_color, color_by)
         kind = _board_kind(board, fly)
         pose = _sky_pose(kind, board_yaw, board_tilt, plane_weight, grid, lift)
@@ -272,10 +280,18 @@ def write(
                 board_tilt_deg=pose.tilt_deg,
                 grid=pose.grid,
                 places=places.places if sharing.split else None,
+                home_altitude_m=floor,
             )
         inputs = [p for p in (strokes, svg, hanzi) if p is not None]
         summary = write_outputs(
-            show, out, rate, force=force, inputs=inputs, extra=extra(show), palette=palette
+            show,
+            out,
+            rate,
+            force=force,
+            inputs=inputs,
+            extra=extra(show),
+            palette=palette,
+            min_altitude_m=floor,
         )
     say_done(
         f"{out}: {summary['duration_s']:.1f} s of flight, planned in "
@@ -465,6 +481,7 @@ def write_outputs(
     inputs: Sequence[Path] = (),
     extra: dict[str, Any] | None = None,
     palette: tuple[Sequence[RGB], str] | None = None,
+    min_altitude_m: float = MIN_ALTITUDE_M,
 ) -> dict[str, Any]:
     """The plan directory: trajectories, ``input_strokes.json``, ``plot.png``, ``summary.json``.
 
@@ -524,6 +541,7 @@ def write_outputs(
             | pictures
             | (extra or {}),
             plot=lambda path: plot_missions(missions, path, "skyquill write"),
+            min_altitude_m=min_altitude_m,
         )
 
 

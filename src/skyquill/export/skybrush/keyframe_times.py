@@ -37,7 +37,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from skyquill.errors import InputError
-from skyquill.limits import BoxLimit, CylinderLimit, DerivativeLimit, NormLimit
+from skyquill.limits import DerivativeLimit, limit_bounds
 from skyquill.trajectory import PiecewisePolynomial, RestToRestSequence, Trajectory
 
 #: Shortest cubic piece of the plan kept as an exact segment of its own, ms.
@@ -75,27 +75,6 @@ class Segmentation:
     times_ms: NDArray[np.int64]
     exact: NDArray[np.bool_]
     regions: tuple[tuple[int, int], ...]
-
-
-def limit_bounds(limits: Sequence[DerivativeLimit]) -> dict[int, float]:
-    """The smallest bound on each derivative order's magnitude the limits state, SI units.
-
-    A norm gives its radius, a cylinder the smaller of its radius and vertical bounds, a box
-    its smallest bound; orders without a limit are left out.
-    """
-    out: dict[int, float] = {}
-    for lim in limits:
-        if isinstance(lim, NormLimit | CylinderLimit):
-            bound = float(lim.radius)
-            if isinstance(lim, CylinderLimit) and lim.z_lower is not None:
-                assert lim.z_upper is not None
-                bound = min(bound, abs(lim.z_lower), abs(lim.z_upper))
-        elif isinstance(lim, BoxLimit):
-            bound = float(np.minimum(np.abs(lim.lower), np.abs(lim.upper)).min())
-        else:  # pragma: no cover - the three limit kinds
-            continue
-        out[lim.order] = min(out.get(lim.order, math.inf), bound)
-    return out
 
 
 def fit_segment_ms(limits: Sequence[DerivativeLimit], unit_m: float, scale: float = 1.0) -> int:

@@ -7,7 +7,9 @@ arithmetic (:mod:`.playback`) and checked densely against the plan's limits
 millimetre grid cannot avoid where the plan touches a limit). Beyond that the keyframes are
 made again, each time further from the limits: :data:`ATTEMPTS` (a planning margin on the fit,
 longer fit segments, and at last every segment fitted, none copied from the plan); if even the
-last plays over a limit, the export is refused with the numbers.
+last plays over a limit, the export is refused with the numbers. A fit that keeps the limits
+only by leaving the plan (more than :data:`MAX_DEVIATION_M` from it: a plan over its own
+limits) is refused too.
 """
 
 from __future__ import annotations
@@ -24,6 +26,9 @@ from skyquill.verify import verify
 
 #: ``(margin, exact pieces kept, fit segment scale)`` tried in order.
 ATTEMPTS = ((0.0, True, 1.0), (0.02, True, 1.5), (0.05, False, 2.0))
+#: Farthest the keyframes may be from the plan before rounding, m: a fit farther off is a
+#: plan its limits cannot fly (it is over them), not the plan delivered.
+MAX_DEVIATION_M = 0.02
 
 
 @dataclass(frozen=True)
@@ -67,18 +72,23 @@ def played_keyframes(name: str, planned: PlannedTrajectory) -> PlayedKeyframes:
         except InfeasibleError as exc:  # a fit region that cannot keep the limits
             infeasible = exc
             continue
+        if frames.fit_error_m > MAX_DEVIATION_M:  # kept the limits by leaving the plan
+            raise _unfittable(
+                name,
+                planned,
+                f"keyframes inside them are {100 * frames.fit_error_m:.1f} cm from it, "
+                f"farther than {100 * MAX_DEVIATION_M:g} cm",
+            )
         back = played_trajectory(name, {"points": frames.points()}).trajectory()
         last = PlayedKeyframes(frames, check_delivered(name, planned, back), i)
         if last.delivered.within_allowed or not planned.limits:
             return last
     if last is not None:
         raise _refusal(name, last.delivered)
-    raise _unfittable(name, planned, infeasible)
+    raise _unfittable(name, planned, str(infeasible))
 
 
-def _unfittable(
-    name: str, planned: PlannedTrajectory, cause: InfeasibleError | None
-) -> InfeasibleError:
+def _unfittable(name: str, planned: PlannedTrajectory, cause: str) -> InfeasibleError:
     """The refusal of a drone no keyframes keep inside its limits, with the plan's own excess."""
     own = verify(planned.trajectory, planned.limits, guaranteed=False)
     orders = [(n, own.excess(n)) for n in ORDER_NAMES]
@@ -88,10 +98,9 @@ def _unfittable(
         if excess > 0
         else "the plan keeps its limits, but not on Skybrush's grid"
     )
-    where = f" ({cause})" if cause is not None else ""
     return InfeasibleError(
         f"plan: got drone {name}, which no C2 cubic keyframes on Skybrush's ms and mm grid "
-        f"keep inside its limits: {itself}{where}; expected a plan inside its limits",
+        f"keep inside its limits ({cause}): {itself}; expected a plan inside its limits",
         ("limits",),
     )
 

@@ -2,7 +2,8 @@
 
 Each drone's plan becomes C2 cubic Bézier keyframes on the grid Skybrush's server stores,
 played back and refitted until they play inside the plan's limits
-(:mod:`skyquill.export.skybrush.refit`), a light program that is on in the chosen colour
+(:mod:`skyquill.export.skybrush.refit`), starting and ending on its pad
+(:mod:`skyquill.export.skybrush.pads`), a light program that is on in the chosen colour
 while the pen is down (:mod:`skyquill.export.skybrush.lights`), a constant yaw of 0, and the
 show gets validation settings that the played curves meet (:mod:`.validation`). The written
 file is then read back and played with Skybrush's own arithmetic
@@ -38,6 +39,7 @@ from skyquill.export.skybrush.lights import (
     light_slices,
     program_bytes,
 )
+from skyquill.export.skybrush.pads import on_pads, takeoff_report
 from skyquill.export.skybrush.playback import played_show, played_trajectory
 from skyquill.export.skybrush.refit import played_keyframes
 from skyquill.export.skybrush.skyc_file import (
@@ -66,6 +68,7 @@ class SkycExporter:
         self, plans: Sequence[NamedPlan], out: Path, options: ExportOptions
     ) -> ExportReport:
         """Write the show, read it back as the drones play it, check it against the plans."""
+        plans = [(name, on_pads(plan)) for name, plan in plans]  # as Skybrush expects
         made = [played_keyframes(name, plan) for name, plan in plans]
         drones = [
             SkycDrone(
@@ -103,6 +106,9 @@ class SkycExporter:
             for i, ((_, plan), back) in enumerate(zip(plans, played, strict=True))
         ]
         details = _details(drones, delivered, lights, validation)
+        details["pads"] = [
+            takeoff_report(plan.trajectory) | {"drone": name} for name, plan in plans
+        ]
         details["keyframes"] = [
             keys.report() | {"drone": name} for (name, _), keys in zip(plans, made, strict=True)
         ]
