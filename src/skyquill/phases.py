@@ -46,6 +46,8 @@ DEFAULT_ALTITUDE_M = 1.0
 MAX_ALTITUDE_M = 120.0
 #: Largest speed (m/s) and acceleration (m/s^2) that count as rest.
 REST_TOLERANCE = 1e-6
+#: A sampled speed below which a local minimum is refined to see whether it is a rest, m/s.
+SLOW_MPS = 0.05
 #: How far below the minimum altitude the plan may touch it (round-off), m.
 ALTITUDE_TOLERANCE_M = 1e-6
 #: Limits of a take-off or landing leg added to a plan that states none.
@@ -165,12 +167,36 @@ def check_altitude(name: str, value: float, min_altitude_m: float) -> float:
 
 
 def rest_times(traj: Trajectory) -> FloatArray:
-    """Where ``traj`` is at rest among its breakpoints (and ends), s, sorted."""
-    t = np.unique(np.concatenate([[0.0, traj.duration], np.asarray(traj.breakpoints, float)]))
-    t = t[(t >= 0.0) & (t <= traj.duration)]
+    """Where ``traj`` is at rest (speed and acceleration within :data:`REST_TOLERANCE`), s.
+
+    Candidates are its ends, its breakpoints (where rest-to-rest pieces meet) and every local
+    minimum of the speed between dense samples, refined (a waypoint a fit stops at lies
+    between knots).
+    """
+    t = dense_times(np.asarray(traj.breakpoints, dtype=float))
     speed = np.linalg.norm(traj.evaluate(t, 1), axis=1)
-    accel = np.linalg.norm(traj.evaluate(t, 2), axis=1)
-    return np.asarray(t[(speed <= REST_TOLERANCE) & (accel <= REST_TOLERANCE)])
+    dips = np.flatnonzero((speed[1:-1] <= speed[:-2]) & (speed[1:-1] <= speed[2:])) + 1
+    still = t[speed <= REST_TOLERANCE]  # at rest already (a hold): no need to refine
+    dips = dips[(speed[dips] > REST_TOLERANCE) & (speed[dips] <= SLOW_MPS)]
+    refined = [_slowest(traj, float(t[i - 1]), float(t[i + 1])) for i in dips]
+    candidates = np.unique(
+        np.concatenate([[0.0, traj.duration], np.asarray(traj.breakpoints, float), still, refined])
+    )
+    candidates = candidates[(candidates >= 0.0) & (candidates <= traj.duration)]
+    v = np.linalg.norm(traj.evaluate(candidates, 1), axis=1)
+    a = np.linalg.norm(traj.evaluate(candidates, 2), axis=1)
+    return np.asarray(candidates[(v <= REST_TOLERANCE) & (a <= REST_TOLERANCE)])
+
+
+def _slowest(traj: Trajectory, lo: float, hi: float) -> float:
+    """The time of the least speed in ``[lo, hi]`` (bounded scalar minimisation), s."""
+    from scipy.optimize import minimize_scalar
+
+    def speed2(t: float) -> float:
+        return float(np.sum(traj.evaluate(np.array([t]), 1) ** 2))
+
+    result = minimize_scalar(speed2, bounds=(lo, hi), method="bounded", options={"xatol": 1e-10})
+    return float(result.x)
 
 
 def flight_phases(

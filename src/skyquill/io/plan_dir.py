@@ -58,7 +58,7 @@ def write_plan(
     guaranteed: bool,
     summary: dict[str, Any],
     plot: Callable[[Path], None] | None = None,
-    min_altitude_m: float = MIN_ALTITUDE_M,
+    min_altitude_m: float | None = MIN_ALTITUDE_M,
 ) -> dict[str, Any]:
     """Write the plan directory ``out`` and return the ``summary.json`` written.
 
@@ -81,7 +81,8 @@ def write_plan(
     min_altitude_m
         The mission's minimum altitude above the ground, m: each trajectory's phases are
         found (:func:`~skyquill.phases.flight_phases`, unless given) and recorded in its
-        ``trajectory.json`` and in ``summary.json``.
+        ``trajectory.json`` and in ``summary.json``. ``None`` records none: trajectories
+        that are not a vehicle's flight (a test's synthetic show); exporters find them then.
 
     Raises
     ------
@@ -93,12 +94,8 @@ def write_plan(
     for i, p in enumerate(planned):
         if p.trajectory.dim != 3:
             raise InputError(f"planned[{i}]: got {p.trajectory.dim} axes, expected 3 (x, y, z)")
-    planned = [
-        p
-        if p.phases is not None
-        else replace(p, phases=flight_phases(p.trajectory, min_altitude_m))
-        for p in planned
-    ]
+    if min_altitude_m is not None:
+        planned = [_with_phases(p, min_altitude_m) for p in planned]
     out.mkdir(parents=True, exist_ok=True)
     drones = [
         _write_drone(out, names, p, rate, guaranteed)
@@ -120,6 +117,13 @@ def write_plan(
     }
     write_json(out / "summary.json", full)
     return full
+
+
+def _with_phases(planned: PlannedTrajectory, min_altitude_m: float) -> PlannedTrajectory:
+    """``planned`` with its phases (found at ``min_altitude_m`` unless it has them)."""
+    if planned.phases is not None:
+        return planned
+    return replace(planned, phases=flight_phases(planned.trajectory, min_altitude_m))
 
 
 def _write_drone(
