@@ -20,6 +20,7 @@ from skyquill.coverage.geo import GeoFrame
 from skyquill.errors import InputError
 from skyquill.io.trajectory_json import PlannedTrajectory, pen_down
 from skyquill.trajectory import Trajectory, dense_times
+from skyquill.trajectory.window import time_window
 from skyquill.validation import as_float
 from skyquill.verify import verify
 
@@ -266,6 +267,30 @@ class Exporter(Protocol):
     def __call__(
         self, plans: Sequence[NamedPlan], out: Path, options: ExportOptions
     ) -> ExportReport: ...
+
+
+def mission_plan(planned: PlannedTrajectory) -> PlannedTrajectory:
+    """The mission part of ``planned`` on its own clock, with its pen windows moved along."""
+    phases = planned.flight()
+    start, end = phases.mission_s
+    if end <= start:
+        raise InputError(
+            f"plan: got a mission of no length (at {start:.2f} s), expected a flight between "
+            "two rests in the air"
+        )
+    windows = tuple(
+        (max(a, start) - start, min(b, end) - start)
+        for a, b in planned.pen_windows_s
+        if b >= start and a <= end
+    )
+    colors = tuple(
+        c
+        for (a, b), c in zip(planned.pen_windows_s, planned.pen_rgb, strict=False)
+        if b >= start and a <= end
+    )
+    return PlannedTrajectory(
+        time_window(planned.trajectory, start, end), windows, planned.limits, colors
+    )
 
 
 def target(out: Path, name: str, several: bool, suffix: str) -> Path:

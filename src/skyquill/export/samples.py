@@ -19,6 +19,7 @@ from skyquill.export.base import (
     ExportReport,
     NamedPlan,
     check_delivered,
+    mission_plan,
     target,
 )
 from skyquill.io.points import write_trajectory_csv
@@ -39,18 +40,26 @@ def _write_json(traj: Trajectory, path: Path, rate: float) -> SampledTrajectory:
 
 @dataclass(frozen=True)
 class SampledExporter:
-    """A format that holds samples: one file per drone, read back by its own reader."""
+    """A format that holds samples: one file per drone, read back by its own reader.
+
+    ``mission_only``: the file holds the plan's mission (:mod:`skyquill.phases`) on its own
+    clock, for a vehicle that takes off and lands by itself (PX4: its first row is the first
+    airborne setpoint, where offboard starts); else the whole plan.
+    """
 
     name: str
     suffix: str
     help: str
     write: Callable[[Trajectory, Path, float], SampledTrajectory]
+    mission_only: bool = False
 
     def __call__(
         self, plans: Sequence[NamedPlan], out: Path, options: ExportOptions
     ) -> ExportReport:
         """Write each drone's samples, read them back, compare with the plan."""
         files, checks = [], []
+        if self.mission_only:
+            plans = [(name, mission_plan(planned)) for name, planned in plans]
         for name, planned in plans:
             path = target(out, name, len(plans) > 1, self.suffix)
             back = self.write(planned.trajectory, path, options.rate_hz)

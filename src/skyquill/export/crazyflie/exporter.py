@@ -32,6 +32,7 @@ from skyquill.export.base import (
     ExportReport,
     NamedPlan,
     check_delivered,
+    mission_plan,
     target,
 )
 from skyquill.export.crazyflie import fly_script
@@ -53,7 +54,6 @@ from skyquill.io.trajectory_json import PlannedTrajectory
 from skyquill.phases import FlightPhases
 from skyquill.targets import CRAZYFLIE, Upload, plan_uploads
 from skyquill.trajectory import Trajectory
-from skyquill.trajectory.window import time_window
 from skyquill.validation import FloatArray
 
 #: Relative limit excess of the delivered float32 polynomials that is float32 rounding, not a
@@ -248,30 +248,6 @@ def export_drone(name: str, planned: PlannedTrajectory, path: Path) -> DroneExpo
         )
     flight = _flight(phases, planned)
     return DroneExport(name, tuple(files), flown, check_delivered(name, mission, flown), flight)
-
-
-def mission_plan(planned: PlannedTrajectory) -> PlannedTrajectory:
-    """The mission part of ``planned`` on its own clock, with its pen windows moved along."""
-    phases = planned.flight()
-    start, end = phases.mission_s
-    if end <= start:
-        raise InputError(
-            f"plan: got a mission of no length (at {start:.2f} s), expected a flight between "
-            "two rests in the air"
-        )
-    windows = tuple(
-        (max(a, start) - start, min(b, end) - start)
-        for a, b in planned.pen_windows_s
-        if b >= start and a <= end
-    )
-    colors = tuple(
-        c
-        for (a, b), c in zip(planned.pen_windows_s, planned.pen_rgb, strict=False)
-        if b >= start and a <= end
-    )
-    return PlannedTrajectory(
-        time_window(planned.trajectory, start, end), windows, planned.limits, colors
-    )
 
 
 def _flight(phases: FlightPhases, planned: PlannedTrajectory) -> dict[str, Any]:

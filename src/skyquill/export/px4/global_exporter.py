@@ -109,7 +109,9 @@ class Px4GlobalExporter:
             return read_px4_global(path, origin)
 
         # The sampled formats' loop: one file a drone, read back, checked against the plan.
-        report = SampledExporter(self.name, self.suffix, self.help, write)(plans, out, options)
+        report = SampledExporter(self.name, self.suffix, self.help, write, mission_only=True)(
+            plans, out, options
+        )
         return replace(
             report,
             message=f"wrote {len(report.files)} PX4 global setpoint file(s) at "

@@ -1,7 +1,9 @@
 """PX4 offboard setpoints in PX4's local NED frame: a CSV of samples, read back as ENU.
 
 The frame conversion is :mod:`skyquill.export.px4.setpoints`; the file is checked as a
-consumer reads it, with the NED-to-ENU conversion applied.
+consumer reads it, with the NED-to-ENU conversion applied. It holds the plan's mission only
+(:mod:`skyquill.phases`): ``send_mavsdk`` arms, takes off with PX4's own take-off to the first
+row's height, enters offboard there, streams the rows and lands with PX4's own landing.
 """
 
 from __future__ import annotations
@@ -19,5 +21,10 @@ def _write_px4(traj: Trajectory, path: Path, rate: float) -> SampledTrajectory:
 
 
 EXPORTER = SampledExporter(
-    "px4", ".csv", "PX4 offboard setpoints CSV in NED, yaw in degrees", _write_px4
+    "px4",
+    ".csv",
+    "PX4 offboard setpoints CSV in NED, yaw in degrees: the plan's mission, from its first "
+    "airborne point (PX4 takes off to it and lands after it)",
+    _write_px4,
+    mission_only=True,
 )
