@@ -12,6 +12,7 @@ rate), landing.
 
 from __future__ import annotations
 
+import math
 import socket
 import threading
 import time
@@ -94,7 +95,7 @@ class FakePx4:
         link.close()
 
     def _command(self, msg: Any) -> None:
-        finite = [v if v == v else -1.0 for v in (msg.param2, msg.param3)]  # NaN: none
+        finite = [v if math.isfinite(v) else -1.0 for v in (msg.param2, msg.param3)]
         mode = (int(finite[0]), int(finite[1]))
         if msg.command == MAV_CMD_COMPONENT_ARM_DISARM:
             self.events.append((time.monotonic(), "arm" if msg.param1 == 1 else "disarm"))
