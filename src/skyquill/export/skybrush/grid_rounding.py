@@ -179,8 +179,11 @@ class _Grid:
         drift = start - exact[0]
         grid = np.stack(
             np.meshgrid(
-                # with the drift taken back, or left (where taking it back is too fast)
-                np.unique([*(np.rint(d1 - drift / 3.0) + np.array(d1_steps)), np.floor(d1)]),
+                # with the drift taken back, or left (where taking it back is too fast: the
+                # first difference rounded towards zero, whichever its sign)
+                np.unique(
+                    [*(np.rint(d1 - drift / 3.0) + np.array(d1_steps)), np.floor(d1), np.ceil(d1)]
+                ),
                 np.floor(d2) + np.array(d23_steps),
                 np.floor(d3) + np.array(d23_steps),
                 indexing="ij",

@@ -40,7 +40,8 @@ from skyquill.errors import InputError
 from skyquill.limits import DerivativeLimit, limit_bounds
 from skyquill.trajectory import PiecewisePolynomial, RestToRestSequence, Trajectory
 
-#: Shortest cubic piece of the plan kept as an exact segment of its own, ms.
+#: Shortest cubic piece of the plan kept as an exact segment of its own, ms (or half a fit
+#: segment, if that is longer).
 MIN_EXACT_MS = 100
 #: Longest exact segment, ms (a hold or a cruise is split into segments of at most this).
 MAX_EXACT_MS = 1000
@@ -162,8 +163,11 @@ def segmentation(
     """
     total = max(1, math.ceil(traj.duration * 1000 - 1e-6))
     h_fit = fit_segment_ms(limits, unit_m, scale)
+    # An exact piece much shorter than a fit segment would be rounded coarser than the limits
+    # allow (slow limits: 100 ms at 0.05 m/s moves the speed by 60 % a unit).
+    shortest = max(MIN_EXACT_MS, h_fit // 2)
     spans = [
-        (a, b, flag and exact and b - a >= MIN_EXACT_MS) for a, b, flag in cubic_spans(traj, total)
+        (a, b, flag and exact and b - a >= shortest) for a, b, flag in cubic_spans(traj, total)
     ]
     regions = _grown(_runs(spans), total, round(2 * h_fit * grow))
     times: list[int] = [0]

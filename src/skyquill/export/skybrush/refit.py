@@ -24,8 +24,10 @@ from skyquill.export.skybrush.playback import played_trajectory
 from skyquill.io.trajectory_json import PlannedTrajectory
 from skyquill.verify import verify
 
-#: ``(margin, exact pieces kept, fit segment scale)`` tried in order.
-ATTEMPTS = ((0.0, True, 1.0), (0.02, True, 1.5), (0.05, False, 2.0))
+#: ``(margin, exact pieces kept, fit segment scale)`` tried in order: as planned; shorter fit
+#: segments (nearer a plan the longer ones cannot follow, the rounding then left to the
+#: limit-aware search); a planning margin; a margin and longer segments, everything fitted.
+ATTEMPTS = ((0.0, True, 1.0), (0.0, True, 0.5), (0.02, True, 1.0), (0.05, False, 2.0))
 #: Farthest the keyframes may be from the plan before rounding, m: a fit farther off is a
 #: plan its limits cannot fly (it is over them), not the plan delivered.
 MAX_DEVIATION_M = 0.02
@@ -63,6 +65,7 @@ def played_keyframes(name: str, planned: PlannedTrajectory) -> PlayedKeyframes:
         far over, and what to do.
     """
     last: PlayedKeyframes | None = None
+    far: float | None = None  # the least distance of keyframes that kept the limits
     infeasible: InfeasibleError | None = None
     for i, (margin, exact, scale) in enumerate(ATTEMPTS):
         try:
@@ -72,19 +75,24 @@ def played_keyframes(name: str, planned: PlannedTrajectory) -> PlayedKeyframes:
         except InfeasibleError as exc:  # a fit region that cannot keep the limits
             infeasible = exc
             continue
-        if frames.fit_error_m > MAX_DEVIATION_M:  # kept the limits by leaving the plan
-            raise _unfittable(
-                name,
-                planned,
-                f"keyframes inside them are {100 * frames.fit_error_m:.1f} cm from it, "
-                f"farther than {100 * MAX_DEVIATION_M:g} cm",
-            )
         back = played_trajectory(name, {"points": frames.points()}).trajectory()
-        last = PlayedKeyframes(frames, check_delivered(name, planned, back), i)
-        if last.delivered.within_allowed or not planned.limits:
-            return last
-    if last is not None:
+        here = PlayedKeyframes(frames, check_delivered(name, planned, back), i)
+        inside = here.delivered.within_allowed or not planned.limits
+        if inside and frames.fit_error_m <= MAX_DEVIATION_M:
+            return here
+        if inside:  # kept the limits by leaving the plan
+            far = frames.fit_error_m if far is None else min(far, frames.fit_error_m)
+        else:
+            last = here
+    if last is not None and far is None:
         raise _refusal(name, last.delivered)
+    if far is not None:
+        raise _unfittable(
+            name,
+            planned,
+            f"keyframes inside them are {100 * far:.1f} cm from it at best, farther than "
+            f"{100 * MAX_DEVIATION_M:g} cm",
+        )
     raise _unfittable(name, planned, str(infeasible))
 
 
