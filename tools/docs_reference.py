@@ -18,6 +18,9 @@ module got its page.
 
 from __future__ import annotations
 
+import ast
+import json
+import re
 from pathlib import Path
 
 SRC = Path(__file__).resolve().parents[1] / "src"
@@ -41,36 +44,69 @@ def api_page(module: str) -> str:
     return "/".join(module.split(".")) + ".md"
 
 
+def defined_names(module: str, src: Path = SRC) -> list[str]:
+    """Public names a package's ``__init__.py`` defines itself (not those it imports)."""
+    tree = ast.parse((src / Path(*module.split(".")) / "__init__.py").read_text(encoding="utf-8"))
+    names: list[str] = []
+    for node in tree.body:
+        if isinstance(node, ast.FunctionDef | ast.ClassDef):
+            names.append(node.name)
+        elif isinstance(node, ast.Assign):
+            names += [t.id for t in node.targets if isinstance(t, ast.Name)]
+        elif isinstance(node, ast.AnnAssign) and isinstance(node.target, ast.Name):
+            names.append(node.target.id)
+    return [n for n in names if not n.startswith("_") and n != "__all__"]
+
+
 def api_markdown(module: str, src: Path = SRC) -> str:
-    """The page of one module: its title and the mkdocstrings directive that renders it."""
-    is_package = (src / Path(*module.split(".")) / "__init__.py").exists()
-    # A package re-exports what its modules define: listing the names is enough there
-    # (rendering each twice would double the build time for nothing).
-    options = "    options:\n      members: false\n      summary: true\n" if is_package else ""
-    return f"# `{module}`\n\n::: {module}\n{options}"
+    """The page of one module: the mkdocstrings directive that renders it, titled by its name."""
+    options = ""
+    if (src / Path(*module.split(".")) / "__init__.py").exists():
+        # A package re-exports what its modules define, and those are documented on the
+        # modules' own pages: render only what the package itself defines (rendering every
+        # export twice would double the build time for nothing).
+        own = defined_names(module, src)
+        options = f"    options:\n      members: {json.dumps(own) if own else 'false'}\n"
+    return f"::: {module}\n{options}"
+
+
+_CODE = re.compile(r"(```.*?```|`[^`]*`)", re.DOTALL)
+
+
+def escape_brackets(markdown: str) -> str:
+    """``[`` and ``]`` outside code escaped: help texts hold ``[default: 1.0]`` and ``x,y[,t]``,
+    which the site would otherwise read as references to other pages."""
+    parts = _CODE.split(markdown)
+    return "".join(
+        part if i % 2 else part.replace("[", "\\[").replace("]", "\\]")
+        for i, part in enumerate(parts)
+    )
 
 
 def cli_pages() -> dict[str, str]:
     """``{page name: Markdown}`` for the command line: ``index`` and one page per command."""
-    import click
     import typer
     from typer.cli import get_docs_for_click
+    from typer.core import TyperGroup
 
     from skyquill.cli.main import app
 
+    # typer carries its own copy of click: its Context and TyperGroup, not click's.
     root = typer.main.get_command(app)
-    assert isinstance(root, click.Group)
-    ctx = click.Context(root, info_name=PROG)
+    assert isinstance(root, TyperGroup)
+    ctx = typer.Context(root, info_name=PROG)
     pages = {}
     rows = []
     for name in root.list_commands(ctx):
         command = root.get_command(ctx, name)
         assert command is not None
-        sub_ctx = click.Context(command, info_name=name, parent=ctx)
-        pages[name] = get_docs_for_click(obj=command, ctx=sub_ctx, name=f"{PROG} {name}")
+        sub_ctx = typer.Context(command, info_name=name, parent=ctx)
+        pages[name] = escape_brackets(
+            get_docs_for_click(obj=command, ctx=sub_ctx, name=f"{PROG} {name}")
+        )
         rows.append(f"| [`{PROG} {name}`]({name}.md) | {command.get_short_help_str(120)} |")
     options = [
-        f"* `{rec[0]}`: {rec[1]}"
+        escape_brackets(f"* `{rec[0]}`: {rec[1]}")
         for param in root.get_params(ctx)
         if (rec := param.get_help_record(ctx)) is not None
     ]
