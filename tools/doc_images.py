@@ -49,7 +49,9 @@ class Picture:
 PICTURES = (
     Picture("first-character", "write 永 --out {out}", "plot.png", "first-character.png"),
     Picture("ink", "write 永 --fly --out {out}", "ink.png", "ink-yong.png"),
-    Picture("fit", "fit examples/spiral.csv --timing path --out {out}", "plot.png", "fit-spiral.png"),
+    Picture(
+        "fit", "fit examples/spiral.csv --timing path --out {out}", "plot.png", "fit-spiral.png"
+    ),
     Picture(
         "fly", "fly {plan} --out {out}", "plot.png", "fly-yong.png", setup="write 永 --out {plan}"
     ),
@@ -71,7 +73,9 @@ PICTURES = (
         "long_exposure.png",
         "light-painting-sky.png",
     ),
-    Picture("show", "show examples/show_small.toml --out {out}", "long_exposure.png", "show-small.png"),
+    Picture(
+        "show", "show examples/show_small.toml --out {out}", "long_exposure.png", "show-small.png"
+    ),
 )
 
 
@@ -103,7 +107,9 @@ def make(picture: Picture, work: Path) -> dict[str, Any]:
     numbers = {k: summary[k] for k in ("duration_s", "max_excess") if k in summary}
     return {
         "command": " && ".join(
-            f"skyquill {c.format(out='OUT', plan='PLAN')}" for c in (picture.setup, picture.args) if c
+            f"skyquill {c.format(out='OUT', plan='PLAN')}"
+            for c in (picture.setup, picture.args)
+            if c
         ),
         "drawn": picture.drawn,
         "seconds": round(seconds, 1),
