@@ -212,9 +212,9 @@ class DronePlan(BaseModel):
     t: list[float] = Field(description="Sample times, s.")
     path: list[tuple[float, float, float]] = Field(description="Planned tip (u, v, h), m.")
     pen: list[int] = Field(description="1 where the pen is down at t, else 0.")
-    speed: list[float] = Field(description="Largest |velocity component| at t, m/s.")
-    acc: list[float] = Field(description="Largest |acceleration component| at t, m/s^2.")
-    jerk: list[float] = Field(description="Largest |jerk component| at t, m/s^3.")
+    speed: list[float] = Field(description="Speed (the velocity's norm) at t, m/s.")
+    acc: list[float] = Field(description="Acceleration norm at t, m/s^2.")
+    jerk: list[float] = Field(description="Jerk norm at t, m/s^3.")
     flight: list[tuple[float, float, float]] = Field(
         description="Simulated tip (u, v, h), m, at the same times (empty if not flown)."
     )

@@ -380,7 +380,7 @@ def _solve_stage(step: str, solves: int) -> str:
         what = "fitting the flight to the limits"
     else:
         what = "fitting again, slower"
-    return f"{what} (solve {solves}; how many a drawing needs shows only as they happen)"
+    return f"{what} (solve {solves})"
 
 
 class _SolveHandler(logging.Handler):
@@ -441,7 +441,8 @@ def _drone_plan(
     """One drone's curves for the page, in its board's coordinates (and its flight's)."""
     traj, board = mission.trajectory, mission.board
     t = _view_times(traj.duration)
-    v, a, j = (np.abs(traj.evaluate(t, n)).max(axis=1) for n in (1, 2, 3))
+    # The norms: the limits are norms (the page plots them against the limit lines).
+    v, a, j = (np.linalg.norm(traj.evaluate(t, n), axis=1) for n in (1, 2, 3))
     lo, hi = part.bounds()
     check = mission.verification
     fields: dict[str, Any] = {
