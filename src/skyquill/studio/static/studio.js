@@ -440,6 +440,7 @@ function showEstimate(guess) {
   }
   parts.push(`setpoint file ≈ ${kb(guess.setpoint_bytes)}`);
   ui.estimate.hidden = false;
+  ui.estimate.dataset.seconds = String(guess.flight_time_s);
   ui.estimate.textContent = `Estimate: ${parts.join(", ")}.`;
 }
 
@@ -573,6 +574,7 @@ function showResult(result, waitedS) {
   ui.overlay.dataset.pathPoints = String(result.drones.reduce((n, d) => n + d.path.length, 0));
   ui.studio.dataset.state = "planned";
   ui.studio.dataset.planId = result.plan_id;
+  ui.studio.dataset.duration = String(result.duration_s);
   announce(`Planned: ${result.duration_s.toFixed(1)} s of flight, ${verdict(result)}.`, true);
   drawFrame();
   setPlaying(true);
