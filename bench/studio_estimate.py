@@ -21,10 +21,10 @@ import time
 from pathlib import Path
 from typing import Any
 
-from common import jsonable, machine_info
 from rich.progress import track
 from threadpoolctl import threadpool_limits
 
+from common import jsonable, machine_info
 from skyquill.strokes.hanzi import BENCHMARK_HANZI
 from skyquill.studio.estimate import estimate
 from skyquill.studio.models import PlanRequest
