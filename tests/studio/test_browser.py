@@ -472,6 +472,19 @@ def test_a_reload_keeps_the_drawing_and_the_settings(page: Any) -> None:
     assert page.text_content("#stroke-count") == "3 of 200 strokes"
 
 
+@pytest.mark.parametrize(
+    "stored",
+    ["{not json", '{"strokes": [[1]], "settings": {"vmax": 5}}', "[]", '"x"', "null"],
+)
+def test_a_damaged_store_is_ignored(page: Any, stored: str) -> None:
+    """Whatever sits under the page's storage key, the page starts clean (and says nothing)."""
+    page.evaluate("(v) => localStorage.setItem('skyquill-studio-v1', v)", stored)
+    page.reload()
+    page.wait_for_selector("#studio[data-ready='true']", timeout=10_000)
+    assert page.text_content("#stroke-count") == "0 of 200 strokes"
+    assert page.input_value("#vmax") == "1"
+
+
 def test_leaving_mid_plan_asks_first(browser: Any, slow_studio_url: str) -> None:
     """A reload or a closed tab while a plan runs asks before the plan is lost."""
     with _open(browser, slow_studio_url) as page:

@@ -308,7 +308,7 @@ class JobManager:
         if guess is None:
             return f"{limit}; draw or type less, use fewer drones or raise the limits"
         flight = (
-            f"a flight of at least {guess.flight_time_s:,.0f} s "
+            f"a flight of about {guess.flight_time_s:,.0f} s "
             f"({guess.path_length_m:.1f} m of route at {request.vmax:g} m/s)"
         )
         if guess.flight_time_s > WARN_FLIGHT_S:  # long because slow: the speed is the cause

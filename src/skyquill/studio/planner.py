@@ -585,6 +585,7 @@ def _exports(
 def _export_note(name: str, stem: str, report: ExportReport) -> str:
     """What the export was checked against, in plain words."""
     mm = 1e3 * report.max_error_m
+    within = "less than 0.01 mm" if mm < 0.01 else f"{mm:.2g} mm"
     uploads = report.details.get("drone_uploads")
     extra = ""
     if uploads:
@@ -592,7 +593,7 @@ def _export_note(name: str, stem: str, report: ExportReport) -> str:
         extra = f"; {max(counts)} upload{'' if max(counts) == 1 else 's'} per drone at most"
     return (
         f"The {stem} file, read back as {CONSUMERS.get(name, 'its player reads it')}, stays "
-        f"within {mm:.2g} mm of the planned flight{extra}"
+        f"within {within} of the planned flight{extra}"
     )
 
 
