@@ -95,9 +95,7 @@ def test_random_paths_feasible_and_as_fast_as_the_lp(
             plan_speed(curve, vmax, amax, None, n=400, norm_sides=sides, method="lp")
         return
     _rows_hold(curve, 400, vmax, amax, sides)
-    ref = plan_speed(
-        curve, vmax, amax, None, n=400, norm_sides=sides, max_excess=None, method="lp"
-    )
+    ref = plan_speed(curve, vmax, amax, None, n=400, norm_sides=sides, max_excess=None, method="lp")
     assert fast.method == "reach"
     assert fast.b.sum() <= ref.b.sum() * (1 + 1e-9)
     # Coarse grids of sharp random paths: the boxes of the non-monotone rows cost more.
