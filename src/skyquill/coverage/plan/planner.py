@@ -65,8 +65,10 @@ def plan_coverage(
         with holes whose flight comes closer to a hole than allowed (family
         ``"keepout"``; never returned).
     """
+    start = time.perf_counter()
     opts = options or CoverageOptions()
-    return plan_within(region, opts, Deadline(opts.time_limit, progress))
+    plan = plan_within(region, opts, Deadline(opts.time_limit, progress))
+    return replace(plan, planning_time=time.perf_counter() - start)  # the whole planning
 
 
 def plan_within(region: Region, opts: CoverageOptions, deadline: Deadline) -> CoveragePlan:

@@ -47,7 +47,8 @@ class CoveragePlan:
         The dense check of ``trajectory`` against :func:`coverage_limits`
         (see :func:`limits_report`) and ``joins``.
     planning_time : float
-        Wall time of :func:`plan_coverage`, s.
+        Wall time of the whole planning, s: of :func:`plan_coverage`, or of
+        :func:`plan_tuned` with every candidate and estimate it tried.
     speed_plan : SpeedPlan or None
         The LP's plan (spline patterns only; with a target, of the planned
         path before it was re-fitted).

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import functools
 import math
+import time
 from dataclasses import replace
 
 import numpy as np
@@ -102,6 +103,7 @@ def plan_tuned(
         No candidate reaches ``target``, or none that does can be timed; the
         time limit is spent (family ``"time_limit"``).
     """
+    start = time.perf_counter()
     goal = as_float("min_coverage", target, positive=True)
     if goal > 1.0:
         raise InputError(f"min_coverage: got {goal:g}, expected a fraction in (0, 1]")
@@ -112,8 +114,11 @@ def plan_tuned(
     if options.target is not None:
         # Trials are compared as planned; only the winner is re-fitted for the target.
         untargeted = _tuned(region, replace(options, target=None), goal, deadline)
-        return for_target(untargeted, replace(untargeted.options, target=options.target), deadline)
-    return _tuned(region, options, goal, deadline)
+        plan = for_target(untargeted, replace(untargeted.options, target=options.target), deadline)
+    else:
+        plan = _tuned(region, options, goal, deadline)
+    # The whole planning: every candidate and estimate, not only the winner's own plan.
+    return replace(plan, planning_time=time.perf_counter() - start)
 
 
 def _tuned(
