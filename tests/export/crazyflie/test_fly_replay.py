@@ -159,3 +159,54 @@ def test_the_script_checks_the_cflib_it_needs(
     with pytest.raises(SystemExit):
         script.check_cflib(found)
     assert script.cflib_version() >= script.CFLIB_NEEDED  # the one installed here
+
+
+@pytest.mark.parametrize("case", ["ground", "air", "2d"])
+def test_the_whole_flight_checked_is_what_the_firmware_commands(
+    case: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The exporter's model of the whole flight (take-off, approach, uploads, landing) is
+    the position the replayed firmware commands, tick by tick, and keeps the plan's limits
+    from motors start to stop (summary: the flight's ``as_played``)."""
+    from skyquill.export.crazyflie.exporter import read_export
+    from skyquill.export.crazyflie.whole_flight import whole_flight
+
+    folder, floor = _planned(tmp_path, case)
+    script = _script(folder, monkeypatch)
+    flight = script.flight_of(None, script.SCHEDULE)
+    pad = np.array([flight.first_point[0] + 0.3, flight.first_point[1], 0.0])
+    link = ReplayLink(tuple(pad))
+    script.fly(link.cf, flight, folder, clock=link.clock, sleep=link.sleep)
+    (takeoff,) = link.when("takeoff")
+    summary = json.loads((folder / "cs.csv.summary.json").read_text())
+    (drone,) = summary["drone_uploads"]
+    flown = read_export(folder / "cs.csv.summary.json")[drone["drone"]]
+    model = whole_flight(drone["flight"], flown, pad=pad)
+    ticks = [(t - takeoff, g.position) for t, g in link.setpoints if t > takeoff and g is not None]
+    times = np.array([t for t, _ in ticks])
+    assert times[-1] == pytest.approx(model.duration, abs=0.011)
+    np.testing.assert_allclose(
+        np.array([p for _, p in ticks]), model.evaluate(np.minimum(times, model.duration)),
+        atol=2e-5,
+    )  # fmt: skip
+    played = drone["flight"]["as_played"]
+    assert max(played["relative_excess"].values()) <= 1e-6  # float32 rounding only
+    assert played["lowest_after_takeoff_m"] >= floor - FLOAT32_M
+    assert summary["as_played"]["every_limit_met"]
+
+
+def test_a_take_off_too_short_for_the_limits_is_seen_as_played(tmp_path: Path) -> None:
+    """The whole-flight check sees the firmware's take-off: halved, it breaks the limits."""
+    from skyquill.export.crazyflie.exporter import read_export
+    from skyquill.export.crazyflie.whole_flight import whole_flight
+    from skyquill.verify import verify
+
+    folder, _ = _planned(tmp_path, "air")
+    summary = json.loads((folder / "cs.csv.summary.json").read_text())
+    (drone,) = summary["drone_uploads"]
+    flown = read_export(folder / "cs.csv.summary.json")[drone["drone"]]
+    ((_, planned),) = read_plan(tmp_path / "plan")
+    flight = drone["flight"]
+    flight["takeoff"]["duration_s"] /= 2
+    check = verify(whole_flight(flight, flown), planned.limits, guaranteed=False)
+    assert check.max_excess > 0.5

@@ -133,8 +133,10 @@ def poly7_nojerk(
     return p
 
 
-def _planned(duration: float, start: Goal, end: FloatArray, yaw: float = 0.0) -> FirmwareTrajectory:
-    """``piecewise_plan_7th_order_no_jerk`` from ``start`` to rest at ``end`` (3,)."""
+def rest_to_rest(
+    duration: float, start: Goal, end: FloatArray, yaw: float = 0.0
+) -> FirmwareTrajectory:
+    """``piecewise_plan_7th_order_no_jerk`` from ``start`` to rest at ``end`` (3,), float32."""
     coeffs = np.zeros((1, N_AXES, PP_SIZE), dtype=np.float32)
     for ax in range(3):
         coeffs[0, ax] = poly7_nojerk(
@@ -232,7 +234,7 @@ class HighLevelCommander:
             self.pos = self.here.copy()
         start = Goal(self.pos.copy(), np.zeros(3), np.zeros(3))
         target = np.array([self.pos[0], self.pos[1], height])
-        self.plan = _Plan(_planned(duration, start, target), t)
+        self.plan = _Plan(rest_to_rest(duration, start, target), t)
         self.state = State.FLYING if takeoff else State.LANDING
         return 0
 
@@ -245,7 +247,7 @@ class HighLevelCommander:
             assert goal is not None
             start = goal
         target = point + start.position if relative else point
-        self.plan = _Plan(_planned(duration, start, target), t)
+        self.plan = _Plan(rest_to_rest(duration, start, target), t)
         self.state = State.FLYING
         return 0
 

@@ -11,22 +11,26 @@ per knot span or polynomial piece), then read back the way it will fly: the
 CSV parsed, packed with cflib's ``Poly4D`` arithmetic, at most 4096 B per
 upload, and evaluated in float32 as the firmware's ``pptraj.c`` does
 (:mod:`skyquill.export.crazyflie.memory`). That read-back, flown on the plan's
-clock with the hovers between uploads, is what the dense limit check and the
-distance check of :func:`~skyquill.export.base.check_delivered` see.
+clock with the hovers between uploads, is what the distance check of
+:func:`~skyquill.export.base.check_delivered` sees; the dense limit check sees the whole
+flight, from the firmware's take-off through the uploads to the end of its landing
+(:mod:`.whole_flight`), each manoeuvre as the firmware plans it.
 """
 
 from __future__ import annotations
 
 import json
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from skyquill.errors import InputError
+from skyquill.errors import InfeasibleError, InputError
 from skyquill.export.base import (
+    ALLOWED_EXCESS,
+    ORDER_NAMES,
     DeliveredCheck,
     ExportOptions,
     ExportReport,
@@ -50,11 +54,13 @@ from skyquill.export.crazyflie.memory import (
     flown_uploads,
     pack_pieces,
 )
+from skyquill.export.crazyflie.whole_flight import whole_flight
 from skyquill.io.trajectory_json import PlannedTrajectory
 from skyquill.phases import FlightPhases
 from skyquill.targets import CRAZYFLIE, Upload, plan_uploads
 from skyquill.trajectory import Trajectory
 from skyquill.validation import FloatArray
+from skyquill.verify import verify
 
 #: Relative limit excess of the delivered float32 polynomials that is float32 rounding, not a
 #: broken limit: a limit the plan meets exactly shows ~1.2e-7 (one float32 ulp) on the
@@ -247,7 +253,58 @@ def export_drone(name: str, planned: PlannedTrajectory, path: Path) -> DroneExpo
             )
         )
     flight = _flight(phases, planned)
-    return DroneExport(name, tuple(files), flown, check_delivered(name, mission, flown), flight)
+    delivered = _whole_flight_checked(name, check_delivered(name, mission, flown), flight, flown,
+                                      planned)  # fmt: skip
+    return DroneExport(name, tuple(files), flown, delivered, flight)
+
+
+def _whole_flight_checked(
+    name: str,
+    mission: DeliveredCheck,
+    flight: dict[str, Any],
+    flown: FlownUploads,
+    planned: PlannedTrajectory,
+) -> DeliveredCheck:
+    """``mission``'s check with the limits checked from motors start to stop.
+
+    The firmware's take-off, approach and landing around the uploads
+    (:func:`~.whole_flight.whole_flight`) are checked densely at the plan's limits; the
+    check's excess is the worse of the mission's and the whole flight's, and
+    ``flight["as_played"]`` records the whole flight's numbers.
+
+    Raises
+    ------
+    InfeasibleError
+        The whole flight is over a limit by more than
+        :data:`~skyquill.export.base.ALLOWED_EXCESS` (the manoeuvres' durations keep the
+        limits, so this is the float32 polynomials' doing).
+    """
+    whole = whole_flight(flight, flown)
+    check = verify(whole, planned.limits, guaranteed=False)
+    excess = tuple(max(e, check.excess(n)) for n, e in enumerate(mission.excess_by_order, start=1))
+    flight["as_played"] = {
+        "from": "motors start (take-off) to motors stop (landing ended)",
+        "duration_s": whole.duration,
+        "relative_excess": {ORDER_NAMES[n]: check.excess(n) for n in ORDER_NAMES},
+        "lowest_after_takeoff_m": float(
+            whole.evaluate(np.linspace(whole.starts[1], whole.starts[3], 2001))[:, 2].min()
+        ),
+    }
+    for order, value in enumerate(excess, start=1):
+        if value > ALLOWED_EXCESS[order]:
+            raise InfeasibleError(
+                f"plan: got drone {name}'s {ORDER_NAMES[order]} {100 * value:.2f} % over its "
+                f"limit as the Crazyflie flies it from take-off to landing, expected at most "
+                f"{100 * ALLOWED_EXCESS[order]:g} % over; plan it with a lower "
+                f"{ORDER_NAMES[order]} limit",
+                ("limits",),
+            )
+    return replace(
+        mission,
+        limit_excess=max(mission.limit_excess, check.max_excess),
+        limits=tuple(check.limits_report()),
+        excess_by_order=(excess[0], excess[1], excess[2]),
+    )
 
 
 def _flight(phases: FlightPhases, planned: PlannedTrajectory) -> dict[str, Any]:

@@ -1,0 +1,122 @@
+"""A Crazyflie's whole flight as its firmware plans it, from motors start to motors stop.
+
+The fly script (:mod:`.fly_script`) sends, in order: ``takeoff`` to the mission's first
+height, ``go_to`` the mission's first point, the uploads (``start_trajectory``, a ``go_to``
+to the point where each ended while the next is written), ``land`` to the ground. The
+firmware plans each ``takeoff``, ``go_to`` and ``land`` as one ``poly7_nojerk`` polynomial
+from rest to rest (crazyflie-firmware ``planner.c``, ``plan_takeoff``, ``plan_go_to_from``,
+``plan_land``; ``pptraj.c``, ``piecewise_plan_7th_order_no_jerk``), which
+:func:`.commander.rest_to_rest` computes in float32 as the firmware does; the uploads are
+flown as :class:`~.memory.FlownUploads` evaluates them. :func:`whole_flight` puts them on
+one clock, so that the dense limit check sees every instant the motors run.
+
+Where the drone stands is the user's: the script asks for a pad within
+:data:`~.manoeuvres.APPROACH_OFFSET_M` of the point below the mission's first point. The
+approach's speed, acceleration and jerk grow with its length (``PEAKS[n] d / T^n``), so
+the flight is checked from a pad that far away: every nearer pad flies inside what is
+checked.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from skyquill.export.crazyflie.commander import Goal, rest_to_rest
+from skyquill.export.crazyflie.manoeuvres import APPROACH_OFFSET_M
+from skyquill.export.crazyflie.memory import FlownUploads
+from skyquill.trajectory import Samples, Trajectory, evaluation_times, sample
+from skyquill.validation import FloatArray
+
+
+@dataclass(frozen=True)
+class Chained:
+    """Trajectories flown back to back on one clock (a :class:`~skyquill.trajectory.Trajectory`).
+
+    Unlike :class:`~skyquill.trajectory.RestToRestSequence` it does not hold its joins to
+    1e-6 m: the firmware's float32 polynomials end within a float32 rounding of their
+    targets (about 1e-6 m at 10 m), and what is checked here is what is commanded.
+    """
+
+    pieces: tuple[Trajectory, ...]
+
+    @property
+    def starts(self) -> FloatArray:
+        """Start time of each piece and the end, shape (n + 1,), s."""
+        return np.concatenate([[0.0], np.cumsum([p.duration for p in self.pieces])])
+
+    @property
+    def duration(self) -> float:
+        """Length, s."""
+        return float(self.starts[-1])
+
+    @property
+    def dim(self) -> int:
+        """3: x, y, z."""
+        return 3
+
+    @property
+    def breakpoints(self) -> FloatArray:
+        """Every piece's breakpoints on the flight's clock, shape (L + 1,), s."""
+        starts = self.starts
+        inner = [s + p.breakpoints[:-1] for s, p in zip(starts, self.pieces, strict=False)]
+        return np.concatenate([*inner, [starts[-1]]])
+
+    def evaluate(self, t: FloatArray, order: int = 0) -> FloatArray:
+        """Derivative ``order`` at flight times ``t`` (N,); returns (N, 3)."""
+        times = evaluation_times(t, self.duration)
+        starts = self.starts
+        which = np.clip(np.searchsorted(starts, times, side="right") - 1, 0, len(self.pieces) - 1)
+        out = np.empty((times.size, 3))
+        for k in np.unique(which):
+            mask = which == k
+            local = np.clip(times[mask] - starts[k], 0.0, self.pieces[k].duration)
+            out[mask] = self.pieces[k].evaluate(local, order)
+        return out
+
+    def sample(self, rate: float) -> Samples:
+        """Samples at ``rate`` Hz (position to jerk), including both ends."""
+        return sample(self, rate)
+
+
+def _at_rest(point: FloatArray) -> Goal:
+    return Goal(np.asarray(point, dtype=float), np.zeros(3), np.zeros(3))
+
+
+def whole_flight(
+    flight: dict[str, Any], mission: FlownUploads, pad: FloatArray | None = None
+) -> Chained:
+    """The commanded trajectory from take-off to the end of the landing, on one clock.
+
+    Parameters
+    ----------
+    flight
+        The drone's take-off, approach and landing as the fly script's schedule holds them
+        (``takeoff``: ``height_m``, ``duration_s``; ``approach``: ``point_m``,
+        ``duration_s``; ``landing``: ``height_m``, ``from_m``, ``duration_s``).
+    mission
+        The uploads as flown on the mission's clock (3 axes), starting and ending at rest.
+    pad
+        Where the drone stands, (3,) m; default :data:`~.manoeuvres.APPROACH_OFFSET_M`
+        east of the point below the first point, on the ground (the farthest pad the
+        script allows).
+
+    Returns
+    -------
+    Chained
+        Take-off, approach, mission, landing (4 pieces), z-up world frame, m and s.
+    """
+    first = np.array(flight["approach"]["point_m"], dtype=float)
+    last = np.array(flight["landing"]["from_m"], dtype=float)
+    if pad is None:
+        pad = np.array([first[0] + APPROACH_OFFSET_M, first[1], flight["landing"]["height_m"]])
+    pad = np.asarray(pad, dtype=float)
+    # plan_takeoff: straight up from the last setpoint (the vehicle on its pad).
+    up = np.array([pad[0], pad[1], flight["takeoff"]["height_m"]])
+    takeoff = rest_to_rest(float(flight["takeoff"]["duration_s"]), _at_rest(pad), up)
+    approach = rest_to_rest(float(flight["approach"]["duration_s"]), _at_rest(up), first)
+    down = np.array([last[0], last[1], flight["landing"]["height_m"]])
+    landing = rest_to_rest(float(flight["landing"]["duration_s"]), _at_rest(last), down)
+    return Chained((takeoff, approach, mission, landing))
