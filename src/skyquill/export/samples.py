@@ -13,6 +13,7 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 from skyquill.export.base import (
     ExportOptions,
@@ -25,6 +26,7 @@ from skyquill.export.base import (
 from skyquill.io.points import write_trajectory_csv
 from skyquill.io.setpoints_json import read_setpoints_json, write_setpoints_json
 from skyquill.io.trajectory_csv import read_trajectory_csv
+from skyquill.io.trajectory_json import PlannedTrajectory
 from skyquill.trajectory import SampledTrajectory, Trajectory
 
 
@@ -52,6 +54,10 @@ class SampledExporter:
     help: str
     write: Callable[[Trajectory, Path, float], SampledTrajectory]
     mission_only: bool = False
+    #: Per drone, more for the summary's ``details`` (PX4: its take-off and landing
+    #: parameters), under ``details_key``.
+    drone_details: Callable[[PlannedTrajectory], dict[str, Any]] | None = None
+    details_key: str = ""
 
     def __call__(
         self, plans: Sequence[NamedPlan], out: Path, options: ExportOptions
@@ -72,9 +78,14 @@ class SampledExporter:
             max_error_m=max(c.max_error_m for c in checks),
             message=f"wrote {len(files)} {self.name} file(s) at {options.rate_hz:g} Hz: "
             + ", ".join(f.name for f in files),
-            details={"rate_hz": options.rate_hz},
+            details={"rate_hz": options.rate_hz} | self._more(plans),
             delivered=tuple(checks),
         )
+
+    def _more(self, plans: Sequence[NamedPlan]) -> dict[str, Any]:
+        if self.drone_details is None:
+            return {}
+        return {self.details_key: {name: self.drone_details(p) for name, p in plans}}
 
 
 CSV = SampledExporter("csv", ".csv", "trajectory.csv columns (t, x..jz), z-up, SI", _write_csv)

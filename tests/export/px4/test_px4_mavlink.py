@@ -89,6 +89,8 @@ class FakePx4:
                 name = name.rstrip("\x00")
                 if name == "MIS_TAKEOFF_ALT":
                     self.takeoff_alt = float(msg.param_value)
+                else:
+                    self.events.append((time.monotonic(), f"{name}={msg.param_value:.3g}"))
                 link.mav.param_value_send(name.encode(), msg.param_value, msg.param_type, 1, 0)
             elif kind == "SET_POSITION_TARGET_LOCAL_NED":
                 self.received.append((time.monotonic(), msg))
@@ -126,6 +128,10 @@ def _free_port() -> int:
         return int(s.getsockname()[1])
 
 
+#: Parameters :func:`~skyquill.export.px4.flight_parameters.px4_flight_parameters` gives.
+PARAMETERS = {"MPC_TKO_SPEED": 0.5, "MPC_JERK_AUTO": 2.0}
+
+
 @pytest.mark.timeout(60)
 def test_px4_receives_every_setpoint_in_ned_in_order_above_2_hz() -> None:
     points = np.array([[0, 0, 1], [0, 0, 1], [0.5, 0.2, 1.5], [1, 0.5, 1.5], [1, 0.5, 1.5]])
@@ -136,15 +142,26 @@ def test_px4_receives_every_setpoint_in_ned_in_order_above_2_hz() -> None:
     thread.start()
     try:
         sent = send_mavsdk(
-            setpoints, f"udpin://127.0.0.1:{vehicle.port}", dry_run=False, connect_timeout_s=10
+            setpoints,
+            f"udpin://127.0.0.1:{vehicle.port}",
+            dry_run=False,
+            connect_timeout_s=10,
+            parameters=PARAMETERS,
         )
     finally:
         vehicle.stop.set()
         thread.join(5.0)
     assert sent == len(setpoints)
     assert MAV_CMD_DO_SET_MODE in vehicle.commands  # offboard asked for, and acknowledged
-    # armed, took off to the first setpoint's height, streamed, landed: in that order
-    assert [e for _, e in vehicle.events] == ["arm", "takeoff", "land"]
+    # the take-off and landing parameters set, armed, took off to the first setpoint's height,
+    # streamed, landed: in that order
+    assert [e for _, e in vehicle.events] == [
+        "MPC_TKO_SPEED=0.5",
+        "MPC_JERK_AUTO=2",
+        "arm",
+        "takeoff",
+        "land",
+    ]
     assert vehicle.takeoff_alt == pytest.approx(-setpoints.position_ned[0, 2], abs=1e-6)
     times = {e: t for t, e in vehicle.events}
     first, last = vehicle.received[0][0], vehicle.received[-1][0]

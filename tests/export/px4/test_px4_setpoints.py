@@ -160,6 +160,9 @@ class FakeSystem:
         self.z = 0.0
         self.polls = 0
 
+    async def set_parameter(self, name: str, value: float) -> None:
+        self.calls.append(f"{name} {value:g}")
+
     async def arm(self) -> None:
         self.calls.append("arm")
 
@@ -342,3 +345,22 @@ def test_setpoints_is_frozen() -> None:
     assert isinstance(sp, Px4Setpoints)
     with pytest.raises(AttributeError):
         sp.rate_hz = 5.0  # type: ignore[misc]
+
+
+def test_px4_parameters_keep_its_take_off_and_landing_inside_the_plan() -> None:
+    """Each parameter is PX4's default or the plan's bound for its order, whichever is
+    smaller; they are set before arming."""
+    from skyquill.export.px4.flight_parameters import PX4_DEFAULTS, px4_flight_parameters
+    from skyquill.limits import VehicleLimits
+
+    slow = px4_flight_parameters(VehicleLimits(0.5, 1.0, 2.0).derivative_limits(3))
+    assert slow["MPC_TKO_SPEED"] == slow["MPC_LAND_SPEED"] == 0.5
+    assert slow["MPC_ACC_UP_MAX"] == slow["MPC_ACC_DOWN_MAX"] == 1.0
+    assert slow["MPC_JERK_AUTO"] == 2.0
+    fast = px4_flight_parameters(VehicleLimits(10.0, 20.0, 100.0).derivative_limits(3))
+    assert fast == {name: value for name, (_, value) in PX4_DEFAULTS.items()}
+    system = FakeSystem()
+    sp = px4_setpoints(line((1.0, 0.0, 0.0), duration=0.4), rate_hz=50.0)
+    send_mavsdk(sp, dry_run=False, system_factory=lambda: system, parameters=slow,
+                step_timeout_s=5.0)  # fmt: skip
+    assert system.calls[2 : len(slow) + 3] == [f"{k} {v:g}" for k, v in slow.items()] + ["arm"]

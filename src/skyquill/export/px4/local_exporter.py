@@ -3,13 +3,16 @@
 The frame conversion is :mod:`skyquill.export.px4.setpoints`; the file is checked as a
 consumer reads it, with the NED-to-ENU conversion applied. It holds the plan's mission only
 (:mod:`skyquill.phases`): ``send_mavsdk`` arms, takes off with PX4's own take-off to the first
-row's height, enters offboard there, streams the rows and lands with PX4's own landing.
+row's height, enters offboard there, streams the rows and lands with PX4's own landing; the
+summary's ``px4_parameters`` (per drone) are the parameters to pass it, which keep that
+take-off and landing inside the plan's limits (:mod:`.flight_parameters`).
 """
 
 from __future__ import annotations
 
 from pathlib import Path
 
+from skyquill.export.px4.flight_parameters import px4_flight_parameters
 from skyquill.export.px4.setpoints import px4_setpoints, read_px4_csv
 from skyquill.export.samples import SampledExporter
 from skyquill.trajectory import SampledTrajectory, Trajectory
@@ -27,4 +30,6 @@ EXPORTER = SampledExporter(
     "airborne point (PX4 takes off to it and lands after it)",
     _write_px4,
     mission_only=True,
+    drone_details=lambda planned: px4_flight_parameters(planned.limits),
+    details_key="px4_parameters",
 )

@@ -189,6 +189,9 @@ class OffboardSystem(Protocol):
     async def stop_offboard(self) -> None:
         """Leave offboard mode (PX4 goes to Hold)."""
 
+    async def set_parameter(self, name: str, value: float) -> None:
+        """Set one of PX4's float parameters (``MPC_TKO_SPEED``...)."""
+
     async def arm(self) -> None:
         """Arm the vehicle (motors at idle)."""
 
@@ -251,6 +254,7 @@ class MavsdkSystem:
         self._offboard: Any = None
         self._action: Any = None
         self._telemetry: Any = None
+        self._param: Any = None
 
     async def connect(self, system_address: str) -> None:
         """Add the connection URL (e.g. ``udpin://0.0.0.0:14540``)."""
@@ -272,6 +276,7 @@ class MavsdkSystem:
         action = importlib.import_module("mavsdk.asyncio.plugins.action")
         telemetry = importlib.import_module("mavsdk.asyncio.plugins.telemetry")
         self._action = action.ActionAsync(system)
+        self._param = importlib.import_module("mavsdk.asyncio.plugins.param").ParamAsync(system)
         self._telemetry = telemetry.TelemetryAsync(system)
         self._errors = (action.ActionError, telemetry.TelemetryError)
         self._on_ground = telemetry.LandedState.ON_GROUND
@@ -307,6 +312,17 @@ class MavsdkSystem:
         """Stop offboard (PX4 holds position)."""
         await self._offboard.stop()
 
+    async def set_parameter(self, name: str, value: float) -> None:
+        """``param.set_param_float``; a SolverError carries PX4's reason when it refuses."""
+        param = importlib.import_module("mavsdk.asyncio.plugins.param")
+        try:
+            await self._param.set_param_float(name, float(value))
+        except param.ParamError as exc:
+            raise SolverError(
+                f"parameters: got {exc} from PX4 for {name} = {value:g}, expected PX4 to accept "
+                "it (a parameter of this PX4 version, within its range)"
+            ) from None
+
     async def arm(self) -> None:
         """``action.arm``; a SolverError carries PX4's reason when it refuses."""
         await self._act("arm", self._action.arm())
@@ -341,7 +357,7 @@ class MavsdkSystem:
 
     def close(self) -> None:
         """Destroy the MAVSDK instance (this also ends a pending discovery)."""
-        for plugin in (self._offboard, self._action, self._telemetry):
+        for plugin in (self._offboard, self._action, self._telemetry, self._param):
             if plugin is not None:
                 plugin.destroy()
         self._mavsdk.destroy()
@@ -371,12 +387,16 @@ def send_mavsdk(
     send_timeout_s: float = 1.0,
     step_timeout_s: float = 30.0,
     system_factory: Callable[[], OffboardSystem] | None = None,
+    parameters: dict[str, float] | None = None,
 ) -> int:
     """Fly ``setpoints`` on a PX4 vehicle: take off, offboard, land, through MAVSDK.
 
     The vehicle stands on the ground below the first setpoint (PX4's local origin, the
     EKF origin, is where it was armed). The sequence: connect and wait for an autopilot;
-    arm; PX4's own take-off to the first setpoint's height and wait until it is there;
+    set ``parameters`` (the export summary's ``px4_parameters``, which keep PX4's own
+    take-off and landing inside the plan's limits:
+    :mod:`skyquill.export.px4.flight_parameters`); arm; PX4's own take-off to the first
+    setpoint's height and wait until it is there;
     send the first setpoint (PX4 refuses offboard without one), start offboard (at the
     first airborne setpoint), stream every setpoint at ``setpoints.rate_hz``, stop
     offboard (also after an error); PX4's own landing and wait until it is on the ground.
@@ -403,6 +423,8 @@ def send_mavsdk(
     system_factory
         Makes the :class:`OffboardSystem` to talk to; default
         :class:`MavsdkSystem` (tests pass a fake vehicle here).
+    parameters
+        PX4 float parameters set before arming, each within ``step_timeout_s``.
 
     Returns
     -------
@@ -425,6 +447,9 @@ def send_mavsdk(
             f"setpoints: got {type(setpoints).__name__}, expected Px4Setpoints (from px4_setpoints)"
         )
     check_stream_rate(setpoints.rate_hz)
+    parameters = dict(parameters or {})
+    for key, value in parameters.items():
+        as_float(f"parameters[{key!r}]", value, positive=True)
     limits = _Timeouts(
         as_float("connect_timeout_s", connect_timeout_s, positive=True),
         as_float("send_timeout_s", send_timeout_s, positive=True),
@@ -439,7 +464,7 @@ def send_mavsdk(
         return len(setpoints)
     system = (system_factory or MavsdkSystem)()
     try:
-        return asyncio.run(_stream(system, setpoints, address, limits))
+        return asyncio.run(_stream(system, setpoints, address, limits, parameters))
     finally:
         system.close()
 
@@ -465,8 +490,14 @@ async def _bounded(step: Awaitable[T], limit: float, what: str, name: str) -> T:
         ) from None
 
 
-async def _stream(system: OffboardSystem, sp: Px4Setpoints, address: str, lim: _Timeouts) -> int:
-    """Connect, send the first setpoint, start offboard, stream at the rate, stop."""
+async def _stream(
+    system: OffboardSystem,
+    sp: Px4Setpoints,
+    address: str,
+    lim: _Timeouts,
+    parameters: dict[str, float],
+) -> int:
+    """Connect, set the parameters, arm, take off, offboard at the rate, land."""
 
     async def connect() -> None:
         await system.connect(system_address=address)
@@ -475,6 +506,9 @@ async def _stream(system: OffboardSystem, sp: Px4Setpoints, address: str, lim: _
     await _bounded(
         connect(), lim.connect, f"a vehicle was discovered at {address!r}", "connect_timeout_s"
     )
+    for name, value in parameters.items():
+        await _bounded(system.set_parameter(name, value), lim.step, f"PX4 set {name}",
+                       "step_timeout_s")  # fmt: skip
     await _bounded(system.arm(), lim.step, "the vehicle armed", "step_timeout_s")
     height = -float(sp.position_ned[0, 2])
     await _bounded(_take_off(system, height), lim.step, f"it took off to {height:.2f} m",
