@@ -17,7 +17,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-from skyquill.errors import InfeasibleError
+from skyquill.errors import InfeasibleError, SolverError
 from skyquill.export.base import ALLOWED_EXCESS, ORDER_NAMES, DeliveredCheck, check_delivered
 from skyquill.export.skybrush.keyframes import Keyframes, skybrush_keyframes
 from skyquill.export.skybrush.playback import played_trajectory
@@ -66,13 +66,15 @@ def played_keyframes(name: str, planned: PlannedTrajectory) -> PlayedKeyframes:
     """
     last: PlayedKeyframes | None = None
     far: float | None = None  # the least distance of keyframes that kept the limits
-    infeasible: InfeasibleError | None = None
+    infeasible: InfeasibleError | SolverError | None = None
     for i, (margin, exact, scale) in enumerate(ATTEMPTS):
         try:
             frames = skybrush_keyframes(
                 planned.trajectory, planned.limits, margin=margin, exact=exact, segment_scale=scale
             )
-        except InfeasibleError as exc:  # a fit region that cannot keep the limits
+        except (InfeasibleError, SolverError) as exc:
+            # A fit region that cannot keep the limits, or whose QP the solver could not
+            # settle (seen on long coverage plans): the next attempt's segments differ.
             infeasible = exc
             continue
         back = played_trajectory(name, {"points": frames.points()}).trajectory()
