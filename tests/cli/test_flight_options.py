@@ -74,3 +74,24 @@ def test_a_plan_that_cannot_be_delivered_inside_its_limits_is_refused(tmp_path: 
     out = tmp_path / "over.skyc"
     _refused(["export", str(plan), "--format", "skyc", "--out", str(out)], "plan")
     assert not out.exists()
+
+
+def test_a_2d_fit_is_flown_at_its_altitude_and_records_its_phases(tmp_path: Path) -> None:
+    """Never silently at z = 0: the default altitude, printed; phases in both files."""
+    import json
+
+    from skyquill.io.plan_dir import read_plan
+
+    out = tmp_path / "spiral"
+    result = runner.invoke(app, ["fit", str(EXAMPLES / "spiral.csv"), "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    assert "flown at 1 m (--altitude)" in " ".join(result.output.split())
+    ((_, planned),) = read_plan(out)
+    t = np.linspace(0.0, planned.trajectory.duration, 2001)
+    z = planned.trajectory.evaluate(t)[:, 2]
+    np.testing.assert_allclose(z, 1.0, atol=1e-9)
+    summary = json.loads((out / "summary.json").read_text())
+    (drone,) = summary["plan"]["drones"]  # the plan writer's record
+    assert planned.phases is not None and drone["phases"] == planned.phases.as_dict()
+    assert drone["phases"]["min_altitude_m"] == 0.3 and drone["phases"]["lowest_m"] >= 0.3
+    assert summary["altitude_m"] == 1.0
