@@ -56,14 +56,14 @@ Where this departs from the paper
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import least_squares
 
 from skyquill.errors import InputError
 from skyquill.painting.estimate import Estimator, Plan, UpdateMode
-from skyquill.painting.segmentation import Pieces, corner_or_step, fit_pieces, screen
+from skyquill.painting.robust_fit import DriftModel, LineFit, fit_lines
+from skyquill.painting.segmentation import Pieces, Splits, fit_pieces, screen
 from skyquill.painting.wall import Placement, rot2
 from skyquill.validation import FloatArray, as_float, as_int
 
@@ -166,6 +166,10 @@ class JointEstimator(Estimator):
         Residual up to which the wall is said to fit the model, m.
     noise_floor_m
         Contact noise below which more pieces are never worth it (the criterion's floor), m.
+    noise_m, drift_m_per_sqrt_s
+        The localization's specification: white noise per coordinate, m, and drift rate (a
+        random walk reset at every landing), m / sqrt(s). With a drift rate each contact's
+        drift is fitted with the wall (:mod:`skyquill.painting.robust_fit`).
     """
 
     name = "joint"
@@ -178,6 +182,8 @@ class JointEstimator(Estimator):
         max_pieces: int = 8,
         tolerance_m: float = 0.03,
         noise_floor_m: float = 0.002,
+        noise_m: float = 0.0,
+        drift_m_per_sqrt_s: float = 0.0,
     ) -> None:
         super().__init__(prior)
         if update not in ("depth", "normal"):
@@ -186,7 +192,13 @@ class JointEstimator(Estimator):
         self.max_pieces = as_int("max_pieces", max_pieces, low=1, high=32)
         self.tolerance = as_float("tolerance_m", tolerance_m, positive=True)
         self.noise_floor = as_float("noise_floor_m", noise_floor_m, positive=True)
+        self.noise = math.hypot(as_float("noise_m", noise_m, nonneg=True), self.noise_floor)
+        self.drift_rate = as_float("drift_m_per_sqrt_s", drift_m_per_sqrt_s, nonneg=True)
         self._contacts: list[FloatArray] = []
+        self._battery: list[int] = []
+        self._airborne: list[float] = []
+        self._clock = (0, 0.0)
+        self._drift = np.zeros(0)
         self._estimate = prior
         self._model: WallModel | None = None
         self._pieces: Pieces | None = None
@@ -196,10 +208,16 @@ class JointEstimator(Estimator):
 
     # -- the estimate -------------------------------------------------------------------------
 
+    def tick(self, battery: int, airborne_s: float) -> None:
+        """Keep the mission's clock: contacts are stamped with it, plans use its drift."""
+        self._clock = (int(battery), float(airborne_s))
+
     def update(self, ref_w: FloatArray, contact_rho: FloatArray) -> None:
         """Add a contact (``ref_w`` is not used: contacts are not paired) and refit."""
         del ref_w
         self._contacts.append(np.asarray(contact_rho[:2], dtype=float))
+        self._battery.append(self._clock[0])
+        self._airborne.append(self._clock[1])
         n = len(self._contacts)
         if n > REFIT_EVERY_UNTIL and n < self._fitted_at * REFIT_GROWTH:
             return
@@ -212,26 +230,53 @@ class JointEstimator(Estimator):
     def _refit(self, pts: FloatArray) -> None:
         """Cut, fit, drop outliers, and again while the outliers change (at most 3 times)."""
         x, y = pts[:, 0], pts[:, 1]
-        keep = screen(x, y)
+        drift = DriftModel(np.array(self._battery), np.array(self._airborne), self.drift_rate)
+        d = np.concatenate([self._drift, np.zeros(x.size - self._drift.size)])
+        keep = screen(x, y - d)
         if np.ptp(x[keep]) < MIN_BASELINE_M:
             keep = np.ones(x.size, dtype=bool)
         for _ in range(3):
-            pieces = fit_pieces(
-                x[keep], y[keep], max_pieces=self.max_pieces, noise_floor_m=self.noise_floor
-            )
-            pieces, scale = robust_lines(x[keep], y[keep], pieces, self.noise_floor)
-            residual = y - pieces.predict(x)
+            fit = self._select(x, y, keep, d, drift)
+            pieces, d, scale = fit.pieces, fit.drift, fit.scale
+            residual = y - d - pieces.predict(x)
             new_keep = np.abs(residual) <= max(REJECT_SCALES * scale, REJECT_FLOOR_M)
             if np.array_equal(new_keep, keep) or np.ptp(x[new_keep]) < MIN_BASELINE_M:
                 break
             keep = new_keep
         straight = max(REJECT_SCALES * scale, 2.0 * self.noise_floor)
-        estimate = read_placement(pieces, self._estimate, pts[keep], straight)
+        corrected = np.column_stack([x, y - d])[keep]
+        estimate = read_placement(pieces, self._estimate, corrected, straight)
         if abs(estimate.gamma_rad) > MAX_GAMMA_HAT_RAD:
             return  # degenerate: keep the last sane estimate
-        self._estimate, self._pieces, self._kept = estimate, pieces, keep
+        self._estimate, self._pieces, self._kept, self._drift = estimate, pieces, keep, d
         self._model = wall_in_w(pieces, estimate)
         self.fit = self._wall_fit(pieces, keep, residual)
+
+    def _select(
+        self, x: FloatArray, y: FloatArray, keep: np.ndarray, d: FloatArray, drift: DriftModel
+    ) -> LineFit:
+        """The pieces and lines that explain the kept contacts best.
+
+        Without drift: the BIC-best cut (:func:`fit_pieces`), its lines fitted robustly. With
+        drift, a cut seen in the contacts as measured may be drift, and one seen after the
+        last fit's drift was removed may have had a corner taken for drift; so the best cuts
+        of both, with one piece fewer and one more, are each fitted with the drift
+        marginalised and compared by the information criterion on that likelihood
+        (:func:`~skyquill.painting.robust_fit.fit_lines`), not on residuals after the drift.
+        """
+        xk = x[keep]
+        if self.drift_rate == 0.0:
+            pieces = fit_pieces(xk, y[keep], max_pieces=self.max_pieces, noise_floor_m=self.noise)
+            return fit_lines(x, y, keep, [pieces], noise_m=self.noise, drift=drift)
+        spread = math.hypot(self.noise, self.drift_rate * math.sqrt(float(drift.airborne_s.mean())))
+        seen: dict[tuple[int, ...], Pieces] = {}
+        sources = [(y, spread)] + ([(y - d, self.noise)] if np.any(d != 0.0) else [])
+        for data, floor in sources:
+            splits = Splits(xk, data[keep], max_pieces=self.max_pieces, noise_floor_m=floor)
+            for k in range(max(splits.best - 1, 1), min(splits.best + 1, splits.most) + 1):
+                pieces = splits.pieces(k)
+                seen.setdefault(tuple(np.round(pieces.breaks, 3)), pieces)
+        return fit_lines(x, y, keep, list(seen.values()), noise_m=self.noise, drift=drift)
 
     def _wall_fit(self, pieces: Pieces, keep: np.ndarray, residual: FloatArray) -> WallFit:
         """How well the model explains the contacts (residuals along ``R_rho``'s ``y``)."""
@@ -263,13 +308,24 @@ class JointEstimator(Estimator):
         x, z = float(ref_w[0]), float(ref_w[2])
         k = model.piece_of(x)
         t, e = float(model.slopes[k]), float(model.offsets[k])
+        shift = np.array([0.0, self.drift_now(), 0.0])  # the wall as the drone sees it now
         if self.update_mode == "depth":
             target_w = np.array([x, t * x + e, z])
-            return Plan(est.to_rho(target_w), -est.gamma_rad)
+            return Plan(est.to_rho(target_w) + shift, -est.gamma_rad)
         u = np.array([1.0, t]) / math.hypot(1.0, t)
         anchor = np.array([0.0, e])
         foot = anchor + ((np.array([x, 0.0]) - anchor) @ u) * u
-        return Plan(est.to_rho(np.array([foot[0], foot[1], z])), math.atan(t) - est.gamma_rad)
+        target = est.to_rho(np.array([foot[0], foot[1], z])) + shift
+        return Plan(target, math.atan(t) - est.gamma_rad)
+
+    def drift_now(self) -> float:
+        """The drift of this flight's latest fitted contact (a random walk's best guess of
+        the drift now), m; 0 before a contact of this flight (the localization was reset)."""
+        n = self._drift.size
+        if n == 0:
+            return 0.0
+        same = np.flatnonzero(np.array(self._battery[:n]) == self._clock[0])
+        return float(self._drift[same[-1]]) if same.size else 0.0
 
     @property
     def placement(self) -> Placement:
@@ -292,42 +348,6 @@ class JointEstimator(Estimator):
             return np.zeros((0, 4))
         p = self._pieces
         return np.column_stack([p.slopes, p.intercepts, p.x_lo, p.x_hi])
-
-
-def robust_lines(
-    x: FloatArray, y: FloatArray, pieces: Pieces, noise_floor_m: float
-) -> tuple[Pieces, float]:
-    """Every piece's line refitted to its points by ``least_squares`` with a soft-L1 loss.
-
-    One problem for all pieces (parameters ``a_k, b_k``); the loss's scale is the robust
-    scale (1.4826 x median) of the least-squares residuals, never below ``noise_floor_m``.
-    Returns the pieces with the robust lines (and breaks recomputed from them) and that scale.
-    """
-    labels = pieces.piece_of(x)
-    theta0 = np.column_stack([pieces.slopes, pieces.intercepts]).ravel()
-    design = np.zeros((x.size, theta0.size))
-    rows = np.arange(x.size)
-    design[rows, 2 * labels] = x
-    design[rows, 2 * labels + 1] = 1.0
-    scale = max(1.4826 * float(np.median(np.abs(design @ theta0 - y))), noise_floor_m)
-    sol = least_squares(
-        lambda th: design @ th - y,
-        theta0,
-        jac=lambda th: design,
-        loss="soft_l1",
-        f_scale=scale,
-        method="trf",
-    )
-    lines = sol.x.reshape(-1, 2)
-    breaks = np.array(
-        [
-            corner_or_step(pieces.x_hi[k], pieces.x_lo[k + 1], lines[k], lines[k + 1])
-            for k in range(pieces.n_pieces - 1)
-        ]
-    )
-    fitted = replace(pieces, slopes=lines[:, 0], intercepts=lines[:, 1], breaks=breaks)
-    final = max(1.4826 * float(np.median(np.abs(design @ sol.x - y))), noise_floor_m)
-    return fitted, final
 
 
 def read_placement(

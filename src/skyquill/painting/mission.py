@@ -54,6 +54,7 @@ from skyquill.painting.dots import check_dots
 from skyquill.painting.estimate import (
     Estimator,
     NoEstimator,
+    Plan,
     RigidEstimator,
     SegmentEstimator,
     UpdateMode,
@@ -407,6 +408,7 @@ def make_estimator(
     *,
     segments: bool,
     update: UpdateMode = "depth",
+    localization: Localization | None = None,
 ) -> Estimator:
     """``none`` / ``svd`` / ``robust`` (paper 002: with ``segments`` the line model of §5) or
     ``joint`` (placement and wall together, :mod:`skyquill.painting.joint`)."""
@@ -415,7 +417,13 @@ def make_estimator(
     if name == "none":
         return NoEstimator(prior)
     if name == "joint":
-        return JointEstimator(prior, update=update)
+        spec = localization or Localization()
+        return JointEstimator(
+            prior,
+            update=update,
+            noise_m=spec.noise_m,
+            drift_m_per_sqrt_s=spec.drift_m_per_sqrt_s,
+        )
     if segments:
         return SegmentEstimator(prior, update=update, robust=name == "robust")
     return RigidEstimator(prior, robust=name == "robust")
@@ -670,13 +678,18 @@ def run_mission(
     est = (
         estimator
         if isinstance(estimator, Estimator)
-        else make_estimator(estimator, cfg.prior, segments=segments, update=update)
+        else make_estimator(
+            estimator, cfg.prior, segments=segments, update=update, localization=loc
+        )
     )
     home_w = truth.to_w(np.zeros(3))
     probes = np.zeros((0, 3))
     if isinstance(est, JointEstimator) and cfg.probe_spacing_m > 0 and len(dots) > 1:
         probes = probing_pass(dots, cfg.probe_spacing_m)
-    start_xz = probes[-1, [0, 2]] if len(probes) else np.array([home_w[0], 0.0])
+    # after a probing pass the dots start in front of the take-off point, where a turned
+    # estimate moves a dot least (the lever is the distance from the take-off point), and
+    # move out as the contacts pin the placement down
+    start_xz = np.array([home_w[0], probes[0, 2]]) if len(probes) else np.array([home_w[0], 0.0])
     route = order_dots(dots, order, start_xz=start_xz)
     flight = _Flight(wall=wall, truth=truth, loc=loc, config=cfg, rng=rng)
     painted = np.full((len(dots), 3), np.nan)
@@ -688,15 +701,18 @@ def run_mission(
     if cfg.probe and isinstance(est, RigidEstimator) and len(dots) > 1:
         queue.insert(0, (-1, _probe_dot(dots, int(route[0]))))
     for done, (i, ref_w) in enumerate(queue):
-        plan = est.plan(ref_w)
-        wait = plan.target_rho.copy()
-        wait[:2] -= cfg.waiting_distance_m * plan.direction_rho
+        est.tick(flight.landings, flight.t_air)
+        plan, wait = _planned(est, ref_w, cfg)
         landed = flight.land_if_needed(wait)
+        if landed:  # the localization was reset on the ground: plan again for the new flight
+            est.tick(flight.landings, flight.t_air)
+            plan, wait = _planned(est, ref_w, cfg)
         if i >= 0:
             aimed[i] = flight.aim(wait, plan.yaw_rad)
         key = (0, i) if i >= 0 else (1, done)
         measured, touch_w = flight.touch(wait, plan.yaw_rad, key)
         if measured is not None:
+            est.tick(flight.landings, flight.t_air)
             est.update(ref_w, measured)
         if i >= 0:
             painted[i] = touch_w
@@ -738,6 +754,14 @@ def run_mission(
         battery_s=cfg.battery_s,
         wall_fit=est.fit if isinstance(est, JointEstimator) else None,
     )
+
+
+def _planned(est: Estimator, ref_w: FloatArray, cfg: MissionConfig) -> tuple[Plan, FloatArray]:
+    """The estimator's plan for ``ref_w`` and its waiting point ``Delta`` before the target."""
+    plan = est.plan(ref_w)
+    wait = plan.target_rho.copy()
+    wait[:2] -= cfg.waiting_distance_m * plan.direction_rho
+    return plan, wait
 
 
 def _lines_rho(est: Estimator) -> FloatArray:

@@ -118,26 +118,81 @@ def fit_pieces(
         Steepest piece of a split fit (``|a|``): a steeper run is a few points that happen
         to line up across a corner or a step, not a wall the drone could face.
     """
-    x = np.asarray(x, dtype=float)
-    y = np.asarray(y, dtype=float)
-    n = x.size
-    if n < 2 or y.shape != x.shape or float(np.ptp(x)) <= 0.0:
-        raise InputError(f"x, y: got {n} point(s), expected at least 2 at distinct x")
-    order = np.argsort(x, kind="stable")
-    xs, ys = x[order], y[order]
-    bounds = _atoms(n)
-    max_pieces = max(1, min(max_pieces, n // max(min_points, 1)))
-    sse = _run_costs(xs, ys, bounds, min_points, min_width_m, max_slope)
-    costs, back = _dp(sse, max_pieces)
-    line_rss = _one_line_rss(xs, ys)
-    rss = np.concatenate([[line_rss], costs[2:, -1]]) if max_pieces > 1 else np.array([line_rss])
-    params = 3.0 * np.arange(1, rss.size + 1) - 1.0
-    floor = max(noise_floor_m, 1e-9) ** 2
-    bic = n * np.log(np.maximum(rss / n, floor)) + params * math.log(n)
-    bic[~np.isfinite(rss)] = np.inf
-    k_best = int(np.argmin(bic)) + 1
-    starts = [0] if k_best == 1 else _backtrack(back, bounds, k_best)
-    return _pieces(xs, ys, order, starts, float(rss[k_best - 1]), bic)
+    splits = Splits(
+        x,
+        y,
+        max_pieces=max_pieces,
+        min_points=min_points,
+        min_width_m=min_width_m,
+        noise_floor_m=noise_floor_m,
+        max_slope=max_slope,
+    )
+    return splits.pieces(splits.best)
+
+
+class Splits:
+    """The least-squares best cut of the points into ``K = 1 .. max_pieces`` pieces.
+
+    Built once by the dynamic programme; :meth:`pieces` reads any ``K`` off it. Arguments as
+    :func:`fit_pieces`.
+
+    Attributes
+    ----------
+    bic
+        The criterion of each ``K`` (``inf`` where no cut exists), shape (max_pieces,).
+    best
+        The ``K`` with the smallest criterion.
+    """
+
+    def __init__(
+        self,
+        x: FloatArray,
+        y: FloatArray,
+        *,
+        max_pieces: int = 8,
+        min_points: int = 3,
+        min_width_m: float = 0.1,
+        noise_floor_m: float = 0.002,
+        max_slope: float = MAX_SLOPE,
+    ) -> None:
+        x = np.asarray(x, dtype=float)
+        y = np.asarray(y, dtype=float)
+        n = x.size
+        if n < 2 or y.shape != x.shape or float(np.ptp(x)) <= 0.0:
+            raise InputError(f"x, y: got {n} point(s), expected at least 2 at distinct x")
+        self._order = np.argsort(x, kind="stable")
+        self._xs, self._ys = x[self._order], y[self._order]
+        self._bounds = _atoms(n)
+        max_pieces = max(1, min(max_pieces, n // max(min_points, 1)))
+        sse = _run_costs(
+            self._xs,
+            self._ys,
+            self._bounds,
+            min_points=min_points,
+            min_width=min_width_m,
+            max_slope=max_slope,
+        )
+        costs, self._back = _dp(sse, max_pieces)
+        line_rss = _one_line_rss(self._xs, self._ys)
+        rss = np.concatenate([[line_rss], costs[2:, -1]])
+        params = 3.0 * np.arange(1, rss.size + 1) - 1.0
+        floor = max(noise_floor_m, 1e-9) ** 2
+        bic = n * np.log(np.maximum(rss / n, floor)) + params * math.log(n)
+        bic[~np.isfinite(rss)] = np.inf
+        self._rss, self.bic = rss, bic
+        self.best = int(np.argmin(bic)) + 1
+
+    @property
+    def most(self) -> int:
+        """The largest ``K`` for which a cut exists."""
+        return int(np.flatnonzero(np.isfinite(self._rss))[-1]) + 1
+
+    def pieces(self, k: int) -> Pieces:
+        """The best cut into ``k`` pieces (1 <= k <= :attr:`most`)."""
+        starts = [0] if k == 1 else _backtrack(self._back, self._bounds, k)
+        return _pieces(
+            self._xs, self._ys, self._order, starts, rss=float(self._rss[k - 1]), bic=self.bic
+        )
 
 
 def _atoms(n: int) -> np.ndarray:
@@ -158,6 +213,7 @@ def _run_costs(
     xs: FloatArray,
     ys: FloatArray,
     bounds: np.ndarray,
+    *,
     min_points: int,
     min_width: float,
     max_slope: float,
@@ -190,7 +246,7 @@ def _run_costs(
 
 
 def _dp(sse: FloatArray, max_pieces: int) -> tuple[FloatArray, np.ndarray]:
-    """Best cost of ``k`` runs covering atoms ``0 .. j - 1``: ``costs[k, j]``, with back-pointers."""
+    """Best cost of ``k`` runs over atoms ``0 .. j - 1``, ``costs[k, j]``, and back-pointers."""
     m = sse.shape[0]
     costs = np.full((max_pieces + 1, m), np.inf)
     back = np.zeros((max_pieces + 1, m), dtype=int)
@@ -233,6 +289,7 @@ def _pieces(
     ys: FloatArray,
     order: np.ndarray,
     starts: list[int],
+    *,
     rss: float,
     bic: FloatArray,
 ) -> Pieces:
@@ -254,9 +311,7 @@ def _pieces(
     return Pieces(slopes, intercepts, breaks, labels, x_lo, x_hi, rss, bic)
 
 
-def corner_or_step(
-    x_left: float, x_right: float, left: FloatArray, right: FloatArray
-) -> float:
+def corner_or_step(x_left: float, x_right: float, left: FloatArray, right: FloatArray) -> float:
     """Where two neighbouring pieces meet: their lines' crossing if it lies between the left
     piece's last point ``x_left`` and the right one's first ``x_right`` (a corner), else
     half-way between them (a step). ``left``, ``right``: ``(slope, intercept)``."""

@@ -204,7 +204,7 @@ class Wall:
         half = math.asin(reach / abs(r))
         m = math.ceil(half / step + 0.5)
         k = np.arange(-m, m + 1)
-        angles = k * step * math.copysign(1.0, r)
+        angles = (k * step * math.copysign(1.0, r)).astype(np.float64)
         # corner between the tangents at k * step and (k + 1) * step
         mid = (k[:-1] + 0.5) * step
         breaks = abs(r) / math.cos(step / 2) * np.sin(mid)

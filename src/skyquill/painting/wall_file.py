@@ -64,7 +64,9 @@ def read_wall(path: str | Path) -> Wall:
         raise InputError(f"--wall: got {str(file)!r}, expected an existing .toml wall file")
     size = file.stat().st_size
     if size > MAX_BYTES:
-        raise InputError(f"--wall: got {size:,} bytes in {file.name}, expected at most {MAX_BYTES:,}")
+        raise InputError(
+            f"--wall: got {size:,} bytes in {file.name}, expected at most {MAX_BYTES:,}"
+        )
     try:
         text = file.read_bytes().decode("utf-8")
     except UnicodeDecodeError:
@@ -122,7 +124,9 @@ def _segments(raw: Any, height: float) -> Wall:
         raise InputError("[[segment]]: got none, expected a list of segments, left to right")
     if len(raw) > MAX_SEGMENTS:
         raise InputError(f"[[segment]]: got {len(raw)}, expected at most {MAX_SEGMENTS}")
-    starts, ends, angles = [], [], []
+    starts: list[float] = []
+    ends: list[float] = []
+    angles: list[float] = []
     for i, table in enumerate(raw):
         where = f"segment[{i}]"
         t = _known(table, where, ("from", "to", "angle"))
@@ -186,7 +190,9 @@ def _known(table: Any, where: str, keys: tuple[str, ...]) -> dict[str, Any]:
         raise InputError(f"{where}: got {type(table).__name__}, expected a table")
     for key in table:
         if key not in keys:
-            raise InputError(f"{where}.{key}: got an unknown key, expected one of {', '.join(keys)}")
+            raise InputError(
+                f"{where}.{key}: got an unknown key, expected one of {', '.join(keys)}"
+            )
     return table
 
 
