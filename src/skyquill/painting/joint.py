@@ -34,8 +34,11 @@ along the wall, are cut into ``K`` runs by dynamic programming and ``K`` by the 
 information criterion (:mod:`skyquill.painting.segmentation`, which says why not RANSAC).
 False contacts (the IMU firing short of the wall) are dropped by a local test before the cut
 (:func:`~skyquill.painting.segmentation.screen`), weighed down by the soft-L1 loss, and dropped
-when their residual exceeds ``3.5`` robust scales (at least 3 cm); the cut and the fit are then
-repeated without them. Missed contacts simply add nothing.
+when they are short of the fitted wall by more than ``3.5`` robust scales (at least 3 cm); the
+cut and the fit are then repeated without them. The test is one-sided because the fault is: a
+contact is never measured beyond the wall, so one beyond the model says the model is wrong and
+is kept to correct it (a piece fitted to false contacts would otherwise discard the real ones
+behind it). Missed contacts simply add nothing.
 
 Where this departs from the paper
 ---------------------------------
@@ -69,6 +72,10 @@ from skyquill.validation import FloatArray, as_float, as_int
 
 #: Contacts spread over less than this along the wall give no direction yet, m.
 MIN_BASELINE_M = 0.3
+#: Fewest contacts the first estimate is made from: with two or three, one false contact
+#: decides the line (measured: a 48 deg estimate from the first two probes, one false), with
+#: four the robust fit out-votes it. (The paper starts at two, eq. 3 for i >= 2.)
+MIN_CONTACTS = 4
 #: An estimate of gamma beyond this is degenerate and not adopted, rad.
 MAX_GAMMA_HAT_RAD = math.radians(60.0)
 #: Residuals beyond this many robust scales (and beyond ``REJECT_FLOOR_M``) are outliers.
@@ -222,8 +229,8 @@ class JointEstimator(Estimator):
         if n > REFIT_EVERY_UNTIL and n < self._fitted_at * REFIT_GROWTH:
             return
         pts = np.array(self._contacts)
-        if np.ptp(pts[:, 0]) < MIN_BASELINE_M:
-            return  # contacts this close together give no direction
+        if n < MIN_CONTACTS or np.ptp(pts[:, 0]) < MIN_BASELINE_M:
+            return  # too few, or too close together, to give a direction
         self._refit(pts)
         self._fitted_at = n
 
@@ -239,7 +246,9 @@ class JointEstimator(Estimator):
             fit = self._select(x, y, keep, d, drift)
             pieces, d, scale = fit.pieces, fit.drift, fit.scale
             residual = y - d - pieces.predict(x)
-            new_keep = np.abs(residual) <= max(REJECT_SCALES * scale, REJECT_FLOOR_M)
+            # one-sided: a false contact is short of the wall, no contact is beyond it (one
+            # beyond the model says the model is wrong, and is kept to correct it)
+            new_keep = residual >= -max(REJECT_SCALES * scale, REJECT_FLOOR_M)
             if np.array_equal(new_keep, keep) or np.ptp(x[new_keep]) < MIN_BASELINE_M:
                 break
             keep = new_keep

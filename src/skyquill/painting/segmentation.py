@@ -334,17 +334,20 @@ def screen(
     floor_m: float = 0.03,
     scales: float = 3.5,
 ) -> np.ndarray:
-    """Mask of the points some pair of their neighbours along ``x`` agrees with (True: keep).
+    """Mask of the points not short of every line through two of their neighbours (True: keep).
 
-    A point on a piecewise-planar wall lies on the line through two other points of its own
-    piece; on a piece of three contacts the other two are its neighbours. A false contact
-    (the IMU firing short of the wall) lies on no line through two wall points: the lines
-    through points of one piece run along the wall, and those across a corner or a step miss
-    it by no more than the corner's sag. So each point is tested against the lines through
-    every pair among its ``neighbours`` nearest points on each side (within ``reach_m``,
-    pairs at least ``min_baseline_m`` apart and no steeper than ``max_slope``), and is dropped
-    when the best of them misses it by more than ``max(scales * s, floor_m)``, ``s`` the
-    robust scale (1.4826 x median) of the best misses. A point with no usable pair is kept.
+    ``y`` grows away from the drone (into the wall). A false contact -- the IMU firing before
+    the wall -- is measured short of the wall, never beyond it. A point on a piecewise-planar
+    wall lies on the line through two other points of its own piece (on a piece of three
+    contacts, its two neighbours); a false contact lies short of every line through two wall
+    points nearby, by more than a corner's sag. So each point is tested against the lines
+    through every pair among its ``neighbours`` nearest points on each side (within
+    ``reach_m``, pairs at least ``min_baseline_m`` apart and no steeper than ``max_slope``),
+    and dropped when it is short of all of them by more than ``max(scales * s, floor_m)``,
+    ``s`` the robust scale (1.4826 x median) of the points' smallest misses. A point beyond
+    a line is never dropped (it says the wall is farther), nor one with no usable pair. A line
+    with a neighbour beyond it by as much, between its two points, is not a wall line (it goes
+    through a false contact: the wall is behind it there) and explains nothing.
 
     Why this test and not the residuals of one fit: the piecewise fit that follows would
     otherwise spend a piece on a false contact and two neighbours (a line through three
@@ -370,13 +373,36 @@ def screen(
     with np.errstate(divide="ignore", invalid="ignore"):
         slope = (ny[:, q] - ny[:, p]) / dx
     usable &= np.abs(slope) <= max_slope
-    predicted = ny[:, p] + slope * (xs[:, None] - nx[:, p])
-    miss = np.where(usable, np.abs(ys[:, None] - predicted), np.inf)
-    best = miss.min(axis=1)
-    seen = np.isfinite(best)
+    signed = ys[:, None] - (ny[:, p] + slope * (xs[:, None] - nx[:, p]))
+    seen = usable.any(axis=1)
     if not seen.any():
         return keep
-    s = 1.4826 * float(np.median(best[seen]))
+    smallest = np.where(usable, np.abs(signed), np.inf).min(axis=1)
+    s = 1.4826 * float(np.median(smallest[seen]))
     tau = max(scales * s, floor_m)
-    keep[order[seen & (best > tau)]] = False
+    usable &= ~_beyond(nx, ny, inside, (p, q), slope=slope, tau=tau)
+    deepest = np.where(usable, signed, -np.inf).max(axis=1)  # the least short of any line
+    keep[order[seen & (deepest < -tau)]] = False
     return keep
+
+
+def _beyond(
+    nx: FloatArray,
+    ny: FloatArray,
+    inside: np.ndarray,
+    pairs: tuple[np.ndarray, np.ndarray],
+    *,
+    slope: FloatArray,
+    tau: float,
+) -> np.ndarray:
+    """Per point and pair: a neighbour strictly between the pair's two points lies beyond the
+    pair's line by more than ``tau``, shape (n, pairs)."""
+    p, q = pairs
+    lo = np.minimum(nx[:, p], nx[:, q])[:, :, None]
+    hi = np.maximum(nx[:, p], nx[:, q])[:, :, None]
+    rx, ry = nx[:, None, :], ny[:, None, :]
+    between = inside[:, None, :] & (rx > lo) & (rx < hi)
+    line = ny[:, p][:, :, None] + slope[:, :, None] * (rx - nx[:, p][:, :, None])
+    with np.errstate(invalid="ignore"):
+        out: np.ndarray = (between & (ry - line > tau)).any(axis=2)
+    return out
