@@ -404,5 +404,5 @@ def _beyond(
     between = inside[:, None, :] & (rx > lo) & (rx < hi)
     line = ny[:, p][:, :, None] + slope[:, :, None] * (rx - nx[:, p][:, :, None])
     with np.errstate(invalid="ignore"):
-        out: np.ndarray = (between & (ry - line > tau)).any(axis=2)
+        out = np.asarray((between & (ry - line > tau)).any(axis=2), dtype=bool)
     return out
