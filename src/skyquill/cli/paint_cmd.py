@@ -35,6 +35,8 @@ if TYPE_CHECKING:  # the painting package is imported lazily
 
 #: Largest |gamma| accepted, deg: beyond it the drone does not face the wall.
 MAX_GAMMA_DEG = 60.0
+#: Widest probing pass spacing, m (wider is one probe at each end of any drawing).
+MAX_PROBE_SPACING_M = 10.0
 
 
 @app.command()
@@ -54,13 +56,40 @@ def paint(
         str, typer.Option(help="True placement offset delta x,y,z in the wall frame, m.")
     ] = "0,-1.1,0",
     wall_angles: Annotated[
-        str, typer.Option(help="Segment angles left to right, deg, e.g. -10,0,10 (0: flat).")
+        str,
+        typer.Option(
+            help="Segment angles left to right, deg, e.g. -10,0,10 (0: flat), splitting the "
+            "drawing's width equally."
+        ),
     ] = "0",
-    estimator: Annotated[str, typer.Option(help="none, svd or robust.")] = "svd",
+    wall: Annotated[
+        Path | None,
+        typer.Option(
+            help="The wall from a TOML file instead: [[segment]]s, a [cylinder] or a [recess] "
+            "(docs/wall-painting-estimation.md)."
+        ),
+    ] = None,
+    estimator: Annotated[
+        str,
+        typer.Option(
+            help="joint (placement and wall shape together), or paper 002's none, svd, robust."
+        ),
+    ] = "joint",
     localization: Annotated[str, typer.Option(help="onboard or truth.")] = "onboard",
-    order: Annotated[str, typer.Option(help="given, paper (right-left, top-bottom), shortest.")] = (
-        "given"
-    ),
+    order: Annotated[
+        str,
+        typer.Option(
+            help="shortest (a short tour), spread (first dots far apart), paper (right-left, "
+            "top-bottom) or given."
+        ),
+    ] = "shortest",
+    probe_spacing: Annotated[
+        float,
+        typer.Option(
+            help="joint: touch the wall without painting every this many m across the drawing "
+            "before the first dot (0: no probing pass)."
+        ),
+    ] = 0.4,
     update: Annotated[
         str, typer.Option(help="Segmented walls: depth (eq. 15) or normal (fresco).")
     ] = "depth",
@@ -81,9 +110,10 @@ def paint(
     from skyquill.io.trajectory_json import PlannedTrajectory
     from skyquill.painting.dots import drawing_span
     from skyquill.painting.flight import painting_flight
-    from skyquill.painting.mission import ESTIMATORS, MissionConfig, run_mission
+    from skyquill.painting.mission import ESTIMATORS, MissionConfig, check_on_wall, run_mission
     from skyquill.painting.order import ORDERS
     from skyquill.painting.wall import Placement, Wall, parse_angles
+    from skyquill.painting.wall_file import read_wall
     from skyquill.validation import as_seed
     from skyquill.viz.painting_plot import plot_mission
 
@@ -109,6 +139,16 @@ def paint(
                 "-20 <= y < 0 m and every component within 20 m"
             )
         angles = parse_angles(wall_angles)
+        if wall is not None and wall_angles != "0":
+            raise InputError(
+                f"--wall / --wall-angles: got both ({wall.name}, {wall_angles!r}), expected one"
+            )
+        if not (math.isfinite(probe_spacing) and 0.0 <= probe_spacing <= MAX_PROBE_SPACING_M):
+            raise InputError(
+                f"--probe-spacing: got {probe_spacing:g}, expected 0 (no probing pass) to "
+                f"{MAX_PROBE_SPACING_M:g} m"
+            )
+        surface = None if wall is None else read_wall(wall)
         for option, rate in (
             ("--false-contacts", false_contacts),
             ("--missed-contacts", missed_contacts),
@@ -117,24 +157,32 @@ def paint(
                 raise InputError(f"{option}: got {rate:g}, expected a probability in [0, 1)")
         with _progress() as bar:
             points = _dots(dots_csv, image, dots, width, seed, bar)
-            lo, hi = drawing_span(points)
-            wall = Wall.segmented(angles, (lo, hi))
+            if surface is None:
+                surface = Wall.segmented(angles, drawing_span(points))
+            check_on_wall(
+                points,
+                surface,
+                name=str(dots_csv.name if dots_csv else "--image"),
+                wall_name=wall.name if wall else "--wall-angles",
+            )
             task = bar.add_task("painting", total=None)
             result = run_mission(
                 points,
-                wall=wall,
+                wall=surface,
                 truth=Placement(delta, math.radians(gamma)),
                 estimator=estimator,
                 localization=localization,
                 order=order,
                 update=update_mode,
                 config=MissionConfig(
-                    false_contact_rate=false_contacts, missed_contact_rate=missed_contacts
+                    false_contact_rate=false_contacts,
+                    missed_contact_rate=missed_contacts,
+                    probe_spacing_m=probe_spacing,
                 ),
                 rng=np.random.default_rng(seed),
                 progress=lambda done, total: bar.update(task, completed=done, total=total),
             )
-        inputs = [p for p in (dots_csv, image) if p is not None]
+        inputs = [p for p in (dots_csv, image, wall) if p is not None]
         with (
             console.status("timing the flight's legs, writing and checking the plan"),
             staged_output(out, "paint", force=force, inputs=inputs) as stage,
@@ -149,6 +197,7 @@ def paint(
                 summary=result.summary()
                 | {
                     "source": str(dots_csv or image),
+                    "wall": str(wall) if wall else f"--wall-angles {wall_angles}",
                     "seed": seed,
                     "order": order,
                     "gamma_deg": gamma,
@@ -160,7 +209,20 @@ def paint(
     say_done(
         f"{out}: {result.painted.sum()} of {len(result.reference)} dots, RMSE "
         f"{100 * result.rmse_m:.2f} cm, max {100 * result.max_error_m:.2f} cm, "
-        f"{result.flight_time_s / 60:.1f} min, {result.landings} landing(s)"
+        f"{result.flight_time_s / 60:.1f} min ({result.battery_use:.1f} batteries), "
+        f"{result.landings} landing(s)" + _wall_note(result)
+    )
+
+
+def _wall_note(result: MissionResult) -> str:
+    """What the joint estimator says of the wall, when it does not fit its model."""
+    fit = result.wall_fit
+    if fit is None or fit.fits:
+        return ""
+    return (
+        f"; the wall does not fit the plane-pieces model ({fit.pieces} pieces, "
+        f"{100 * fit.residual_m:.1f} cm off, {fit.outliers} contacts dropped): the painting "
+        "follows the closest model"
     )
 
 

@@ -429,8 +429,10 @@ def make_estimator(
     return RigidEstimator(prior, robust=name == "robust")
 
 
-def check_on_wall(dots: FloatArray, wall: Wall) -> None:
-    """InputError if a dot lies outside the wall's extent."""
+def check_on_wall(
+    dots: FloatArray, wall: Wall, *, name: str = "dots", wall_name: str = "the wall"
+) -> None:
+    """InputError naming ``name`` (and ``wall_name``) if a dot lies outside the wall's extent."""
     x0, x1 = wall.x_range_m
     outside = (
         (dots[:, 0] < x0) | (dots[:, 0] > x1) | (dots[:, 1] < 0) | (dots[:, 1] > wall.height_m)
@@ -438,9 +440,9 @@ def check_on_wall(dots: FloatArray, wall: Wall) -> None:
     if outside.any():
         i = int(np.flatnonzero(outside)[0])
         raise InputError(
-            f"dots: got {int(outside.sum())} dot(s) outside the wall, the first (row {i + 1}) at "
-            f"x={dots[i, 0]:g}, z={dots[i, 1]:g} m; expected {x0:g} <= x <= {x1:g} and "
-            f"0 <= z <= {wall.height_m:g} m"
+            f"{name}: got {int(outside.sum())} dot(s) outside the wall, the first (row {i + 1}) "
+            f"at x={dots[i, 0]:g}, z={dots[i, 1]:g} m; expected {x0:g} <= x <= {x1:g} and "
+            f"0 <= z <= {wall.height_m:g} m ({wall_name})"
         )
 
 
