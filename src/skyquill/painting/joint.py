@@ -78,8 +78,6 @@ MIN_BASELINE_M = 0.3
 MIN_CONTACTS = 4
 #: An estimate of gamma beyond this is degenerate and not adopted, rad.
 MAX_GAMMA_HAT_RAD = math.radians(60.0)
-#: A change of the estimated yaw larger than this waits for the next fit to confirm it, rad.
-JUMP_RAD = math.radians(3.0)
 #: Residuals beyond this many robust scales (and beyond ``REJECT_FLOOR_M``) are outliers.
 REJECT_SCALES = 3.5
 REJECT_FLOOR_M = 0.03
@@ -208,7 +206,6 @@ class JointEstimator(Estimator):
         self._airborne: list[float] = []
         self._clock = (0, 0.0)
         self._drift = np.zeros(0)
-        self._pending: float | None = None
         self._estimate = prior
         self._model: WallModel | None = None
         self._pieces: Pieces | None = None
@@ -258,10 +255,8 @@ class JointEstimator(Estimator):
         straight = max(REJECT_SCALES * scale, 2.0 * self.noise_floor)
         corrected = np.column_stack([x, y - d])[keep]
         estimate = read_placement(pieces, self._estimate, corrected, straight)
-        if abs(estimate.gamma_rad) > MAX_GAMMA_HAT_RAD:
-            return  # degenerate: keep the last sane estimate
-        if not self._confirmed(estimate.gamma_rad):
-            return
+        if estimate is None or abs(estimate.gamma_rad) > MAX_GAMMA_HAT_RAD:
+            return  # not said yet, or degenerate: keep the last estimate
         self._estimate, self._pieces, self._kept, self._drift = estimate, pieces, keep, d
         self._model = wall_in_w(pieces, estimate)
         self.fit = self._wall_fit(pieces, keep, residual)
@@ -291,20 +286,6 @@ class JointEstimator(Estimator):
                 pieces = splits.pieces(k)
                 seen.setdefault(tuple(np.round(pieces.breaks, 3)), pieces)
         return fit_lines(x, y, keep, list(seen.values()), noise_m=self.noise, drift=drift)
-
-    def _confirmed(self, gamma: float) -> bool:
-        """Whether to adopt ``gamma``: always, unless it jumps by more than :data:`JUMP_RAD`
-        from an established estimate; then only once the next fit lands within that of it
-        (a single contact that re-cuts the wall, measured: a -16 deg estimate for one dot
-        between two of 0.3 deg, 34 cm of aim error on the dot it planned)."""
-        if self._model is None or abs(gamma - self._estimate.gamma_rad) <= JUMP_RAD:
-            self._pending = None
-            return True
-        if self._pending is not None and abs(gamma - self._pending) <= JUMP_RAD:
-            self._pending = None
-            return True
-        self._pending = gamma
-        return False
 
     def _wall_fit(self, pieces: Pieces, keep: np.ndarray, residual: FloatArray) -> WallFit:
         """How well the model explains the contacts (residuals along ``R_rho``'s ``y``)."""
@@ -380,7 +361,7 @@ class JointEstimator(Estimator):
 
 def read_placement(
     pieces: Pieces, previous: Placement, contacts: FloatArray, straight_m: float
-) -> Placement:
+) -> Placement | None:
     """``(gamma, delta)`` that make the fitted wall run along ``x_w`` through ``x_w = 0``.
 
     The piece under the previous estimate's ``x_w = 0`` gives ``gamma = -atan(a)`` and
@@ -392,8 +373,10 @@ def read_placement(
     chord at ``x_w = 0`` is off-centre, or a narrow piece -- the direction and depth at
     ``x_w = 0`` come from a quadratic fitted to the ``contacts`` (N, 2, ``R_rho``) over the
     widest window ``|x_w| <= h`` (at most :data:`LOCAL_HALF_WIDTH_M`) on which it stays within
-    ``straight_m`` of them (:func:`_local_tangent`). ``delta_x`` stays at the previous
-    (nominal) value.
+    ``straight_m`` of them (:func:`_local_tangent`); when too few contacts are near
+    ``x_w = 0`` for that yet, None: the contacts do not say the direction there (measured
+    onboard: a piece of three drifted contacts at ``x_w = 0`` turned the estimate by 16 deg
+    for one dot, 34 cm of aim error). ``delta_x`` stays at the previous (nominal) value.
     """
     estimate, k = previous, _piece_at_origin(pieces, previous)
     for _ in range(3):
@@ -408,11 +391,11 @@ def read_placement(
     own = contacts[pieces.piece_of(contacts[:, 0]) == k]
     if _reaches(pieces, k, estimate) and not _curved(own @ rot2(estimate.gamma_rad).T):
         return estimate
-    for _ in range(3):
+    for attempt in range(3):
         w = contacts @ rot2(estimate.gamma_rad).T + estimate.delta_w[:2]
         tangent = _local_tangent(w, straight_m)
         if tangent is None:
-            break
+            return None if attempt == 0 else estimate
         turn, depth = tangent
         delta = estimate.delta_w.copy()
         delta[1] -= depth

@@ -42,6 +42,8 @@ from skyquill.validation import FloatArray
 #: Steepest piece, |dy/dx| (75 deg): a wall at up to 60 deg seen by a drone turned by up to
 #: 15 deg more than it believes.
 MAX_SLOPE = math.tan(math.radians(75.0))
+#: Points closer together along ``x`` than this are at the same ``x``, m.
+MIN_SPREAD_M = 1e-6
 #: Most candidate boundaries the DP considers; above it points are grouped in runs of equal
 #: count (a mural of thousands of dots is still cut anywhere within ~1 % of its contacts).
 MAX_ATOMS = 128
@@ -158,7 +160,7 @@ class Splits:
         x = np.asarray(x, dtype=float)
         y = np.asarray(y, dtype=float)
         n = x.size
-        if n < 2 or y.shape != x.shape or float(np.ptp(x)) <= 0.0:
+        if n < 2 or y.shape != x.shape or float(np.ptp(x)) <= MIN_SPREAD_M:
             raise InputError(f"x, y: got {n} point(s), expected at least 2 at distinct x")
         self._order = np.argsort(x, kind="stable")
         self._xs, self._ys = x[self._order], y[self._order]
@@ -272,6 +274,8 @@ def _one_line_rss(xs: FloatArray, ys: FloatArray) -> float:
     """Residual of the least-squares line through all points (any count >= 2)."""
     xc, yc = xs - xs.mean(), ys - ys.mean()
     cxx = float(xc @ xc)
+    if cxx <= 1e-12:
+        return float(yc @ yc)
     return max(float(yc @ yc) - float(xc @ yc) ** 2 / cxx, 0.0)
 
 
@@ -367,23 +371,57 @@ def screen(
     idx = np.clip(idx, 0, n - 1)
     nx, ny = xs[idx], ys[idx]
     inside &= np.abs(nx - xs[:, None]) <= reach_m
-    p, q = np.triu_indices(steps.size, k=1)
+    pairs = np.triu_indices(steps.size, k=1)
+    dropped = np.zeros(n, dtype=bool)
+    for _ in range(3):  # a dropped point explains nothing: test again without it
+        now = _short(
+            (xs, ys),
+            (nx, ny, inside & ~dropped[idx]),
+            pairs,
+            min_baseline_m=min_baseline_m,
+            max_slope=max_slope,
+            floor_m=floor_m,
+            scales=scales,
+        )
+        if np.array_equal(now, dropped):
+            break
+        dropped = now
+    keep[order[dropped]] = False
+    return keep
+
+
+def _short(
+    points: tuple[FloatArray, FloatArray],
+    near: tuple[FloatArray, FloatArray, np.ndarray],
+    pairs: tuple[np.ndarray, np.ndarray],
+    *,
+    min_baseline_m: float,
+    max_slope: float,
+    floor_m: float,
+    scales: float,
+) -> np.ndarray:
+    """One pass of :func:`screen` over the sorted ``points`` (xs, ys) and their neighbours
+    ``near`` (x, y, usable), shape (n, m) each: which points are short of every line."""
+    xs, ys = points
+    nx, ny, inside = near
+    p, q = pairs
     dx = nx[:, q] - nx[:, p]
     usable = inside[:, p] & inside[:, q] & (np.abs(dx) >= min_baseline_m)
-    with np.errstate(divide="ignore", invalid="ignore"):
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         slope = (ny[:, q] - ny[:, p]) / dx
-    usable &= np.abs(slope) <= max_slope
-    signed = ys[:, None] - (ny[:, p] + slope * (xs[:, None] - nx[:, p]))
+        usable &= np.abs(slope) <= max_slope
+        slope = np.where(usable, slope, 0.0)
+        signed = ys[:, None] - (ny[:, p] + slope * (xs[:, None] - nx[:, p]))
     seen = usable.any(axis=1)
     if not seen.any():
-        return keep
+        return np.zeros(xs.size, dtype=bool)
     smallest = np.where(usable, np.abs(signed), np.inf).min(axis=1)
     s = 1.4826 * float(np.median(smallest[seen]))
     tau = max(scales * s, floor_m)
     usable &= ~_beyond(nx, ny, inside, (p, q), slope=slope, tau=tau)
     deepest = np.where(usable, signed, -np.inf).max(axis=1)  # the least short of any line
-    keep[order[seen & (deepest < -tau)]] = False
-    return keep
+    out: np.ndarray = seen & (deepest < -tau)
+    return out
 
 
 def _beyond(
