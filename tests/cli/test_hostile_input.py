@@ -428,6 +428,46 @@ CASES.extend(
 OVER_INPUT = ["export", "{tmp}/traj.csv", "--out", "{tmp}/traj.csv"]
 CASES.append(Case("export over its own input", OVER_INPUT, "inputs", setup=WITH_TRAJ))
 
+# -- paint: wall descriptions that are not walls, dots outside them (issue 29) -----------------
+PAINT_WALL = ["paint", DOTS, "--wall", "{tmp}/w.toml", "--out", "{out}"]
+THREE_SEGMENTS = "".join(
+    f"[[segment]]\nfrom = {a}\nto = {b}\nangle = {angle}\n"
+    for a, b, angle in ((-4, -0.6, -10), (-0.6, 0.6, 0), (0.6, 4, 10))
+)
+WALL_CASES = [
+    ("segments overlap", THREE_SEGMENTS.replace("from = 0.6", "from = 0.2"), "overlaps"),
+    ("segments leave a gap", THREE_SEGMENTS.replace("from = 0.6", "from = 0.9"), "gap"),
+    ("angle 90", THREE_SEGMENTS.replace("angle = 10", "angle = 90"), "segment[2].angle"),
+    ("angle 135", THREE_SEGMENTS.replace("angle = 10", "angle = 135"), "90 deg or more"),
+    ("turned middle", THREE_SEGMENTS.replace("angle = 0", "angle = 5"), "holding x = 0"),
+    ("not toml", "[[segment", "malformed TOML"),
+    ("binary", bytes(range(256)), "not UTF-8"),
+    ("unknown key", "colour = 1\n" + THREE_SEGMENTS, "wall.colour"),
+    ("two shapes", "[cylinder]\nradius = 20\n[recess]\nfrom = 1\nto = 2\ndepth = 0.1\n",
+     "exactly one"),
+    ("tight cylinder", "[cylinder]\nradius = 2\n", "cylinder.radius"),
+    ("recess over the origin", "[recess]\nfrom = -0.5\nto = 0.5\ndepth = 0.1\n", "beside x = 0"),
+    ("dots beside it", "extent = [-1.0, 1.0]\n[cylinder]\nradius = 20\n", "outside the wall"),
+    ("dots above it", "height = 1.5\n[cylinder]\nradius = 20\n", "outside the wall"),
+]  # fmt: skip
+for label, text, message in WALL_CASES:
+    CASES.append(Case(f"paint --wall {label}", PAINT_WALL, message, setup=_write("w.toml", text)))
+CASES.extend(
+    [
+        Case("paint --wall absent", PAINT_WALL, "w.toml"),
+        Case(
+            "paint --wall and --wall-angles",
+            [*PAINT_WALL, "--wall-angles", "-10,0,10"],
+            "got both",
+            setup=_write("w.toml", THREE_SEGMENTS),
+        ),
+        Case("paint --wall-angles 90", _paint("--wall-angles", "-10,90,10"), "--wall-angles"),
+        Case("paint --probe-spacing -1", _paint("--probe-spacing", "-1"), "--probe-spacing"),
+        Case("paint --probe-spacing nan", _paint("--probe-spacing", "nan"), "--probe-spacing"),
+        Case("paint --order spiral", _paint("--order", "spiral"), "--order"),
+    ]
+)
+
 
 @pytest.mark.timeout(60)
 @pytest.mark.parametrize("case", CASES, ids=[c.name for c in CASES])
