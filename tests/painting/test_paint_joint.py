@@ -154,14 +154,14 @@ def test_bad_arguments() -> None:
     drift=st.sampled_from([0.0, 0.004]),
 )
 def test_any_contacts_give_plans_that_face_the_wall(
-    angles: list[float], n: int, seed: int, noise: float, false_rate: float, drift: float
+    angles: list[float], n: int, seed: int, *, noise: float, false_rate: float, drift: float
 ) -> None:
     rng = np.random.default_rng(seed)
     wall = Wall.segmented(angles, (-2.0, 2.0))
     truth = Placement(np.array([0.0, -1.1, 0.0]), math.radians(rng.uniform(-20, 20)))
     est = JointEstimator(PRIOR, noise_m=noise, drift_m_per_sqrt_s=drift)
-    for k, c in enumerate(_contacts(wall, truth, rng.uniform(-2, 2, n))):
-        c = c + rng.normal(0, noise + 1e-9, 3)
+    for k, exact in enumerate(_contacts(wall, truth, rng.uniform(-2, 2, n))):
+        c = exact + rng.normal(0, noise + 1e-9, 3)
         if rng.random() < false_rate:
             c[1] -= rng.uniform(0.05, 0.6)
         est.tick(0, 5.0 * k)

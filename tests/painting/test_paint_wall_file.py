@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 from pathlib import Path
 
 import numpy as np
@@ -163,7 +164,7 @@ def test_any_segment_list_is_a_wall_or_one_input_error(
     edges = [-4.0, *sorted(cuts), 4.0]
     text = "".join(
         f"[[segment]]\nfrom = {a!r}\nto = {b!r}\nangle = {angle!r}\n"
-        for (a, b), angle in zip(zip(edges[:-1], edges[1:], strict=True), angles, strict=False)
+        for (a, b), angle in zip(itertools.pairwise(edges), angles, strict=False)
     )
     try:
         wall = parse_wall(text)
