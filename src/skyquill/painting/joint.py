@@ -38,7 +38,10 @@ when they are short of the fitted wall by more than ``3.5`` robust scales (at le
 cut and the fit are then repeated without them. The test is one-sided because the fault is: a
 contact is never measured beyond the wall, so one beyond the model says the model is wrong and
 is kept to correct it (a piece fitted to false contacts would otherwise discard the real ones
-behind it). Missed contacts simply add nothing.
+behind it). Missed contacts simply add nothing. With onboard localization every contact is
+off by the drift since the last take-off; the fit marginalises it as the random walk it is
+(:mod:`skyquill.painting.robust_fit`), and the plan adds the drift of the latest contact of the
+current flight to the target's depth (the wall as the drone now sees it).
 
 Where this departs from the paper
 ---------------------------------
