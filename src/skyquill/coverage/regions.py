@@ -21,7 +21,8 @@ from shapely.geometry import LineString, MultiPolygon, Polygon, shape
 from shapely.geometry.base import BaseGeometry
 
 from skyquill.errors import InputError
-from skyquill.io.json_read import check_depth, decode_utf8, parse_json
+from skyquill.io.json_read import check_depth, parse_json
+from skyquill.io.source import decode_text
 from skyquill.validation import FloatArray, as_array, as_float
 
 #: Region coordinates beyond this (m) are refused: a local metric frame, not degrees or mm.
@@ -112,7 +113,7 @@ def load_region(source: str | Path, project: Callable[[Any, str], Any] | None = 
         )
     raw = path.read_bytes()
     if path.suffix.lower() == ".wkt":
-        return _from_wkt(decode_utf8(raw, path.name, "a WKT POLYGON"), path.name)
+        return _from_wkt(decode_text(raw, path.name, "a WKT POLYGON"), path.name)
     data = parse_json(raw, path.name, _WHAT)
     return _from_geojson(data if project is None else project(data, path.name), path.name)
 
