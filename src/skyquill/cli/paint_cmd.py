@@ -21,6 +21,7 @@ from skyquill.cli.main import (
     check_out,
     console,
     parse_vector3,
+    progress_bar,
     say_done,
     user_errors,
 )
@@ -166,11 +167,9 @@ def paint(
 
 def _progress() -> Progress:
     """A rich progress bar on stderr (the console the CLI prints to)."""
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn
+    from rich.progress import BarColumn, MofNCompleteColumn, TextColumn
 
-    return Progress(
-        TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), console=console
-    )
+    return progress_bar(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn())
 
 
 def _update(name: str) -> UpdateMode:

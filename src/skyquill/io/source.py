@@ -27,7 +27,7 @@ import os
 import stat
 from collections.abc import Iterator
 from pathlib import Path
-from typing import TextIO
+from typing import BinaryIO, TextIO
 
 from skyquill.errors import InputError
 
@@ -99,6 +99,25 @@ def open_text(
         raw = io.FileIO(os.dup(fd), "r")
         with io.TextIOWrapper(io.BufferedReader(raw), encoding=ENCODING, newline="") as text:
             yield text
+
+
+@contextlib.contextmanager
+def open_binary(
+    path: str | Path, what: str, *, max_bytes: int, name: str | None = None
+) -> Iterator[BinaryIO]:
+    """A binary stream of the regular file ``path`` (for ZIP archives and pictures).
+
+    Raises
+    ------
+    InputError
+        As :func:`read_bytes`, before anything is read.
+    """
+    shown = str(path) if name is None else name
+    with (
+        _opened(Path(path), what, shown, max_bytes) as fd,
+        io.BufferedReader(io.FileIO(os.dup(fd), "r")) as stream,
+    ):
+        yield stream
 
 
 def decode_text(raw: bytes, name: str, what: str) -> str:
