@@ -16,6 +16,7 @@ from numpy.typing import NDArray
 from skyquill.errors import InputError
 from skyquill.io.source import read_bytes
 from skyquill.strokes.model import MAX_POINTS, MAX_STROKES, Strokes
+from skyquill.strokes.svg_checks import check_svg_markup
 
 logger = logging.getLogger(__name__)
 
@@ -173,10 +174,8 @@ def _read_parts(
         grouped = _drawn_parts(svg)
     except Exception as exc:  # svgelements lets XML, value, recursion and I/O errors through
         raise InputError(f"{p}: cannot be parsed as SVG ({exc}), expected an SVG file") from None
+    check_svg_markup(p, raw)
     metres = _metres_per_px(p, svg) if true_size else 1.0
-    elements = [e for _, _, part in grouped for e in part]
-    for i, element in enumerate(elements):
-        _check_data(p, i, element)
     parts = [(key, name, _reified(part)) for key, name, part in grouped]
     shapes = [s for _, _, part in parts for s in part]
     if len(shapes) > MAX_STROKES:
