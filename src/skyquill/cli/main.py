@@ -195,6 +195,27 @@ def parse_vector3(option: str, text: str, unit: str) -> FloatArray:
     return np.array(values)
 
 
+#: A dask.distributed scheduler address: ``local``, ``tcp://host:port`` (or tls, ws, wss,
+#: ucx, inproc) or ``host:port``.
+_SCHEDULER = re.compile(
+    r"local|(?:(?:tcp|tls|ws|wss|ucx|inproc)://)?[A-Za-z0-9._\-\[\]:]+(?::[0-9]{1,5})?", re.ASCII
+)
+
+
+def scheduler_address(text: str | None) -> str | None:
+    """``--scheduler``, checked to look like an address before dask is asked to reach it."""
+    if text is None:
+        return None
+    if not _SCHEDULER.fullmatch(text) or (
+        "://" not in text and text != "local" and ":" not in text
+    ):
+        raise InputError(
+            f"--scheduler: got {text!r}, expected 'local' or a dask scheduler address such as "
+            "tcp://10.0.0.5:8786"
+        )
+    return text
+
+
 _BYTE = re.compile(r"\s*[0-9]{1,3}\s*", re.ASCII)
 
 

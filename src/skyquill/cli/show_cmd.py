@@ -15,6 +15,7 @@ from skyquill.cli.main import (
     check_out,
     console,
     say_done,
+    scheduler_address,
     stage_progress,
     user_errors,
 )
@@ -30,6 +31,8 @@ from skyquill.show.script import ShowScript, load_script
 #: Relative round-off allowed over the planned limits in the independent check
 #: (Ruckig's profiles touch the limits exactly; the writing QP holds them to its tolerance).
 CHECK_ROUND_OFF = 1e-6
+#: Most ``--workers`` (processes planning the writing): more than any machine's cores is a typo.
+MAX_WORKERS = 256
 
 
 @app.command()
@@ -53,8 +56,9 @@ def show(
     """
     with user_errors():
         check_out(out)
-        if workers is not None and workers < 1:
-            raise InputError(f"--workers: got {workers}, expected at least 1")
+        if workers is not None and not 1 <= workers <= MAX_WORKERS:
+            raise InputError(f"--workers: got {workers}, expected 1 to {MAX_WORKERS}")
+        scheduler = scheduler_address(scheduler)
         show_script = load_script(script)
         stages: dict[str, float] = {}
         plan = _plan(show_script, workers, scheduler)

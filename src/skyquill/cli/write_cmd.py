@@ -5,6 +5,7 @@ from __future__ import annotations
 import dataclasses
 import inspect
 import math
+import re
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any
@@ -29,6 +30,7 @@ from skyquill.cli.main import (
     parse_color,
     positive_rate,
     say_done,
+    scheduler_address,
     stage_progress,
     upload_target,
     user_errors,
@@ -231,6 +233,7 @@ def write(
     with user_errors():
         check_out(out)
         rate = positive_rate(rate)
+        scheduler = scheduler_address(scheduler)
         palette = _palette(light_color, color_by)
         kind = _board_kind(board, fly)
         pose = _sky_pose(kind, board_yaw, board_tilt, plane_weight, grid, lift)
@@ -359,14 +362,24 @@ def _sky_pose(
     return _Pose(yaw, tilt, None if grid is None else _grid(grid))
 
 
+_DIGITS = re.compile(r"[0-9]{1,6}", re.ASCII)
+
+
 def _grid(text: str) -> tuple[int, int]:
     """``"4x5"`` to ``(4, 5)``."""
     rows, sep, columns = text.lower().partition("x")
-    if not (sep and rows.strip().isdigit() and columns.strip().isdigit()):
+    if not (sep and _DIGITS.fullmatch(rows.strip()) and _DIGITS.fullmatch(columns.strip())):
         raise InputError(f"--grid: got {text!r}, expected ROWSxCOLUMNS, e.g. 4x5")
+    from skyquill.calligraphy.show import MAX_DRONES
+
     shape = int(rows), int(columns)
     if min(shape) < 1:
         raise InputError(f"--grid: got {text!r}, expected at least one row and one column")
+    if shape[0] * shape[1] > MAX_DRONES:
+        raise InputError(
+            f"--grid: got {text!r} ({shape[0] * shape[1]:,} boards), expected at most "
+            f"{MAX_DRONES} boards, one per drone (rows x columns <= {MAX_DRONES})"
+        )
     return shape
 
 

@@ -111,7 +111,15 @@ def _medians_in(entry: Any, char: str, where: str) -> Any:
 def _lookup_file(path: Path, char: str) -> Any | None:
     data = read_json(path, f"hanzi-writer data for {char!r}")
     if isinstance(data, dict) and "medians" in data:
-        return data["medians"]  # one character's file, as in hanzi-writer-data
+        # One character's file, as in hanzi-writer-data: its name says which character.
+        held = path.name.removesuffix(".json")
+        if len(held) != 1:
+            raise InputError(
+                f"{path}: got one character's hanzi-writer data in a file named {path.name!r}, "
+                f"expected it named after its character (such as 永.json) to write {char!r}, "
+                "or an object {character: medians}"
+            )
+        return data["medians"] if held == char else None
     if isinstance(data, dict):
         if char in data:
             return _medians_in(data[char], char, str(path))
