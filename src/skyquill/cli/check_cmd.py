@@ -30,6 +30,11 @@ from skyquill.show import (
 )
 from skyquill.show.report import UNITS
 
+#: Most drones one ``check`` takes: their 2,000,000 pairs are bounded in memory (the
+#: separation's intervals, :data:`~skyquill.show.separation.MAX_INTERVALS`) and in time
+#: (bench/ceilings.py measures a show of this many).
+MAX_DRONES = 2_000
+
 
 def _limit(flag: str, value: float | None, *, nonneg: bool = True) -> float | None:
     """A limit from the command line: finite (and >= 0 for speeds and distances)."""
@@ -98,6 +103,11 @@ def check(
             geofence=read_geofence(geofence) if geofence is not None else None,
         )
         drones = load_show(paths)
+        if len(drones) > MAX_DRONES:
+            raise InputError(
+                f"PATH: got {len(drones):,} drones, expected at most {MAX_DRONES:,} in one check "
+                "(check the show in parts of fewer drones)"
+            )
         with console.status(f"checking {len(drones)} drone(s)"):
             report = check_show(drones, minimum, limits)
         summary = report.as_dict() | {"paths": [str(p) for p in paths]}
