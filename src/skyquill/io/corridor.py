@@ -258,6 +258,7 @@ class BoxCorridor:
         if waypoints.shape[0] < 2:
             raise _error("waypoints", f"{waypoints.shape[0]} point(s)", "at least 2 points")
         _check_inside(boxes[0], start, "start", "a point inside boxes[0]")
+        _check_chained(boxes)
         _check_inside(
             boxes[-1], goal, "goal", f"a point inside boxes[{len(boxes) - 1}] (the last box)"
         )
@@ -265,6 +266,29 @@ class BoxCorridor:
         object.__setattr__(self, "start", start)
         object.__setattr__(self, "goal", goal)
         object.__setattr__(self, "waypoints", waypoints)
+
+
+def _check_chained(boxes: tuple[OrientedBox, ...]) -> None:
+    """Raise :class:`InputError` unless every box overlaps the next (a path can pass).
+
+    Two boxes overlap when one point satisfies both half-space forms: a linear
+    feasibility problem (HiGHS through scipy), exact for rotated boxes.
+    """
+    from scipy.optimize import linprog
+
+    for k in range(len(boxes) - 1):
+        A0, b0 = boxes[k].halfspaces()
+        A1, b1 = boxes[k + 1].halfspaces()
+        found = linprog(
+            np.zeros(3), A_ub=np.vstack([A0, A1]), b_ub=np.concatenate([b0, b1]),
+            bounds=[(None, None)] * 3, method="highs",
+        )  # fmt: skip
+        if found.status == 2:  # infeasible: the boxes are apart
+            raise _error(
+                f"boxes[{k + 1}]",
+                f"a box apart from boxes[{k}]",
+                "each box to overlap the next (a chain from start to goal)",
+            )
 
 
 def _check_inside(box: OrientedBox, p: FloatArray, field: str, expected: str) -> None:
