@@ -233,7 +233,8 @@ def click_line(exc: Any) -> str:
     """One "what: got ..., expected ..." line for a Click usage error."""
     exceptions = click_errors
     ctx = getattr(exc, "ctx", None)
-    command = ctx.command_path if ctx is not None else "skyquill"
+    # The program is skyquill however it was started (python -c, a test runner).
+    command = " ".join(["skyquill", *ctx.command_path.split(" ")[1:]]) if ctx else "skyquill"
     see = f"see '{command} --help'"
     if isinstance(exc, OptionError):
         return str(exc.message)

@@ -28,7 +28,7 @@ from skyquill.errors import InputError
 from skyquill.io.atomic import atomic_path, write_json
 from skyquill.io.json_read import parse_json
 from skyquill.io.points import write_table_csv
-from skyquill.io.source import read_bytes
+from skyquill.io.source import read_bytes, special_kind
 from skyquill.io.trajectory_csv import read_trajectory_csv
 from skyquill.io.trajectory_json import (
     PlannedTrajectory,
@@ -165,7 +165,9 @@ def plan_files(path: Path) -> list[Path]:
     if path.is_file():
         return [path]
     if not path.is_dir():
-        raise InputError(f"plan: got {str(path)!r}, expected a plan directory or a trajectory file")
+        kind = special_kind(path)
+        got = repr(str(path)) if kind is None else f"{kind} {str(path)!r}"
+        raise InputError(f"plan: got {got}, expected a plan directory or a trajectory file")
     files = _listed(path) or _found(path)
     if not files:
         raise InputError(

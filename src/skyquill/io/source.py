@@ -151,6 +151,18 @@ def read_text(path: str | Path, what: str, *, max_bytes: int, name: str | None =
     return decode_text(read_bytes(path, what, max_bytes=max_bytes, name=shown), shown, what)
 
 
+def special_kind(path: str | Path) -> str | None:
+    """What ``path`` is when it exists but is neither a regular file nor a folder
+    (``"a named pipe"``, ``"a character device"``, ...); None otherwise."""
+    try:
+        mode = os.stat(path).st_mode
+    except (OSError, ValueError):
+        return None
+    if stat.S_ISREG(mode) or stat.S_ISDIR(mode):
+        return None
+    return next((kind for test, kind in _KINDS if test(mode)), "a special file")
+
+
 def is_regular_file(path: str | Path) -> bool:
     """Whether ``path`` names a regular file (following links), without opening it."""
     try:

@@ -24,6 +24,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from skyquill.errors import InputError
+from skyquill.io.source import special_kind
 from skyquill.strokes.json_io import read_json
 from skyquill.strokes.model import Strokes
 from skyquill.validation import FloatArray, as_float
@@ -142,7 +143,8 @@ def _lookup(place: Path, char: str) -> Any | None:
         return _lookup_dir(place, char)
     if place.is_file():
         return _lookup_file(place, char)
-    raise InputError(f"{place}: no such file or directory, expected hanzi data")
+    kind = special_kind(place) or "no such file or directory"
+    raise InputError(f"{place}: got {kind}, expected hanzi data (a JSON file or a folder)")
 
 
 def hanzi_strokes(char: str, source: str | Path | None = None) -> Strokes:
