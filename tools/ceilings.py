@@ -145,7 +145,42 @@ def render() -> str:
         "|---|---|---|",
     ]
     lines += [f"| {what} | {value} | `{where}` |" for what, value, where in rows()]
+    lines += ["", *_RULES]
     return "\n".join(lines) + "\n"
+
+
+#: How every input is read and every output written: the rules behind the refusals.
+_RULES = [
+    "## How input is read",
+    "",
+    "- **Regular files only.** Every reader opens its file without blocking and checks the "
+    "open descriptor: a named pipe, a device (`/dev/zero`), a socket or a folder is refused at "
+    "once (`skyquill.io.source`). Sizes are checked before a byte is read.",
+    "- **One byte-order-mark rule.** Text is UTF-8, with or without the mark spreadsheets and "
+    "Windows editors write (CSV, JSON, SVG, WKT, TOML alike); UTF-16, a NUL byte or bytes that "
+    "are not UTF-8 are refused, naming the offset.",
+    "- **One number grammar.** A number in a CSV cell, an SVG attribute, a WKT polygon, a TOML "
+    "float or an option is a plain ASCII decimal literal (`1.5`, `-2`, `3e-4`): `1_0`, "
+    "Arabic-Indic `٠.١`, full-width `０.５` and `0x10`, which Python's `float()` takes, are "
+    "refused (`skyquill.io.numbers`). JSON keeps its own grammar; `NaN`, `Infinity`, numbers "
+    "beyond the float range and a key repeated in one object are refused.",
+    "- **SVG errors are errors.** A `transform` that is not a list of the six SVG functions, "
+    "path data short of a coordinate, an odd number of polyline coordinates, a length that is "
+    "not a number and a negative size or radius are refused, naming the element (tag and `id`, "
+    "or its place) and the attribute, where svgelements would drop or repair them.",
+    "- **GeoJSON as RFC 7946 writes it.** A ring is closed, with four or more positions; a "
+    "position is `[x, y]` of JSON numbers.",
+    "",
+    "## How output is written",
+    "",
+    "- Files are staged inside `--out` and moved in by atomic renames under a lock of the "
+    "folder, with the mode the user's umask gives; an interrupted run leaves every file whole.",
+    "- `--out/.skyquill-files.json` is a record, never an authority: a file is replaced or "
+    "removed only if it is a plain name inside `--out` whose regular file still has the inode "
+    "and SHA-256 recorded when skyquill wrote it. Nothing outside `--out` is ever touched.",
+    "- A result that is not faithful exits non-zero: a fit or plan beyond its tolerance, an "
+    "export whose read-back misses `--tolerance`, a reproduction without a feasible solve.",
+]
 
 
 def main(argv: list[str] | None = None) -> int:
