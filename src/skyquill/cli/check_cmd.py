@@ -30,10 +30,11 @@ from skyquill.show import (
 )
 from skyquill.show.report import UNITS
 
-#: Most drones one ``check`` takes: their 2,000,000 pairs are bounded in memory (the
+#: Most drones one ``check`` takes: their half a million pairs are bounded in memory (the
 #: separation's intervals, :data:`~skyquill.show.separation.MAX_INTERVALS`) and in time
-#: (bench/ceilings.py measures a show of this many).
-MAX_DRONES = 2_000
+#: (bench/ceilings.py measures a .skyc of this many, neighbours close; 2,000 took over
+#: 20 minutes, most of it playing the .skyc back as the drones would).
+MAX_DRONES = 1_000
 
 
 def _limit(flag: str, value: float | None, *, nonneg: bool = True) -> float | None:

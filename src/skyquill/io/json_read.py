@@ -77,12 +77,7 @@ def parse_json(raw: bytes, name: str, what: str) -> Any:
     """
     text = decode_text(raw, name, what)
     try:
-        data = json.loads(
-            text,
-            object_pairs_hook=_unique_keys,
-            parse_constant=_no_constant,
-            parse_float=_finite_float,
-        )
+        data = json.loads(text, object_pairs_hook=_unique_keys, parse_constant=_no_constant)
     except _RefusedError as exc:
         raise InputError(f"{name}: got {exc.got}, expected {what} ({exc.rule})") from None
     except json.JSONDecodeError as exc:
@@ -117,14 +112,6 @@ def _no_constant(word: str) -> Any:
     raise _RefusedError(word, "finite JSON numbers: NaN and Infinity are not JSON")
 
 
-def _finite_float(text: str) -> float:
-    """A JSON number with a fraction or exponent, refused when it overflows to infinity."""
-    value = float(text)
-    if not math.isfinite(value):
-        raise _RefusedError(f"the number {_short(text)}", "numbers within the float range, 1.8e308")
-    return value
-
-
 def _short(text: str) -> str:
     return text if len(text) <= 40 else text[:37] + "..."
 
@@ -139,6 +126,11 @@ def check_depth(data: Any, name: str, what: str) -> None:
         elif isinstance(item, list):
             children = item
         else:
+            if isinstance(item, float) and not math.isfinite(item):
+                # Python reads 1e400 as infinity (NaN and Infinity are refused while parsing).
+                raise InputError(
+                    f"{name}: got a number beyond the float range (about 1.8e308), expected {what}"
+                )
             continue
         if depth >= MAX_DEPTH:
             raise InputError(f"{name}: got JSON nested more than {MAX_DEPTH} deep, expected {what}")
