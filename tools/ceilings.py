@@ -35,7 +35,17 @@ def rows() -> list[tuple[str, str, str]]:
     """``(what, ceiling, where it is enforced)`` for every ceiling, read from the code."""
     from skyquill.calligraphy import board, brush, mission
     from skyquill.calligraphy import show as calligraphy_show
-    from skyquill.cli import check_cmd, cover_cmd, export_cmd, fly_cmd, main, show_cmd
+    from skyquill.cli import (
+        check_cmd,
+        cover_cmd,
+        export_cmd,
+        fit_cmd,
+        fly_cmd,
+        main,
+        paint_cmd,
+        show_cmd,
+        write_cmd,
+    )
     from skyquill.coverage import plan as coverage_plan
     from skyquill.coverage import regions
     from skyquill.export.skybrush import csv_file as skybrush_csv
@@ -65,15 +75,18 @@ def rows() -> list[tuple[str, str, str]]:
         ("`fly` simulation", lambda: f"{_n(bounds.MAX_SIM_STEPS)} steps; rate "
          f"{_n(bounds.MIN_RATE_HZ)} to {_n(bounds.MAX_RATE_HZ)} Hz; wind and gusts "
          f"<= {_n(fly_cmd.MAX_WIND_MPS)} m/s", "sim.bounds, cli.fly_cmd.MAX_WIND_MPS"),
-        ("`fit`", lambda: f"{_n(fit.MAX_POINTS)} points, {_n(fit.MAX_SPANS)} knot spans",
-         "optimize.fit.MAX_POINTS, MAX_SPANS"),
+        ("`fit`", lambda: f"{_n(fit.MAX_POINTS)} points, {_n(fit.MAX_SPANS)} knot spans; "
+         f"`--weight` {_n(fit_cmd.WEIGHT_RANGE[0])} to {fit_cmd.WEIGHT_RANGE[1]:.0e}, "
+         f"`--tolerance` <= {_n(fit_cmd.TOLERANCE_RANGE_M[1])} m",
+         "optimize.fit.MAX_POINTS, MAX_SPANS, cli.fit_cmd"),
         ("`write` input", lambda: f"{_n(model.MAX_STROKES)} strokes, {_n(model.MAX_POINTS)} "
          f"points (after flattening curves); {_n(mission.MAX_INPUT_POINTS)} points per drone "
          "before densifying", "strokes.model, calligraphy.mission.MAX_INPUT_POINTS"),
         ("`write` plan", lambda: f"size {_n(size_lo)} to {_n(size_hi)} m, lift <= "
          f"{_n(board.MAX_LIFT_M)} m, brush <= {_n(brush.MAX_BRUSH_LENGTH_M)} m, a route of "
          f"{_n(mission.MAX_ROUTE_SAMPLES)} samples, {_n(mission.MAX_SPANS)} knot spans per "
-         f"solve, altitude <= {_n(mission.MAX_ALTITUDE_M)} m",
+         f"solve, altitude (and `--board-height`) <= {_n(mission.MAX_ALTITUDE_M)} m, "
+         f"`--separation` <= {_n(write_cmd.SEPARATION_RANGE_M[1])} m",
          "calligraphy.mission, board.MAX_LIFT_M, brush.MAX_BRUSH_LENGTH_M"),
         ("`write` drones", lambda: f"{_n(calligraphy_show.MAX_DRONES)} drones (`--grid` at "
          f"most as many boards), {_n(calligraphy_show.MAX_SHOW_STROKES)} strokes in all",
@@ -82,9 +95,12 @@ def rows() -> list[tuple[str, str, str]]:
          f"{_n(regions.MAX_VERTICES)} vertices, a path <= "
          f"{_n(regions.MAX_PATH_LENGTH_M / 1e3)} km (estimated as area / swath + perimeter "
          f"before any path is built); `--altitude` {_n(alt_lo)} (excluded) to {_n(alt_hi)} m; "
-         f"`--origin-alt` {_n(origin_lo)} to {_n(origin_hi)} m",
+         f"`--origin-alt` {_n(origin_lo)} to {_n(origin_hi)} m; `--delta` <= "
+         f"{_n(cover_cmd.DELTA_RANGE_M[1])} m; `--time-limit` <= "
+         f"{_n(cover_cmd.TIME_LIMIT_RANGE_S[1])} s",
          "coverage.plan.MAX_REGION_SIZE_M, coverage.regions, cli.cover_cmd"),
-        ("`paint`", lambda: f"{_n(dots.MAX_DOTS)} dots; pictures <= "
+        ("`paint`", lambda: f"{_n(dots.MAX_DOTS)} dots (`--dots` too); `--width` <= "
+         f"{_n(paint_cmd.MAX_WIDTH_M)} m; pictures <= "
          f"{_n(dots.MAX_IMAGE_PIXELS / 1e6)} Mpx (from the header, before decoding) and "
          f"{_mib(dots.MAX_IMAGE_BYTES)}", "painting.dots"),
         ("`show` scripts", lambda: f"{_n(script.MAX_DRONES)} drones, {_n(script.MAX_SCENES)} "

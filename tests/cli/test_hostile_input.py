@@ -571,6 +571,20 @@ ISSUE25 = [
     Case("fly --wind 1_0,0,0", _fly("--wind", "1_0,0,0"), "--wind", setup=WITH_TRAJ),
     Case("export --tolerance 0", _export("--tolerance", "0"), "--tolerance", setup=WITH_TRAJ),
     Case("show --workers 100000", [*SHOW, "--workers", "100000"], "--workers", setup=_show()),
+    # Every option at the entry against a stated range (a scan of every numeric option with
+    # 1e300, -1e300 and nan found these running on, or refused under another name).
+    Case("fit --weight 1e300 (did not end)", _fit("--weight", "1e300"), "--weight: got 1e+300"),
+    Case("fit --tolerance 1e300", _fit("--tolerance", "1e300"), "--tolerance: got 1e+300"),
+    Case("write --board-height 1e300 (was board: ...)", _write_cmd("--board-height", "1e300"),
+         "--board-height: got 1e+300"),
+    Case("write --separation 1e300", _write_cmd("--separation", "1e300"), "--separation"),
+    Case("cover --delta 1e300 (did not end)", _cover("--delta", "1e300"), "--delta: got 1e+300"),
+    Case("cover --time-limit 1e300", _cover("--time-limit", "1e300"), "--time-limit"),
+    Case("paint --dots 999999999 with a CSV (was ignored)", _paint("--dots", "999999999"),
+         "--dots: got 999999999"),
+    Case("paint --width nan with a CSV (was ignored)", _paint("--width", "nan"),
+         "--width: got nan"),
+    Case("render --azimuth 1e300", [*RENDER, "--azimuth", "1e300"], "--azimuth", setup=WITH_TRAJ),
 ]  # fmt: skip
 CASES.extend(ISSUE25)
 

@@ -16,6 +16,7 @@ from skyquill.cli.main import (
     app,
     check_out,
     console,
+    in_range,
     positive_rate,
     progress_bar,
     say_done,
@@ -41,6 +42,10 @@ ALTITUDE_RANGE_M = (0.0, 120.0)
 #: ``--origin-alt``, m above mean sea level: the shore of the Dead Sea (-430 m) to the
 #: summit of Everest (8849 m), with a margin.
 ORIGIN_ALT_RANGE_M = (-500.0, 9000.0)
+#: ``--delta``, m: a corner control point farther than 100 m is no corner of a field.
+DELTA_RANGE_M = (0.0, 100.0)
+#: ``--time-limit``, s: the planning budget, an hour at most.
+TIME_LIMIT_RANGE_S = (0.0, 3600.0)
 
 
 @app.command()
@@ -145,6 +150,8 @@ def cover(
         check_out(out)
         _check_heights(altitude, origin_alt)
         rate = positive_rate(rate)
+        in_range("--delta", delta, *DELTA_RANGE_M, "m", open_low=True)
+        in_range("--time-limit", time_limit, *TIME_LIMIT_RANGE_S, "s", open_low=True)
         geo = load_geo_region(region, crs, origin_alt)
         shape = geo.region
         options = CoverageOptions(

@@ -181,6 +181,20 @@ def positive_rate(
     return rate
 
 
+def in_range(
+    option: str, value: float, low: float, high: float, unit: str, *, open_low: bool = False
+) -> float:
+    """``value`` of ``option`` within ``[low, high]`` (``(low, high]`` with ``open_low``).
+
+    NaN fails too. Every option a command takes is checked so at the entry, against
+    the range docs/ceilings.md states, before any work starts.
+    """
+    if not (low < value <= high if open_low else low <= value <= high):
+        bracket = "more than" if open_low else "from"
+        raise InputError(f"{option}: got {value:g}, expected {bracket} {low:g} to {high:g} {unit}")
+    return value
+
+
 def parse_vector3(option: str, text: str, unit: str) -> FloatArray:
     """Parse ``"x,y,z"`` into a (3,) float array; InputError naming ``option`` otherwise."""
     try:

@@ -20,6 +20,7 @@ from skyquill.cli.main import (
     app,
     check_out,
     console,
+    in_range,
     parse_vector3,
     progress_bar,
     say_done,
@@ -36,6 +37,8 @@ if TYPE_CHECKING:  # the painting package is imported lazily
 
 #: Largest |gamma| accepted, deg: beyond it the drone does not face the wall.
 MAX_GAMMA_DEG = 60.0
+#: Largest ``--width`` of a stippled drawing, m.
+MAX_WIDTH_M = 20.0
 
 
 @app.command()
@@ -80,17 +83,19 @@ def paint(
     from skyquill.io.outputs import staged_output
     from skyquill.io.plan_dir import write_plan
     from skyquill.io.trajectory_json import PlannedTrajectory
-    from skyquill.painting.dots import drawing_span
+    from skyquill.painting.dots import MAX_DOTS, drawing_span
     from skyquill.painting.flight import painting_flight
     from skyquill.painting.mission import ESTIMATORS, MissionConfig, run_mission
     from skyquill.painting.order import ORDERS
     from skyquill.painting.wall import Placement, Wall, parse_angles
-    from skyquill.validation import as_seed
+    from skyquill.validation import as_int, as_seed
     from skyquill.viz.painting_plot import plot_mission
 
     with user_errors():
         check_out(out)
         seed = as_seed("--seed", seed)
+        as_int("--dots", dots, low=1, high=MAX_DOTS)  # checked with a CSV too: never ignored
+        in_range("--width", width, 0.0, MAX_WIDTH_M, "m", open_low=True)
         if estimator not in ESTIMATORS:
             raise InputError(
                 f"--estimator: got {estimator!r}, expected one of {', '.join(ESTIMATORS)}"
@@ -194,8 +199,6 @@ def _dots(
         )
     if dots_csv is not None:
         return read_dots_csv(dots_csv)
-    if not (math.isfinite(width) and 0.0 < width <= 20.0):
-        raise InputError(f"--width: got {width:g}, expected a width in (0, 20] m")
     assert image is not None  # narrowed by the check above
     darkness = load_darkness(image)
     task = bar.add_task("stippling", total=None)

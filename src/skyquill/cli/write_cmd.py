@@ -27,6 +27,7 @@ from skyquill.cli.main import (
     app,
     check_out,
     console,
+    in_range,
     parse_color,
     positive_rate,
     say_done,
@@ -43,6 +44,9 @@ from skyquill.io.plan_dir import trajectory_names, write_plan
 from skyquill.io.trajectory_json import PlannedTrajectory
 from skyquill.limits import VehicleLimits
 from skyquill.show.lights import COLOR_BY, window_palette
+
+#: ``--separation`` between drones, m: more than 100 m apart is no show of one drawing.
+SEPARATION_RANGE_M = (0.0, 100.0)
 
 if TYPE_CHECKING:
     from skyquill.calligraphy.board import BoardKind
@@ -228,12 +232,15 @@ def write(
     On a sky board (light painting) also long_exposure.png, the photograph of the lights
     from in front, and preview.gif (``skyquill render`` shows them from any view).
     """
+    from skyquill.calligraphy.mission import MAX_ALTITUDE_M
     from skyquill.calligraphy.show import MAX_DRONES, plan_show
 
     with user_errors():
         check_out(out)
         rate = positive_rate(rate)
         scheduler = scheduler_address(scheduler)
+        in_range("--board-height", board_height, 0.0, MAX_ALTITUDE_M, "m", open_low=True)
+        in_range("--separation", separation, *SEPARATION_RANGE_M, "m", open_low=True)
         palette = _palette(light_color, color_by)
         kind = _board_kind(board, fly)
         pose = _sky_pose(kind, board_yaw, board_tilt, plane_weight, grid, lift)
