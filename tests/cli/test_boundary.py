@@ -170,3 +170,29 @@ def test_outputs_get_the_mode_the_umask_gives(tmp_path: Path) -> None:
 
     mode = (tmp_path / "o" / "summary.json").stat().st_mode & 0o777
     assert mode == 0o666 & ~atomic._UMASK
+
+
+def test_a_skyc_of_too_many_drones_is_refused_before_it_is_played_back(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Counted from show.json: playing 2,000 drones back took most of 20 minutes."""
+    import numpy as np
+
+    from skyquill.export.skybrush import playback
+    from skyquill.export.skybrush.keyframes import skybrush_keyframes
+    from skyquill.export.skybrush.skyc_file import SkycDrone, write_skyc
+    from skyquill.trajectory import SplineTrajectory
+
+    ctrl = np.column_stack([np.linspace(0.0, 2.0, 8), np.zeros(8), np.ones(8)])
+    paths = [SplineTrajectory(ctrl + np.array([5.0 * k, 0, 0]), 5, 4.0) for k in range(3)]
+    drones = [SkycDrone(f"d{k}", skybrush_keyframes(p)) for k, p in enumerate(paths)]
+    write_skyc(drones, tmp_path / "s.skyc")
+
+    def never(*_: object) -> None:
+        raise AssertionError("played back")
+
+    monkeypatch.setattr(playback, "played_trajectory", never)
+    monkeypatch.setattr(check_cmd, "MAX_DRONES", 2)
+    result = runner.invoke(app, ["check", str(tmp_path / "s.skyc")])
+    assert result.exit_code == 2
+    assert "PATH: got s.skyc of 3 drones, expected at most 2" in _one_line(result.output)

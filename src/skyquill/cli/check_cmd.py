@@ -103,12 +103,7 @@ def check(
             max_altitude=_limit("--max-altitude", max_altitude, nonneg=False),
             geofence=read_geofence(geofence) if geofence is not None else None,
         )
-        drones = load_show(paths)
-        if len(drones) > MAX_DRONES:
-            raise InputError(
-                f"PATH: got {len(drones):,} drones, expected at most {MAX_DRONES:,} in one check "
-                "(check the show in parts of fewer drones)"
-            )
+        drones = load_show(paths, max_drones=MAX_DRONES)
         with console.status(f"checking {len(drones)} drone(s)"):
             report = check_show(drones, minimum, limits)
         summary = report.as_dict() | {"paths": [str(p) for p in paths]}
