@@ -153,7 +153,7 @@ def render() -> str:
         "Work is estimated before it starts and refused above these ceilings, with one line "
         "naming the option or file and what would fit (exit status 2). Every input within "
         f"them runs in at most **{MEMORY_BOUND_GIB:g} GiB** of memory and "
-        f"**{TIME_BOUND_S / 60:g} minutes** on two cores: `bench/ceilings.py` runs the worst "
+        f"**{TIME_BOUND_S / 60:g} minutes** of CPU: `bench/ceilings.py` runs the worst "
         "input at each ceiling in its own process and records its peak memory and wall time "
         "in `bench/results/ceilings.json`.",
         "",
