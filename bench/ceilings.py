@@ -5,9 +5,10 @@ docs/ceilings.md promises that every input within the ceilings runs in at most 2
 ceiling -- the cases issue 25 found exhausting memory or time among them -- and runs
 ``skyquill`` on it in a child process (BLAS on one thread, an address-space limit of 4 GiB
 so that a regression fails instead of swapping the machine), recording the exit status,
-the child's peak resident memory (``wait4``'s ``ru_maxrss``), its CPU time and its wall time. A case passes when it
-ends (done, or refused with one line) within both bounds, time counted as CPU time: the
-machine is shared, and wall time says more about the neighbours than about skyquill.
+the child's peak resident memory (``wait4``'s ``ru_maxrss``), its CPU time and its wall
+time. A case passes when it ends (done, or refused with one line) within both bounds,
+time counted as CPU time: the machine is shared, and wall time says more about the
+neighbours than about skyquill.
 
 Written to ``bench/results/ceilings.json``. Run: ``.venv/bin/python bench/ceilings.py``
 (``--case fit_spans`` for one; ``--list``). Wall times are what one run measured on a
