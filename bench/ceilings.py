@@ -128,7 +128,11 @@ def _cover_path(tmp: Path) -> list[str]:
         f"POLYGON ((0 0, {side:.1f} 0, {side:.1f} {side:.1f}, 0 {side:.1f}, 0 0))",
         encoding="utf-8",
     )
-    return ["cover", str(tmp / "field.wkt"), "--width", str(width), "--out", str(tmp / "o")]
+    # --min-coverage 0: fly the given spacing (a tuned plan would search several).
+    return [
+        "cover", str(tmp / "field.wkt"), "--width", str(width), "--min-coverage", "0",
+        "--out", str(tmp / "o"),
+    ]  # fmt: skip
 
 
 def _paint_dots(tmp: Path) -> list[str]:
@@ -136,8 +140,8 @@ def _paint_dots(tmp: Path) -> list[str]:
     from skyquill.painting.dots import MAX_DOTS
 
     side = math.ceil(math.sqrt(MAX_DOTS))
-    k = np.arange(MAX_DOTS)
-    dots = np.column_stack([0.05 * (k % side), 1.0 + 0.05 * (k // side)])
+    k = np.arange(MAX_DOTS)  # a grid 7.9 m wide (the wall spans -4..4 m) and 2 m high
+    dots = np.column_stack([-3.95 + 7.9 / side * (k % side), 0.5 + 2.0 / side * (k // side)])
     np.savetxt(tmp / "dots.csv", dots, delimiter=",", header="x,z", comments="", fmt="%.4f")
     return ["paint", str(tmp / "dots.csv"), "--out", str(tmp / "o")]
 
