@@ -137,8 +137,8 @@ OPTION_OF = {
     "plane_weight": "--plane-weight",
     "drones": "--drones",
     "grid": "--grid",
-    "length_m": "--brush-length",
-    "press_depth_m": "--press-depth",
+    "brush length_m": "--brush-length",
+    "brush press_depth_m": "--press-depth",
     "scheduler": "--scheduler",
     "width": "--width",
     "width_m": "--width",
@@ -159,7 +159,7 @@ OPTION_OF = {
     "noise_m": "--noise",
     "min_distance_m": "--min-distance",
 }
-_LEADING_NAME = re.compile(r"([A-Za-z_][A-Za-z0-9_]*)(?=: )")
+_LEADING_NAME = re.compile(r"((?:brush )?[A-Za-z_][A-Za-z0-9_]*)(?=: )")
 _INNER_NAMES = re.compile(
     r"(?<![\w.-])("
     + "|".join(sorted((n for n in OPTION_OF if "_" in n), key=len, reverse=True))
