@@ -2,7 +2,7 @@
 
 Work is estimated before it starts and refused above these; each number on the page is
 read from the module constant that enforces it, so the page cannot drift from the code
-(``tests/test_ceilings_page.py`` fails when it does). Run after changing a ceiling:
+(``tests/docs/test_ceilings_page.py`` fails when it does). Run after changing a ceiling:
 
     .venv/bin/python tools/ceilings.py            # rewrite docs/ceilings.md
     .venv/bin/python tools/ceilings.py --check    # exit 1 if the page is stale

@@ -6,7 +6,7 @@ import importlib.util
 import re
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def _tool():  # type: ignore[no-untyped-def]
@@ -39,3 +39,15 @@ def test_the_readme_links_to_the_page_instead_of_a_copy() -> None:
     readme = (ROOT / "README.md").read_text(encoding="utf-8")
     assert "docs/ceilings.md" in readme
     assert not re.search(r"^\| `write` \|", readme, re.MULTILINE)
+
+
+def test_the_explanation_links_to_the_page_instead_of_a_copy() -> None:
+    """The site's page on errors, ceilings and outputs held a stale copy of the table."""
+    page = (ROOT / "docs" / "explanations" / "errors-and-outputs.md").read_text(encoding="utf-8")
+    assert "(../ceilings.md)" in page
+    assert "| what | ceiling |" not in page
+
+
+def test_the_page_is_in_the_site_navigation() -> None:
+    nav = (ROOT / "mkdocs.yml").read_text(encoding="utf-8")
+    assert re.search(r"^\s*- Ceilings: ceilings\.md$", nav, re.MULTILINE)
