@@ -440,6 +440,12 @@ def _fifo(name: str) -> Callable[[Path], None]:
     return make
 
 
+def _refifo(path: Path) -> None:
+    """``path`` replaced by a named pipe no program writes to."""
+    path.unlink()
+    os.mkfifo(path)
+
+
 def _copy(source: Path, name: str) -> Callable[[Path], None]:
     return _write(name, source.read_bytes())
 
@@ -478,7 +484,24 @@ ISSUE25 = [
          setup=_both(WITH_TRAJ, _fifo("g.wkt"))),
     Case("write --svg /dev/zero", ["write", "--svg", "/dev/zero", "--out", "{out}"],
          "got a character device"),
+    Case("paint a dot CSV that is a named pipe", ["paint", "{tmp}/d.csv", "--out", "{out}"],
+         "got a named pipe", setup=_fifo("d.csv")),
+    Case("cover a WKT named pipe", ["cover", "{tmp}/r.wkt", "--out", "{out}"],
+         "got a named pipe", setup=_fifo("r.wkt")),
+    Case("render a named pipe", ["render", "{tmp}/t.csv", "--out", "{out}"], "got a named pipe",
+         setup=_fifo("t.csv")),
+    Case("reproduce corridor --corridor a named pipe",
+         ["reproduce", "corridor", "--corridor", "{tmp}/c.json", "--out", "{out}"],
+         "got a named pipe", setup=_fifo("c.json")),
+    Case("fly a plan folder whose trajectory.json is a named pipe",
+         ["fly", "{tmp}/plan", "--out", "{out}"], "got a named pipe",
+         setup=_both(_plan, lambda tmp: _refifo(tmp / "plan" / "trajectory.json"))),
+    Case("write --strokes /dev/zero", ["write", "--strokes", "/dev/zero", "--out", "{out}"],
+         "got a character device"),
+    Case("fit a folder", ["fit", "{tmp}", "--out", "{out}"], "got a folder"),
     Case("fit above the knot-span ceiling", _fit("--knot-interval", "1e-4"), "--knot-interval"),
+    Case("fit --timing segments above the knot-span ceiling (took 260 s and 1 GB)",
+         _fit("--timing", "segments", "--knot-interval", "1e-4"), "--knot-interval"),
     # Tracebacks.
     Case("write --light-color 1,2,²", _write_cmd("--light-color", "1,2,²"), "--light-color"),
     Case("export --light 1,2,²", _export("--light", "1,2,²"), "--light", setup=WITH_TRAJ),
@@ -487,6 +510,9 @@ ISSUE25 = [
          "--scheduler: got 'nonsense://x'"),
     Case("show --scheduler nonsense://x", [*SHOW, "--scheduler", "nonsense://x"], "--scheduler",
          setup=_show()),
+    Case("write --scheduler at a port no scheduler answers (was a Client.__del__ traceback)",
+         ["write", "H I", "--drones", "2", "--scheduler", "tcp://127.0.0.1:9", "--out", "{out}"],
+         "expected the address of a running dask scheduler"),
     Case("cover --origin-alt 1e308", _cover("--origin-alt", "1e308"), "--origin-alt"),
     # Wrong results that exited 0.
     Case("export --rate 1e-3", _export("--rate", "1e-3"), "--rate: got 0.001", setup=WITH_TRAJ),

@@ -63,7 +63,7 @@ def _short(value: object, limit: int = 80) -> str:
 def _error(field: str, got: str, expected: str, source: str = "") -> InputError:
     """Build an :class:`InputError` whose message names field, received value and expectation."""
     where = f" in {source}" if source else ""
-    return InputError(f"{field}{where}: expected {expected}, got {got}")
+    return InputError(f"{field}{where}: got {got}, expected {expected}")
 
 
 def _is_number(x: object) -> bool:
@@ -323,9 +323,8 @@ def load_box_corridor(path: str | Path) -> BoxCorridor:
     """
     src = str(path)
     file = Path(path)
-    if not file.is_file():
-        raise _error("path", repr(src), "an existing corridor JSON file")
-    data = read_json_file(file, "a corridor JSON file")  # UTF-8, bounded size and depth
+    # A regular file (a named pipe would block), UTF-8, bounded size and depth, strict JSON.
+    data = read_json_file(file, "a corridor JSON file")
     if not isinstance(data, Mapping):
         raise _error("(top level)", type(data).__name__, "a JSON object {...}", src)
     _check_keys(data, "(top level)", _TOP_KEYS, _OPTIONAL_TOP_KEYS, src)
