@@ -1,4 +1,4 @@
-"""Which legs of a painting flight end at the wall, in memory linear in legs and marks (issue 25)."""
+"""Which legs of a painting flight end at the wall, in memory linear in legs and marks."""
 
 from __future__ import annotations
 

@@ -27,7 +27,7 @@ import numpy as np
 from skyquill.errors import InputError
 from skyquill.io.atomic import atomic_path, write_json
 from skyquill.io.json_read import parse_json
-from skyquill.io.points import write_table_csv
+from skyquill.io.points import check_rows_written, write_table_csv
 from skyquill.io.source import read_bytes, special_kind
 from skyquill.io.trajectory_csv import read_trajectory_csv
 from skyquill.io.trajectory_json import (
@@ -114,6 +114,7 @@ def _write_drone(
     guaranteed: bool,
 ) -> dict[str, Any]:
     csv_name, json_name = names
+    check_rows_written(planned.trajectory.duration, rate)  # its read-back would refuse more
     write_trajectory_json(out / json_name, planned)
     s = sample(planned.trajectory, rate)
     table = np.column_stack([s.t, s.p, s.v, s.a, s.j])
