@@ -78,4 +78,4 @@ def _touched(result: MissionResult) -> list[bool]:
     # The nearest mark by a k-d tree: memory linear in legs and marks (the table of every
     # leg end against every mark took 13.5 GiB at the 10,000-dot ceiling).
     gap, _ = cKDTree(marks).query(ends, k=1)
-    return [bool(g < 1e-9) for g in gap]
+    return [bool(g < 1e-9) for g in np.atleast_1d(gap)]
