@@ -136,14 +136,18 @@ def _cover_path(tmp: Path) -> list[str]:
 
 
 def _paint_dots(tmp: Path) -> list[str]:
-    """``paint`` of the most dots accepted."""
+    """``paint`` of the most dots accepted, at a rate whose ``trajectory.csv`` fits (10 Hz).
+
+    10,000 dots are a 67,000 s flight: at the default 100 Hz its trajectory.csv would
+    hold more rows than it is read back with, and is refused before sampling.
+    """
     from skyquill.painting.dots import MAX_DOTS
 
     side = math.ceil(math.sqrt(MAX_DOTS))
     k = np.arange(MAX_DOTS)  # a grid 7.9 m wide (the wall spans -4..4 m) and 2 m high
     dots = np.column_stack([-3.95 + 7.9 / side * (k % side), 0.5 + 2.0 / side * (k // side)])
     np.savetxt(tmp / "dots.csv", dots, delimiter=",", header="x,z", comments="", fmt="%.4f")
-    return ["paint", str(tmp / "dots.csv"), "--out", str(tmp / "o")]
+    return ["paint", str(tmp / "dots.csv"), "--rate", "10", "--out", str(tmp / "o")]
 
 
 def _zigzag(n: int, step: np.ndarray) -> np.ndarray:

@@ -257,6 +257,7 @@ BOUND_CASES = [
     Case("fly a moving end", _fly(), "expected rest", setup=_write("traj.csv", MOVING_END)),
     Case("fly --seed -1", _fly("--seed", "-1"), "seed", setup=WITH_TRAJ),
     Case("paint --seed -1", _paint("--seed", "-1"), "seed"),
+    Case("paint --rate 0", _paint("--rate", "0"), "--rate: got 0"),
 ]  # fmt: skip
 CASES.extend(BOUND_CASES)
 

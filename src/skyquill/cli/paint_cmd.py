@@ -22,6 +22,7 @@ from skyquill.cli.main import (
     console,
     in_range,
     parse_vector3,
+    positive_rate,
     progress_bar,
     say_done,
     user_errors,
@@ -75,6 +76,7 @@ def paint(
         float, typer.Option(help="Probability of a missed contact per approach.")
     ] = 0.0,
     seed: Annotated[int, typer.Option(help="Seed of the random generator.")] = 0,
+    rate: Annotated[float, typer.Option(help="Sample rate of trajectory.csv, Hz.")] = 100.0,
     force: Force = False,
 ) -> None:
     """Paint DOTS.csv (or a stippled --image) on a wall; write summary.json, painted.csv, plot."""
@@ -94,6 +96,7 @@ def paint(
     with user_errors():
         check_out(out)
         seed = as_seed("--seed", seed)
+        positive_rate(rate)  # a long painting needs a lower one: trajectory.csv has a ceiling
         as_int("--dots", dots, low=1, high=MAX_DOTS)  # checked with a CSV too: never ignored
         in_range("--width", width, 0.0, MAX_WIDTH_M, "m", open_low=True)
         if estimator not in ESTIMATORS:
@@ -115,12 +118,12 @@ def paint(
                 "-20 <= y < 0 m and every component within 20 m"
             )
         angles = parse_angles(wall_angles)
-        for option, rate in (
+        for option, chance in (
             ("--false-contacts", false_contacts),
             ("--missed-contacts", missed_contacts),
         ):
-            if not 0.0 <= rate < 1.0:
-                raise InputError(f"{option}: got {rate:g}, expected a probability in [0, 1)")
+            if not 0.0 <= chance < 1.0:
+                raise InputError(f"{option}: got {chance:g}, expected a probability in [0, 1)")
         with _progress() as bar:
             points = _dots(dots_csv, image, dots, width, seed, bar)
             lo, hi = drawing_span(points)
@@ -150,7 +153,7 @@ def paint(
             write_plan(
                 stage,
                 [PlannedTrajectory(flown.trajectory, flown.pen_windows_s, flown.limits)],
-                rate=100.0,
+                rate=rate,
                 guaranteed=True,
                 summary=result.summary()
                 | {
