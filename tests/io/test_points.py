@@ -103,3 +103,10 @@ def test_a_trajectory_csv_is_never_longer_than_its_read_back_takes(tmp_path: Pat
     ):
         write_trajectory_csv(tmp_path / "t.csv", long, 100.0)
     assert not (tmp_path / "t.csv").exists()
+
+
+def test_the_refusal_names_where_the_rate_came_from() -> None:
+    from skyquill.io.points import check_rows_written
+
+    with pytest.raises(InputError, match=r"^\[show\]\.rate: got 100 Hz over a 20000 s flight"):
+        check_rows_written(20_000.0, 100.0, "[show].rate")

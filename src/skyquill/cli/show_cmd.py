@@ -23,6 +23,7 @@ from skyquill.errors import InfeasibleError, InputError
 from skyquill.io.atomic import write_json
 from skyquill.io.outputs import staged_output
 from skyquill.io.plan_dir import trajectory_names, write_plan
+from skyquill.io.points import check_rows_written
 from skyquill.io.trajectory_json import PlannedTrajectory
 from skyquill.show import ShowDrone, ShowLimits, ShowReport, check_show, load_show
 from skyquill.show.build import ShowPlan, build_show
@@ -166,6 +167,8 @@ def _write(
         "pictures": pictures,
     }
     clock = time.perf_counter()
+    for drone in plan.drones:  # the script's rate, named as written there (show has no --rate)
+        check_rows_written(drone.trajectory.duration, script.rate_hz, "[show].rate")
     full = write_plan(stage, plan.drones, rate=script.rate_hz, guaranteed=True, summary=summary)
     full["planning_time_s"]["files"] = time.perf_counter() - clock
     write_json(stage / "summary.json", full)

@@ -63,7 +63,7 @@ def trajectory_table(traj: Trajectory, rate: float) -> FloatArray:
     return np.column_stack([s.t, as3(s.p), as3(s.v), as3(s.a), as3(s.j)])
 
 
-def check_rows_written(duration: float, rate: float) -> None:
+def check_rows_written(duration: float, rate: float, argument: str = "rate") -> None:
     """Refuse a ``trajectory.csv`` of more rows than its readers take, before sampling.
 
     Parameters
@@ -72,13 +72,15 @@ def check_rows_written(duration: float, rate: float) -> None:
         The flight's duration, s.
     rate
         Sample rate, Hz.
+    argument
+        What the refusal names: where the rate came from.
     """
     rows = math.floor(duration * rate + 1e-9) + 2  # the samples, and the end when off the grid
     if rows > MAX_ROWS:
         raise InputError(
-            f"rate: got {rate:g} Hz over a {duration:.6g} s flight ({rows:,} rows), expected at "
-            f"most {MAX_ROWS:,} rows in trajectory.csv, the most it is read back with (a lower "
-            "rate)"
+            f"{argument}: got {rate:g} Hz over a {duration:.6g} s flight ({rows:,} rows), "
+            f"expected at most {MAX_ROWS:,} rows in trajectory.csv, the most it is read back "
+            "with (a lower rate)"
         )
 
 
