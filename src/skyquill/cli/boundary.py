@@ -141,6 +141,7 @@ OPTION_OF = {
     "brush press_depth_m": "--press-depth",
     "scheduler": "--scheduler",
     "width": "--width",
+    "pattern": "--pattern",
     "width_m": "--width",
     "epsilon": "--epsilon",
     "delta": "--delta",
