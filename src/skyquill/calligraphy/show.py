@@ -380,9 +380,9 @@ def _plan_with_client(
         client = distributed.Client(address, timeout=SCHEDULER_TIMEOUT_S, set_as_default=False)
     except (OSError, TimeoutError, ValueError) as exc:
         raise InputError(
-            f"scheduler: cannot reach the dask scheduler at {address!r} "
-            f"within {SCHEDULER_TIMEOUT_S:g} s ({exc})"
-        ) from exc
+            f"scheduler: got {address!r}, which did not answer within {SCHEDULER_TIMEOUT_S:g} s "
+            f"({exc}), expected the address of a running dask scheduler"
+        ) from None
     with client:
         futures: list[Any] = client.map(_plan, jobs, pure=False)
         arrivals = distributed.as_completed(futures, loop=client.loop)

@@ -22,6 +22,7 @@ from skyquill.cli.main import (
     app,
     check_out,
     console,
+    in_range,
     positive_rate,
     say_done,
     upload_target,
@@ -36,6 +37,12 @@ from skyquill.limits import VehicleLimits
 from skyquill.optimize.budget import lifted
 from skyquill.optimize.fit import FitOptions, PointFit, fit_points
 from skyquill.validation import FloatArray
+
+#: ``--weight`` of the point deviation: beyond 1e9 the solver's conditioning, not the fit,
+#: decides (1e300 did not end).
+WEIGHT_RANGE = (0.0, 1e9)
+#: ``--tolerance``, m: more than a kilometre from the points is no fit of them.
+TOLERANCE_RANGE_M = (0.0, 1000.0)
 
 
 def fit_summary(fit: PointFit, options: FitOptions, rate: float) -> dict[str, Any]:
@@ -157,6 +164,9 @@ def fit(
     """
     with user_errors():
         check_out(out)
+        in_range("--weight", weight, *WEIGHT_RANGE, "(no unit)")
+        if tolerance is not None:
+            in_range("--tolerance", tolerance, *TOLERANCE_RANGE_M, "m", open_low=True)
         options = FitOptions(
             limits=VehicleLimits(vmax, amax, jmax, vmax_axis, amax_axis, jmax_axis),
             norm_sides=norm_sides,

@@ -71,6 +71,7 @@ def fly(
 
     from skyquill.io.plan_dir import plan_files, read_plan
     from skyquill.sim import Disturbances, check_rest_ends
+    from skyquill.sim.bounds import MAX_RATE_HZ, MIN_RATE_HZ
     from skyquill.validation import as_seed
 
     with user_errors():
@@ -86,7 +87,7 @@ def fly(
         for option, value, most in (("--gust", gust, MAX_WIND_MPS), ("--noise", noise, 1.0)):
             if not 0.0 <= value <= most:
                 raise InputError(f"{option}: got {value:g}, expected a number from 0 to {most:g}")
-        rate = positive_rate(rate)
+        rate = positive_rate(rate, low=MIN_RATE_HZ, high=MAX_RATE_HZ)
         seed = as_seed("--seed", seed)
         plans = read_plan(plan)
         if not allow_motion:

@@ -20,7 +20,10 @@ from skyquill.cli.main import (
     app,
     check_out,
     console,
+    in_range,
     parse_vector3,
+    positive_rate,
+    progress_bar,
     say_done,
     user_errors,
 )
@@ -37,6 +40,8 @@ if TYPE_CHECKING:  # the painting package is imported lazily
 MAX_GAMMA_DEG = 60.0
 #: Widest probing pass spacing, m (wider is one probe at each end of any drawing).
 MAX_PROBE_SPACING_M = 10.0
+#: Largest ``--width`` of a stippled drawing, m.
+MAX_WIDTH_M = 20.0
 
 
 @app.command()
@@ -100,6 +105,7 @@ def paint(
         float, typer.Option(help="Probability of a missed contact per approach.")
     ] = 0.0,
     seed: Annotated[int, typer.Option(help="Seed of the random generator.")] = 0,
+    rate: Annotated[float, typer.Option(help="Sample rate of trajectory.csv, Hz.")] = 100.0,
     force: Force = False,
 ) -> None:
     """Paint DOTS.csv (or a stippled --image) on a wall; write summary.json, painted.csv, plot."""
@@ -108,18 +114,21 @@ def paint(
     from skyquill.io.outputs import staged_output
     from skyquill.io.plan_dir import write_plan
     from skyquill.io.trajectory_json import PlannedTrajectory
-    from skyquill.painting.dots import drawing_span
+    from skyquill.painting.dots import MAX_DOTS, drawing_span
     from skyquill.painting.flight import painting_flight
     from skyquill.painting.mission import ESTIMATORS, MissionConfig, check_on_wall, run_mission
     from skyquill.painting.order import ORDERS
     from skyquill.painting.wall import Placement, Wall, parse_angles
     from skyquill.painting.wall_file import read_wall
-    from skyquill.validation import as_seed
+    from skyquill.validation import as_int, as_seed
     from skyquill.viz.painting_plot import plot_mission
 
     with user_errors():
         check_out(out)
         seed = as_seed("--seed", seed)
+        positive_rate(rate)  # a long painting needs a lower one: trajectory.csv has a ceiling
+        as_int("--dots", dots, low=1, high=MAX_DOTS)  # checked with a CSV too: never ignored
+        in_range("--width", width, 0.0, MAX_WIDTH_M, "m", open_low=True)
         if estimator not in ESTIMATORS:
             raise InputError(
                 f"--estimator: got {estimator!r}, expected one of {', '.join(ESTIMATORS)}"
@@ -149,12 +158,12 @@ def paint(
                 f"{MAX_PROBE_SPACING_M:g} m"
             )
         surface = None if wall is None else read_wall(wall)
-        for option, rate in (
+        for option, chance in (
             ("--false-contacts", false_contacts),
             ("--missed-contacts", missed_contacts),
         ):
-            if not 0.0 <= rate < 1.0:
-                raise InputError(f"{option}: got {rate:g}, expected a probability in [0, 1)")
+            if not 0.0 <= chance < 1.0:
+                raise InputError(f"{option}: got {chance:g}, expected a probability in [0, 1)")
         with _progress() as bar:
             points = _dots(dots_csv, image, dots, width, seed, bar)
             if surface is None:
@@ -192,7 +201,7 @@ def paint(
             write_plan(
                 stage,
                 [PlannedTrajectory(flown.trajectory, flown.pen_windows_s, flown.limits)],
-                rate=100.0,
+                rate=rate,
                 guaranteed=True,
                 summary=result.summary()
                 | {
@@ -228,11 +237,9 @@ def _wall_note(result: MissionResult) -> str:
 
 def _progress() -> Progress:
     """A rich progress bar on stderr (the console the CLI prints to)."""
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn
+    from rich.progress import BarColumn, MofNCompleteColumn, TextColumn
 
-    return Progress(
-        TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), console=console
-    )
+    return progress_bar(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn())
 
 
 def _update(name: str) -> UpdateMode:
@@ -257,8 +264,6 @@ def _dots(
         )
     if dots_csv is not None:
         return read_dots_csv(dots_csv)
-    if not (math.isfinite(width) and 0.0 < width <= 20.0):
-        raise InputError(f"--width: got {width:g}, expected a width in (0, 20] m")
     assert image is not None  # narrowed by the check above
     darkness = load_darkness(image)
     task = bar.add_task("stippling", total=None)

@@ -15,6 +15,7 @@ from skyquill.cli.main import (
     check_out,
     console,
     say_done,
+    scheduler_address,
     stage_progress,
     user_errors,
 )
@@ -22,6 +23,7 @@ from skyquill.errors import InfeasibleError, InputError
 from skyquill.io.atomic import write_json
 from skyquill.io.outputs import staged_output
 from skyquill.io.plan_dir import trajectory_names, write_plan
+from skyquill.io.points import check_rows_written
 from skyquill.io.trajectory_json import PlannedTrajectory
 from skyquill.show import ShowDrone, ShowLimits, ShowReport, check_show, load_show
 from skyquill.show.build import ShowPlan, build_show
@@ -30,6 +32,8 @@ from skyquill.show.script import ShowScript, load_script
 #: Relative round-off allowed over the planned limits in the independent check
 #: (Ruckig's profiles touch the limits exactly; the writing QP holds them to its tolerance).
 CHECK_ROUND_OFF = 1e-6
+#: Most ``--workers`` (processes planning the writing): more than any machine's cores is a typo.
+MAX_WORKERS = 256
 
 
 @app.command()
@@ -53,8 +57,9 @@ def show(
     """
     with user_errors():
         check_out(out)
-        if workers is not None and workers < 1:
-            raise InputError(f"--workers: got {workers}, expected at least 1")
+        if workers is not None and not 1 <= workers <= MAX_WORKERS:
+            raise InputError(f"--workers: got {workers}, expected 1 to {MAX_WORKERS}")
+        scheduler = scheduler_address(scheduler)
         show_script = load_script(script)
         stages: dict[str, float] = {}
         plan = _plan(show_script, workers, scheduler)
@@ -162,6 +167,8 @@ def _write(
         "pictures": pictures,
     }
     clock = time.perf_counter()
+    for drone in plan.drones:  # the script's rate, named as written there (show has no --rate)
+        check_rows_written(drone.trajectory.duration, script.rate_hz, "[show].rate")
     full = write_plan(stage, plan.drones, rate=script.rate_hz, guaranteed=True, summary=summary)
     full["planning_time_s"]["files"] = time.perf_counter() - clock
     write_json(stage / "summary.json", full)

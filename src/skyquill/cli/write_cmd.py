@@ -5,6 +5,7 @@ from __future__ import annotations
 import dataclasses
 import inspect
 import math
+import re
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any
@@ -26,9 +27,11 @@ from skyquill.cli.main import (
     app,
     check_out,
     console,
+    in_range,
     parse_color,
     positive_rate,
     say_done,
+    scheduler_address,
     stage_progress,
     upload_target,
     user_errors,
@@ -41,6 +44,9 @@ from skyquill.io.plan_dir import trajectory_names, write_plan
 from skyquill.io.trajectory_json import PlannedTrajectory
 from skyquill.limits import VehicleLimits
 from skyquill.show.lights import COLOR_BY, window_palette
+
+#: ``--separation`` between drones, m: more than 100 m apart is no show of one drawing.
+SEPARATION_RANGE_M = (0.0, 100.0)
 
 if TYPE_CHECKING:
     from skyquill.calligraphy.board import BoardKind
@@ -226,11 +232,15 @@ def write(
     On a sky board (light painting) also long_exposure.png, the photograph of the lights
     from in front, and preview.gif (``skyquill render`` shows them from any view).
     """
+    from skyquill.calligraphy.mission import MAX_ALTITUDE_M
     from skyquill.calligraphy.show import MAX_DRONES, plan_show
 
     with user_errors():
         check_out(out)
         rate = positive_rate(rate)
+        scheduler = scheduler_address(scheduler)
+        in_range("--board-height", board_height, 0.0, MAX_ALTITUDE_M, "m", open_low=True)
+        in_range("--separation", separation, *SEPARATION_RANGE_M, "m", open_low=True)
         palette = _palette(light_color, color_by)
         kind = _board_kind(board, fly)
         pose = _sky_pose(kind, board_yaw, board_tilt, plane_weight, grid, lift)
@@ -359,14 +369,24 @@ def _sky_pose(
     return _Pose(yaw, tilt, None if grid is None else _grid(grid))
 
 
+_DIGITS = re.compile(r"[0-9]{1,6}", re.ASCII)
+
+
 def _grid(text: str) -> tuple[int, int]:
     """``"4x5"`` to ``(4, 5)``."""
     rows, sep, columns = text.lower().partition("x")
-    if not (sep and rows.strip().isdigit() and columns.strip().isdigit()):
+    if not (sep and _DIGITS.fullmatch(rows.strip()) and _DIGITS.fullmatch(columns.strip())):
         raise InputError(f"--grid: got {text!r}, expected ROWSxCOLUMNS, e.g. 4x5")
+    from skyquill.calligraphy.show import MAX_DRONES
+
     shape = int(rows), int(columns)
     if min(shape) < 1:
         raise InputError(f"--grid: got {text!r}, expected at least one row and one column")
+    if shape[0] * shape[1] > MAX_DRONES:
+        raise InputError(
+            f"--grid: got {text!r} ({shape[0] * shape[1]:,} boards), expected at most "
+            f"{MAX_DRONES} boards, one per drone (rows x columns <= {MAX_DRONES})"
+        )
     return shape
 
 

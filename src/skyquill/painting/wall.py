@@ -29,6 +29,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from skyquill.errors import InputError
+from skyquill.io.numbers import parse_number
 from skyquill.validation import FloatArray, as_array, as_float
 
 #: Largest segment angle accepted, deg: a steeper segment is no longer a wall in front of the
@@ -341,10 +342,10 @@ def parse_angles(text: str) -> list[float]:
     """``"-10,0,10"`` (or ``"-10|0|10"``) into degrees; InputError naming ``--wall-angles``."""
     parts = [p.strip() for p in text.replace("|", ",").split(",")]
     try:
-        values = [float(p) for p in parts]
+        values = [parse_number(p) for p in parts]
     except ValueError:
         values = []
-    if not values or not all(math.isfinite(v) for v in values):
+    if not values:
         raise InputError(
             f"--wall-angles: got {text!r}, expected comma-separated finite angles in degrees, "
             "e.g. -10,0,10"

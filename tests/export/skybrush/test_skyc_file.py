@@ -256,5 +256,5 @@ def test_a_truncated_or_nan_show_is_an_input_error(tmp_path: Path) -> None:
         read_show_json(path)
     show["swarm"]["drones"][0]["settings"]["trajectory"]["points"][1][1][0] = math.nan
     nan = _archive(tmp_path / "nan.skyc", json.dumps(show).encode())  # json writes NaN
-    with pytest.raises(InputError, match=r"points\[1\]\[1\]: got \[nan"):
+    with pytest.raises(InputError, match=r"show.json: got NaN, expected a Skybrush show object"):
         read_show_json(nan)

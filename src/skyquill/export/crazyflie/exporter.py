@@ -44,6 +44,7 @@ from skyquill.export.crazyflie.memory import (
     flown_uploads,
     pack_pieces,
 )
+from skyquill.io.json_read import read_json_file
 from skyquill.io.trajectory_json import PlannedTrajectory
 from skyquill.targets import CRAZYFLIE, Upload, plan_uploads
 from skyquill.trajectory import Trajectory
@@ -282,7 +283,7 @@ _Schedule = list[tuple[str, float, int, list[tuple[str, int, int, float]]]]
 def _schedule(summary: Path) -> _Schedule:
     """The drones' uploads as ``summary`` lists them (:data:`_Schedule`)."""
     try:
-        data = json.loads(Path(summary).read_text(encoding="utf-8"))
+        data = read_json_file(summary, "a Crazyswarm export summary")  # a regular file, strictly
         return [
             (
                 str(d["drone"]),

@@ -55,10 +55,13 @@ from skyquill.export.skybrush.lights import lights_json, program_bytes
 from skyquill.export.skybrush.playback import MAX_SEGMENT_S, played_show
 from skyquill.io.atomic import atomic_path
 from skyquill.io.json_read import parse_json
+from skyquill.io.source import open_binary
 from skyquill.trajectory import PiecewisePolynomial
 
 #: Largest ``show.json`` read from an archive, bytes (checked before inflating it).
 MAX_SHOW_BYTES = 256 * 2**20
+#: Largest .skyc file read, bytes: compressed, the show.json of that size takes far less.
+MAX_SKYC_BYTES = 256 * 2**20
 #: Environments Skybrush knows.
 ENVIRONMENTS = ("indoor", "outdoor")
 #: Most control points of a segment Skybrush Live plays (cubic).
@@ -233,10 +236,13 @@ def read_show_json(path: str | Path) -> dict[str, Any]:
         or :func:`validate_show` rejects it.
     """
     file = Path(path)
-    if not file.is_file():
+    if not file.exists():
         raise InputError(f"skyc file: got {str(file)!r}, expected an existing .skyc file")
     try:
-        with zipfile.ZipFile(file) as archive:
+        with (
+            open_binary(file, "a .skyc show", max_bytes=MAX_SKYC_BYTES, name=file.name) as stream,
+            zipfile.ZipFile(stream) as archive,
+        ):
             if "show.json" not in archive.namelist():
                 raise InputError(
                     f"{file.name}: got members {archive.namelist()[:10]}, expected a show.json"
