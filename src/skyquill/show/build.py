@@ -38,7 +38,7 @@ from skyquill.show.formation import (
 from skyquill.show.limits import check_inside
 from skyquill.show.load import ShowDrone
 from skyquill.show.moves import hold, staggered
-from skyquill.show.route import leg_limits, plan_moves, route_to
+from skyquill.show.route import Route, leg_limits, plan_moves, route_to
 from skyquill.show.script import (
     RGB,
     FormationScene,
@@ -218,12 +218,13 @@ def _fly(
         return "takeoff", {"altitude_m": scene.altitude_m}
     if isinstance(scene, FormationScene):
         formation = make_formation(scene, script)
-        _, curtain = _reform(line, formation.points, script)
+        route = _reform(line, formation.points, script)
         line.hold(scene.hold_s, scene.color)
         return "formation", {
             "shape": formation.name,
             "spacing_m": formation.spacing_m,
-            "via_curtain": curtain,
+            "via_curtain": route.via_curtain,
+            "transition": _described(route),
         }
     if isinstance(scene, WriteScene):
         return "write", _write(scene, script, line, where)
@@ -232,9 +233,14 @@ def _fly(
         return "hold", {}
     assert isinstance(scene, Land)
     air = homes + np.array([0.0, 0.0, scene.altitude_m])
-    pads, curtain = _reform(line, air, script)
+    route = _reform(line, air, script)
+    pads = route.chosen
     _climb(line, air[pads], homes[pads], scene.stagger_s, script)
-    return "land", {"altitude_m": scene.altitude_m, "via_curtain": curtain}
+    return "land", {
+        "altitude_m": scene.altitude_m,
+        "via_curtain": route.via_curtain,
+        "transition": _described(route),
+    }
 
 
 def make_formation(scene: FormationScene, script: ShowScript) -> Formation:
@@ -267,12 +273,23 @@ def _climb(
     line.append(list(flights), duration)
 
 
-def _reform(line: _Timeline, targets: FloatArray, script: ShowScript) -> tuple[IntArray, bool]:
-    """Fly to ``targets`` (:func:`~skyquill.show.route.route_to`): targets taken, curtain flown."""
+def _reform(line: _Timeline, targets: FloatArray, script: ShowScript) -> Route:
+    """Fly to ``targets`` (:func:`~skyquill.show.route.route_to`): the route flown."""
     route = route_to(line.positions, targets, script)
     for moves in route.legs:
         _append(line, moves)
-    return route.chosen, route.via_curtain
+    return route
+
+
+def _described(route: Route) -> dict[str, Any]:
+    """A transition for ``summary.json``: how, how long, and against its lower bound."""
+    bound = route.lower_bound_s
+    return {
+        "route": route.how,
+        "duration_s": route.duration,
+        "lower_bound_s": bound,
+        "over_lower_bound": route.duration / bound if bound > 0.0 else 1.0,
+    }
 
 
 def _append(line: _Timeline, moves: Transition) -> None:

@@ -34,6 +34,7 @@ from skyquill.errors import SolverError
 from skyquill.show.fleet import Fleet
 from skyquill.show.motion import LocalMotion, Motion, taylor_bound
 from skyquill.show.pairs import close_boxes
+from skyquill.show.waves import closest_on_segments
 from skyquill.validation import FloatArray, as_float
 
 #: Grid step of the first pass, s.
@@ -132,23 +133,19 @@ class _Intervals:
     db: FloatArray
     w: FloatArray
     jump: FloatArray
+    taylor: FloatArray
 
     def lower(self) -> FloatArray:
         # A jump J inside the interval (round-off where a file's pieces meet) can move the
         # distance by J at the jump and J again against the Lipschitz line: 2 J of slack.
         slack = 0.5 * (self.da + self.db - self.w * (self.b - self.a)) - 2.0 * self.jump
-        return np.minimum(np.minimum(self.da, self.db), slack)
+        return np.minimum(np.minimum(self.da, self.db), np.maximum(slack, self.taylor))
 
     def take(self, keep: NDArray[np.bool_]) -> _Intervals:
-        return _Intervals(
-            self.pair[keep],
-            self.a[keep],
-            self.b[keep],
-            self.da[keep],
-            self.db[keep],
-            self.w[keep],
-            self.jump[keep],
-        )
+        return _Intervals(*(getattr(self, f)[keep] for f in _FIELDS))
+
+
+_FIELDS = tuple(_Intervals.__dataclass_fields__)
 
 
 class _Closest:
@@ -238,7 +235,7 @@ def _sampled_closest(fleet: Fleet, times: FloatArray) -> float:
     best = math.inf
     for t in times:
         points = fleet.position(np.arange(n), np.full(n, t))
-        distance, _ = cKDTree(points).query(points, k=2)
+        distance = np.asarray(cKDTree(points).query(points, k=2)[0])
         best = min(best, float(distance[:, 1].min()))
     return best
 
@@ -311,7 +308,13 @@ def _grid_intervals(
     for begin in range(0, pair.size, per_chunk):
         part = slice(begin, begin + per_chunk)
         items = _window_intervals(
-            fleet, t, pairs, pair=pair[part], window=window[part], lengths=lengths[part]
+            fleet,
+            t,
+            pairs,
+            pair=pair[part],
+            window=window[part],
+            lengths=lengths[part],
+            closest=closest,
         )
         closest.record(items.pair, items.a, items.da)
         closest.record(items.pair, items.b, items.db)
@@ -329,6 +332,7 @@ def _window_intervals(
     pair: IntArray,
     window: IntArray,
     lengths: IntArray,
+    closest: _Closest,
 ) -> _Intervals:
     """The grid intervals of the windows ``window`` of the pairs ``pair``, with their bounds."""
     pair = np.repeat(pair, lengths)
@@ -338,26 +342,71 @@ def _window_intervals(
     a, b = t[k], t[k + 1]
     da = np.linalg.norm(fleet.position(i, a) - fleet.position(j, a), axis=1)
     db = np.linalg.norm(fleet.position(i, b) - fleet.position(j, b), axis=1)
+    return _bounded(fleet, pairs, pair, (a, b), (da, db), closest)
+
+
+def _bounded(  # noqa: PLR0917 - private: one interval's every part
+    fleet: Fleet,
+    pairs: tuple[IntArray, IntArray],
+    pair: IntArray,
+    ends: tuple[FloatArray, FloatArray],
+    distances: tuple[FloatArray, FloatArray],
+    closest: _Closest,
+) -> _Intervals:
+    """Intervals ``ends`` of ``pair`` with the distances there, bounded (midpoints recorded)."""
+    a, b = ends
+    i, j = pairs[0][pair], pairs[1][pair]
+    mid = 0.5 * (a + b)
+    offset = fleet.position(i, mid) - fleet.position(j, mid)
+    closest.record(pair, mid, np.linalg.norm(offset, axis=1))
     one, two = fleet.local(i, a, b), fleet.local(j, a, b)
-    return _Intervals(pair, a, b, da, db, _relative(one, two, 0.5 * (b - a)), one.jump + two.jump)
+    w, taylor = _relative(one, two, 0.5 * (b - a), offset)
+    return _Intervals(pair, a, b, *distances, w, one.jump + two.jump, taylor)
+
+
+def _remainder(derivatives: FloatArray, r: FloatArray) -> FloatArray:
+    """``sum_{q >= 2} |D_q| r^q / q!`` for derivatives (M, Q, 3) of orders 1 to Q (M,)."""
+    norms = np.linalg.norm(derivatives[:, 1:], axis=2)
+    q = np.arange(2, derivatives.shape[1] + 1)
+    weights = r[:, None] ** q[None, :] / np.array([math.factorial(int(k)) for k in q])
+    return np.asarray((norms * weights).sum(axis=1))
 
 
 def _joined(parts: Sequence[_Intervals]) -> _Intervals:
-    fields = _Intervals.__dataclass_fields__
     if not parts:
         empty = np.zeros(0)
-        return _Intervals(np.zeros(0, dtype=np.intp), *([empty] * (len(fields) - 1)))
-    return _Intervals(*(np.concatenate([getattr(p, f) for p in parts]) for f in fields))
+        return _Intervals(np.zeros(0, dtype=np.intp), *([empty] * (len(_FIELDS) - 1)))
+    return _Intervals(*(np.concatenate([getattr(p, f) for p in parts]) for f in _FIELDS))
 
 
-def _relative(one: LocalMotion, two: LocalMotion, half_width: FloatArray) -> FloatArray:
-    """A bound of ``|v_i - v_j|``: Taylor of the difference where both are one polynomial."""
+def _relative(
+    one: LocalMotion, two: LocalMotion, half_width: FloatArray, offset: FloatArray
+) -> tuple[FloatArray, FloatArray]:
+    """Two bounds where both drones are one polynomial on the interval (else the speeds').
+
+    Returns ``w``, a bound of ``|v_i - v_j|`` (the Taylor bound of the difference), and
+    a lower bound of the distance itself, ``-inf`` where both are not one polynomial.
+    The difference ``D(m + tau) = D0 + D1 tau + R(tau)`` of two polynomials is exact
+    with ``|R(tau)| <= sum_{q >= 2} |D_q| r^q / q!`` for ``|tau| <= r``, so the
+    distance is at least the closest the segment ``D0 + D1 tau`` comes to 0, less
+    that remainder: exact for drones in straight uniform motion, and second order in
+    ``r`` otherwise, where the Lipschitz bound is first order. It is what proves two
+    drones that step apart sideways from exactly the minimum distance (moving
+    across their separation, their distance grows though they move fast).
+    """
     w = one.speed + two.speed
+    taylor = np.full(w.size, -np.inf)
     both = one.inside & two.inside
-    if both.any():
+    if not one.derivatives.shape[1]:  # both stand still (constant pieces)
+        taylor[both] = np.linalg.norm(offset[both], axis=1)
+    elif both.any():
         diff = one.derivatives[both] - two.derivatives[both]
-        w[both] = np.minimum(w[both], taylor_bound(diff, half_width[both]))
-    return w
+        r = half_width[both]
+        w[both] = np.minimum(w[both], taylor_bound(diff, r))
+        d0, d1 = offset[both], diff[:, 0]
+        linear, _ = closest_on_segments(d0 - d1 * r[:, None], d0 + d1 * r[:, None])
+        taylor[both] = linear - _remainder(diff, r)
+    return w, taylor
 
 
 def _settle(
@@ -411,36 +460,23 @@ def _refine(
             continue
         if not items.a.size:
             break
-        items = _split(items, fleet, *pairs, closest)
+        items = _split(items, fleet, pairs, closest)
         count += items.a.size
     return lower, count
 
 
 def _split(
-    items: _Intervals,
-    fleet: Fleet,
-    first: IntArray,
-    second: IntArray,
-    closest: _Closest,
+    items: _Intervals, fleet: Fleet, pairs: tuple[IntArray, IntArray], closest: _Closest
 ) -> _Intervals:
     """Both halves of every interval, with the distance at the midpoints recorded."""
     mid = 0.5 * (items.a + items.b)
-    i, j = first[items.pair], second[items.pair]
+    i, j = pairs[0][items.pair], pairs[1][items.pair]
     dm = np.linalg.norm(fleet.position(i, mid) - fleet.position(j, mid), axis=1)
     closest.record(items.pair, mid, dm)
-    a = np.concatenate([items.a, mid])
-    b = np.concatenate([mid, items.b])
-    ii, jj = np.concatenate([i, i]), np.concatenate([j, j])
-    one, two = fleet.local(ii, a, b), fleet.local(jj, a, b)
-    return _Intervals(
-        np.concatenate([items.pair, items.pair]),
-        a,
-        b,
-        np.concatenate([items.da, dm]),
-        np.concatenate([dm, items.db]),
-        _relative(one, two, 0.5 * (b - a)),
-        one.jump + two.jump,
-    )
+    halves = np.concatenate([items.pair, items.pair])
+    ends = (np.concatenate([items.a, mid]), np.concatenate([mid, items.b]))
+    distances = (np.concatenate([items.da, dm]), np.concatenate([dm, items.db]))
+    return _bounded(fleet, pairs, halves, ends, distances, closest)
 
 
 def _result(
