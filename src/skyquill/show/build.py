@@ -27,6 +27,7 @@ from scipy.optimize import linear_sum_assignment
 from scipy.spatial.distance import cdist
 
 from skyquill.io.trajectory_json import PlannedTrajectory
+from skyquill.show.capt import CAPT_SPREAD
 from skyquill.show.check import require_separation
 from skyquill.show.formation import (
     Formation,
@@ -35,6 +36,7 @@ from skyquill.show.formation import (
     home_grid,
     shape_formation,
 )
+from skyquill.show.layers import step_out
 from skyquill.show.limits import check_inside
 from skyquill.show.load import ShowDrone
 from skyquill.show.moves import hold, staggered
@@ -49,7 +51,7 @@ from skyquill.show.script import (
     Takeoff,
     WriteScene,
 )
-from skyquill.show.transition import Transition
+from skyquill.show.transition import PLAN_MARGIN, Transition
 from skyquill.show.writing import plan_writing_scene
 from skyquill.trajectory import PiecewisePolynomial, Trajectory, concatenate
 from skyquill.validation import FloatArray
@@ -214,7 +216,7 @@ def _fly(
     scene: Scene, script: ShowScript, line: _Timeline, homes: FloatArray, where: _Where
 ) -> tuple[str, dict[str, Any]]:
     if isinstance(scene, Takeoff):
-        _climb(line, homes, homes + np.array([0.0, 0.0, scene.altitude_m]), scene.stagger_s, script)
+        _climb(line, homes, _air(homes, scene.altitude_m, script), scene.stagger_s, script)
         return "takeoff", {"altitude_m": scene.altitude_m}
     if isinstance(scene, FormationScene):
         formation = make_formation(scene, script)
@@ -232,7 +234,7 @@ def _fly(
         line.hold(scene.duration_s, scene.color)
         return "hold", {}
     assert isinstance(scene, Land)
-    air = homes + np.array([0.0, 0.0, scene.altitude_m])
+    air = _air(homes, scene.altitude_m, script)
     route = _reform(line, air, script)
     pads = route.chosen
     _climb(line, air[pads], homes[pads], scene.stagger_s, script)
@@ -262,6 +264,18 @@ def make_formation(scene: FormationScene, script: ShowScript) -> Formation:
         strokes = load_svg(scene.svg)
     spacing = scene.spacing_m or safety
     return shape_formation(strokes, n, origin=scene.origin, size_m=scene.size_m, spacing_m=spacing)
+
+
+def _air(homes: FloatArray, altitude_m: float, script: ShowScript) -> FloatArray:
+    """Where the drones climb to above the pads (N, 3): ``altitude_m`` up, in layers if tight.
+
+    Pads closer than ``sqrt(2)`` times the safety distance would need a step out of
+    the air grid's plane before every transition (:mod:`skyquill.show.capt`); the
+    climb takes every other drone a layer higher instead (:func:`~skyquill.show.layers.step_out`).
+    """
+    air = homes + np.array([0.0, 0.0, altitude_m])
+    layers = step_out(air, CAPT_SPREAD * script.safety_m * (1.0 + PLAN_MARGIN))
+    return air if layers is None else layers.points
 
 
 def _climb(

@@ -30,6 +30,7 @@ import math
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy.optimize import linear_sum_assignment
 from scipy.sparse import csr_matrix
 from scipy.sparse.csgraph import maximum_bipartite_matching
 from scipy.spatial import cKDTree
@@ -79,6 +80,38 @@ def straight(a: FloatArray, b: FloatArray, limits: LegLimits, d: float) -> Trans
     return Transition(a, b, (moves,) if moves.schedule else (), flat, math.inf)
 
 
+def straight_to(
+    a: FloatArray, targets: FloatArray, limits: LegLimits, d: float
+) -> tuple[Transition, IntArray] | None:
+    """The fastest one-wave transition to ``targets`` found (unproven), and each drone's target.
+
+    The wave lasts as long as its longest move: the assignment that minimises the
+    squared distances among those whose longest move is the bottleneck distance
+    makes it the lower bound itself; when its paths come too close, the plain
+    minimum-squared-distance assignment (CAPT's, which keeps loose formations apart).
+    """
+    for chosen in assignments(a, targets):
+        wave = straight(a, targets[chosen], limits, d)
+        if wave is not None:
+            return wave, chosen
+    return None
+
+
+def assignments(a: FloatArray, targets: FloatArray) -> list[IntArray]:
+    """The bottleneck-first and the minimum-squared-distance assignments (the same once)."""
+    plain = assign(a, targets)
+    squared = cdist(a, targets, "sqeuclidean")
+    bottleneck = bottleneck_distance(a, targets)
+    longer = squared > bottleneck**2 * (1.0 + 1e-12)
+    if not longer[np.arange(len(a)), plain].any():
+        return [plain]
+    # Moves longer than the bottleneck priced out: the cheapest among the fastest.
+    rows, cols = linear_sum_assignment(np.where(longer, squared.sum() + 1.0, squared))
+    first = np.empty(len(a), dtype=np.intp)
+    first[rows] = cols
+    return [first, plain]
+
+
 def through_layers(
     a: FloatArray, targets: FloatArray, limits: LegLimits, d: float
 ) -> tuple[Transition, IntArray] | None:
@@ -92,15 +125,19 @@ def through_layers(
     out, into = step_out(a, spread), step_out(targets, spread)
     if out is None or into is None:
         return None
-    chosen = assign(out.points, into.points)
-    across = one_wave(out.points, into.points[chosen], limits, d)
+    across = None
+    for chosen in assignments(out.points, into.points):
+        across = one_wave(out.points, into.points[chosen], limits, d)
+        if across is not None:
+            break
     if across is None:
         return None
     goals = targets[chosen]
     back = _reordered(into, chosen)
     legs = [_step(a, out, limits), across, _step(goals, back, limits, inward=True)]
     kept = tuple(leg for leg in legs if leg.schedule)
-    return Transition(a, goals, kept, into.depth[chosen], math.inf), chosen
+    depth = np.round(2.0 * into.depth[chosen]).astype(np.intp)  # in half steps
+    return Transition(a, goals, kept, depth, math.inf), chosen
 
 
 def _reordered(layers: Layers, order: IntArray) -> Layers:

@@ -49,7 +49,7 @@ class Layers:
         The stepped-out points (N, 3), m.
     depth
         Each point's layer (N,): its step along the normal in units of ``step_m``
-        (0: stays in the plane).
+        (0: stays in the plane; half steps when the layers are centred on it).
     normal
         The plane's unit normal (3,).
     step_m
@@ -57,7 +57,7 @@ class Layers:
     """
 
     points: FloatArray
-    depth: IntArray
+    depth: FloatArray
     normal: FloatArray
     step_m: float
 
@@ -114,19 +114,30 @@ def step_out(points: FloatArray, spread_m: float) -> Layers | None:
     and ``None`` when they are not and do not lie on one plane.
     """
     tight = spacing(points)
-    zero = np.zeros(len(points), dtype=np.intp)
+    zero = np.zeros(len(points))
     normal = plane_normal(points)
     if tight >= spread_m:
         return Layers(points, zero, np.array([0.0, 1.0, 0.0]) if normal is None else normal, 0.0)
     if normal is None:
         return None
     colour = colour_close(points, spread_m)
-    if abs(normal[2]) >= HORIZONTAL:
-        depth = colour  # up only: 0, 1, 2, ...
-    else:
-        depth = np.where(colour % 2 == 1, -1, 1) * ((colour + 1) // 2)  # 0, -1, +1, -2, ...
+    depth = layer_depths(int(colour.max()) + 1, upward=abs(normal[2]) >= HORIZONTAL)[colour]
     step = math.sqrt(max(spread_m**2 - tight**2, 0.0)) * (1.0 + LAYER_MARGIN)
     layered = points + (depth * step)[:, None] * normal
     if spacing(layered) < spread_m:
         return None
-    return Layers(layered, depth.astype(np.intp), normal, step)
+    return Layers(layered, depth, normal, step)
+
+
+def layer_depths(count: int, *, upward: bool) -> FloatArray:
+    """The depth of each of ``count`` layers, in steps, the first (the most points) nearest 0.
+
+    Layers of a horizontal formation go up only (0, 1, 2, ...: never towards the
+    ground); those of a vertical one are centred on it, so that no drone steps
+    farther than it must (two layers: half a step in front, half behind; three: in
+    front, on the plane, behind).
+    """
+    if upward:
+        return np.arange(count, dtype=float)
+    centred = np.arange(count) - (count - 1) / 2.0
+    return np.asarray(sorted(centred.tolist(), key=lambda x: (abs(x), x)), dtype=float)

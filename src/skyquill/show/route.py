@@ -31,7 +31,7 @@ from numpy.typing import NDArray
 
 from skyquill.errors import InfeasibleError, InputError
 from skyquill.optimize.legs import LegLimits
-from skyquill.show.capt import lower_bound_s, straight, through_layers
+from skyquill.show.capt import lower_bound_s, straight, straight_to, through_layers
 from skyquill.show.formation import grid_formation
 from skyquill.show.script import ShowScript
 from skyquill.show.transition import Transition, assign, plan_transition, prove
@@ -119,10 +119,9 @@ def route_to(start: FloatArray, targets: FloatArray, script: ShowScript) -> Rout
     names = [f"drone {i}" for i in range(len(targets))]
     bound = lower_bound_s(start, targets, limits)
     options: list[_Option] = []
-    chosen = assign(start, targets)
-    direct = straight(start, targets[chosen], limits, d)
+    direct = straight_to(start, targets, limits, d)
     if direct is not None:
-        route = Route((direct,), chosen, "straight", bound)
+        route = Route((direct[0],), direct[1], "straight", bound)
         options.append((route.duration, _proving(route, d, names)))
     else:
         layered = through_layers(start, targets, limits, d)

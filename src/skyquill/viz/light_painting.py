@@ -20,16 +20,18 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import cast
 
 import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
-from matplotlib.animation import FuncAnimation, PillowWriter
 from matplotlib.axes import Axes
 from matplotlib.collections import LineCollection
 from matplotlib.figure import Figure
+from numpy.typing import NDArray
+from PIL import Image, ImageDraw
 
 from skyquill.colors import RGB
 from skyquill.errors import InputError
@@ -50,6 +52,8 @@ PREVIEW_FPS = 12
 TRAIL_RATE_HZ = 25.0
 #: Colour of a drone whose light is off (RGB 0..1).
 DARK = (0.35, 0.35, 0.35)
+#: Longest trail segment rasterised, px (a segment across the whole preview).
+MAX_SEGMENT_PX = 2000
 DPI = 100
 
 
@@ -95,9 +99,11 @@ class Exposure:
     drones: int
 
 
-def _lit_polylines(
-    drones: Sequence[PlannedTrajectory], default: RGB
-) -> list[tuple[FloatArray, tuple[float, float, float]]]:
+#: A lit stretch of one drone: positions (K, 3), m, and its colour (0..1).
+Polyline = tuple[FloatArray, tuple[float, float, float]]
+
+
+def lit_polylines(drones: Sequence[PlannedTrajectory], default: RGB) -> list[Polyline]:
     """Each lit window of each drone as (positions (K, 3), colour 0..1)."""
     total = sum(b - a for d in drones for a, b in d.pen_windows_s) * EXPOSURE_RATE_HZ
     rate = EXPOSURE_RATE_HZ * min(1.0, MAX_EXPOSURE_SAMPLES / max(total, 1.0))
@@ -141,6 +147,8 @@ def long_exposure(
     camera: Camera,
     path: str | Path,
     default_rgb: RGB = (255, 255, 255),
+    *,
+    lines: Sequence[Polyline] | None = None,
 ) -> Exposure:
     """Write the long-exposure photograph of the show's lights as a PNG.
 
@@ -154,6 +162,8 @@ def long_exposure(
         PNG file to write.
     default_rgb
         The colour of windows whose drone has no colours of its own.
+    lines
+        The lit polylines (:func:`lit_polylines`) when the caller has them already.
 
     Raises
     ------
@@ -162,19 +172,32 @@ def long_exposure(
     """
     if not drones:
         raise InputError("drones: got none, expected at least one to photograph")
+    lines = lit_polylines(drones, default_rgb) if lines is None else lines
     fig, ax = _black_figure(camera)
-    lines = _lit_polylines(drones, default_rgb)
-    segments = [(_segments(camera, points), rgb) for points, rgb in lines]
+    segments = [_segments(camera, points) for points, _ in lines]
+    rgb = np.array([c for _, c in lines]).reshape(-1, 3)
+    extent = np.array([_extent_px(s) for s in segments])
+    counts = np.array([len(s) for s in segments], dtype=np.intp)
+    every = np.concatenate(segments) if segments else np.empty((0, 2, 2))
+    centres = np.array(
+        [s.reshape(-1, 2).mean(axis=0) if len(s) else (np.nan, np.nan) for s in segments]
+    ).reshape(-1, 2)
+    # One collection per glow pass (not one per window: a thousand drones' windows
+    # were thousands of artists); the core of a light trace is whiter than its halo.
     for width, alpha in GLOW:
-        for segs, rgb in segments:
-            # the core of a light trace is whiter than its halo, as on a sensor
-            core = tuple(0.6 * c + 0.4 for c in rgb) if alpha == 1.0 else rgb
-            ax.add_collection(
-                LineCollection(list(segs), colors=[core], linewidths=width, alpha=alpha)
+        colour = 0.6 * rgb + 0.4 if alpha == 1.0 else rgb
+        ax.add_collection(
+            LineCollection(
+                cast("Sequence[FloatArray]", every),  # an (M, 2, 2) array is what it draws
+                colors=np.repeat(colour, counts, axis=0),
+                linewidths=width,
+                alpha=alpha,
             )
-            if _extent_px(segs) < width:  # a light held still (a formation): a dot
-                u, v = segs.reshape(-1, 2).mean(axis=0)
-                ax.scatter(u, v, s=(1.6 * width) ** 2, color=[core], alpha=alpha, lw=0)
+        )
+        still = extent < width  # a light held still (a formation place): a dot
+        if still.any():
+            u, v = centres[still].T
+            ax.scatter(u, v, s=(1.6 * width) ** 2, c=colour[still], alpha=alpha, lw=0)
     fig.savefig(path, dpi=DPI, facecolor="black")
     plt.close(fig)
     length = sum(float(np.linalg.norm(np.diff(p, axis=0), axis=1).sum()) for p, _ in lines)
@@ -191,6 +214,11 @@ def animate_show(
     max_frames: int = MAX_FRAMES,
 ) -> int:
     """Write an animated GIF of the show through ``camera``; returns the number of frames.
+
+    Frames are drawn straight into pixel arrays (numpy) and written by Pillow: every
+    lit stretch of every drone is rasterised once, as the pixels of its segments with
+    the time each is reached, and a frame shows those inside its trail window; the
+    drones are 3 px squares, lit in their colour or dark grey.
 
     Parameters
     ----------
@@ -212,34 +240,98 @@ def animate_show(
     trail = horizon if trail_s == math.inf else as_float("trail_s", trail_s, nonneg=True)
     clock = np.linspace(0.0, horizon, max(2, int(horizon * TRAIL_RATE_HZ)) + 1)
     uv, lit, colors = _tracks(drones, camera, clock, default_rgb)
-    fig, ax = _black_figure(camera)
-    dots = ax.scatter(uv[:, 0, 0], uv[:, 0, 1], s=14, c=[DARK] * len(drones))
-    trails = LineCollection([], linewidths=2.0)
-    ax.add_collection(trails)
-    stamp = ax.text(10, 24, "", color="0.8", fontsize=11)
+    pixels = _trail_pixels(uv, lit, colors, clock, camera)
     times = np.linspace(0.0, horizon, min(frames, max(2, int(horizon * PREVIEW_FPS))))
-
-    def draw(t: float) -> None:
-        k = int(np.searchsorted(clock, t))
-        k = min(k, clock.size - 1)
-        dots.set_offsets(uv[:, k])
-        dots.set_facecolor([tuple(c) for c in np.where(lit[:, k, None], colors[:, k], DARK)])
-        first = max(0, int(np.searchsorted(clock, t - trail)))
-        segs, cols = _trail_segments(uv[:, first : k + 1], lit[:, first : k + 1], colors[:, first:])
-        trails.set_segments(list(segs))
-        trails.set_color([tuple(c) for c in cols])
-        stamp.set_text(f"t = {t:5.1f} s")
-
-    FuncAnimation(fig, draw, frames=times, blit=False).save(
-        str(path), writer=PillowWriter(fps=PREVIEW_FPS), dpi=DPI
+    size = (camera.height_px, camera.width_px, 3)
+    built = np.zeros(size, dtype=np.uint8)  # trails that never fade (trail >= the show)
+    shown = 0
+    images = []
+    for t in times:
+        k = min(int(np.searchsorted(clock, t)), clock.size - 1)
+        end = int(np.searchsorted(pixels.t, t, side="right"))
+        if trail >= horizon:
+            pixels.paint(built, shown, end)
+            shown = end
+            frame = built.copy()
+        else:
+            frame = np.zeros(size, dtype=np.uint8)
+            pixels.paint(frame, int(np.searchsorted(pixels.t, t - trail)), end)
+        _paint_dots(frame, uv[:, k], np.where(lit[:, k, None], colors[:, k], DARK))
+        image = Image.fromarray(frame)
+        ImageDraw.Draw(image).text((10, 10), f"t = {t:5.1f} s", fill=(204, 204, 204))
+        images.append(image)
+    images[0].save(
+        str(path),
+        format="GIF",
+        save_all=True,
+        append_images=images[1:],
+        duration=round(1000 / PREVIEW_FPS),
+        loop=0,
     )
-    plt.close(fig)
     return int(times.size)
+
+
+@dataclass(frozen=True)
+class _Pixels:
+    """Pixels of every lit trail segment, by the time each is reached (sorted)."""
+
+    t: FloatArray
+    u: NDArray[np.intp]
+    v: NDArray[np.intp]
+    rgb: NDArray[np.uint8]
+
+    def paint(self, frame: NDArray[np.uint8], start: int, end: int) -> None:
+        """Set the pixels ``[start, end)`` (2 px wide: each with its right and lower neighbours)."""
+        u, v, rgb = self.u[start:end], self.v[start:end], self.rgb[start:end]
+        height, width = frame.shape[:2]
+        for du, dv in ((0, 0), (1, 0), (0, 1), (1, 1)):
+            frame[np.minimum(v + dv, height - 1), np.minimum(u + du, width - 1)] = rgb
+
+
+def _trail_pixels(
+    uv: FloatArray, lit: NDArray[np.bool_], colors: FloatArray, clock: FloatArray, camera: Camera
+) -> _Pixels:
+    """Rasterise the segments between consecutive lit samples (one pixel step along each)."""
+    both = lit[:, :-1] & lit[:, 1:]
+    drone, k = np.nonzero(both)
+    a, b = uv[drone, k], uv[drone, k + 1]
+    box = np.array([camera.width_px, camera.height_px], dtype=float)
+    inside = np.all((a > -box) & (a < 2 * box) & (b > -box) & (b < 2 * box), axis=1)
+    a, b, drone, k = a[inside], b[inside], drone[inside], k[inside]
+    steps = np.minimum(np.ceil(np.abs(b - a).max(axis=1)).astype(np.intp), MAX_SEGMENT_PX) + 1
+    seg = np.repeat(np.arange(steps.size), steps)
+    frac = (np.arange(steps.sum()) - np.repeat(np.cumsum(steps) - steps, steps)) / np.repeat(
+        steps, steps
+    )
+    points = a[seg] + frac[:, None] * (b[seg] - a[seg])
+    when = clock[k[seg]] + frac * (clock[k[seg] + 1] - clock[k[seg]])
+    keep = np.all((points >= 0) & (points < box), axis=1)
+    order = np.argsort(when[keep], kind="stable")
+    rgb = np.clip(np.round(255 * colors[drone[seg], k[seg]]), 0, 255).astype(np.uint8)
+    return _Pixels(
+        when[keep][order],
+        points[keep, 0].astype(np.intp)[order],
+        points[keep, 1].astype(np.intp)[order],
+        rgb[keep][order],
+    )
+
+
+def _paint_dots(frame: NDArray[np.uint8], uv: FloatArray, rgb: FloatArray) -> None:
+    """Each drone as a 3 px square at ``uv`` (D, 2) in its colour (D, 3) 0..1 (none if hidden)."""
+    height, width = frame.shape[:2]
+    seen = np.all(np.isfinite(uv), axis=1)
+    centre = np.round(uv[seen]).astype(np.intp)
+    colour = np.clip(np.round(255 * rgb[seen]), 0, 255).astype(np.uint8)
+    for du in (-1, 0, 1):
+        for dv in (-1, 0, 1):
+            u, v = centre[:, 0] + du, centre[:, 1] + dv
+            on = (u >= 0) & (u < width) & (v >= 0) & (v < height)
+            frame[v[on], u[on]] = colour[on]
 
 
 def _tracks(
     drones: Sequence[PlannedTrajectory], camera: Camera, clock: FloatArray, default: RGB
-) -> tuple[FloatArray, np.ndarray, FloatArray]:
+) -> tuple[FloatArray, NDArray[np.bool_], FloatArray]:
     """Image positions (D, T, 2), lit (D, T) and colours 0..1 (D, T, 3) on ``clock``."""
     uv = np.empty((len(drones), clock.size, 2))
     lit = np.zeros((len(drones), clock.size), dtype=bool)
@@ -252,15 +344,6 @@ def _tracks(
         lit[i] = light.any(axis=1) & front
         colors[i] = light / 255.0
     return uv, lit, colors
-
-
-def _trail_segments(
-    uv: FloatArray, lit: np.ndarray, colors: FloatArray
-) -> tuple[FloatArray, FloatArray]:
-    """Segments (M, 2, 2) between consecutive lit samples, and their colours (M, 3)."""
-    both = lit[:, :-1] & lit[:, 1:]
-    segs = np.stack([uv[:, :-1], uv[:, 1:]], axis=2)[both]
-    return segs, colors[:, : uv.shape[1] - 1][both]
 
 
 #: Size of the photograph and of the preview, pixels (width, height).
@@ -279,10 +362,12 @@ def write_pictures(
     """Write ``long_exposure.png`` and ``preview.gif`` into ``folder``; their summary entry.
 
     The photograph frames the lit path (what the camera records); the preview frames
-    the whole flight (take-off and landing included).
+    the whole flight (take-off and landing included). The lit path is sampled once for
+    both the framing and the photograph.
     """
-    everything = _positions(drones, lit_only=False)
-    lit = _positions(drones, lit_only=True)
+    lines = lit_polylines(drones, default_rgb)
+    everything = _positions(drones)
+    lit = np.concatenate([p for p, _ in lines]) if lines else np.empty((0, 3))
     photo_camera = Camera.framing(
         lit if lit.size else everything,
         view.azimuth_deg,
@@ -291,7 +376,9 @@ def write_pictures(
         width_px=PHOTO_PX[0],
         height_px=PHOTO_PX[1],
     )
-    photo = long_exposure(drones, photo_camera, folder / "long_exposure.png", default_rgb)
+    photo = long_exposure(
+        drones, photo_camera, folder / "long_exposure.png", default_rgb, lines=lines
+    )
     preview_camera = Camera.framing(
         everything,
         view.azimuth_deg,
@@ -317,11 +404,8 @@ def write_pictures(
     }
 
 
-def _positions(drones: Sequence[PlannedTrajectory], *, lit_only: bool) -> FloatArray:
-    """Sampled positions of every drone (M, 3): the lit ones, or the whole flights."""
-    if lit_only:
-        lines = _lit_polylines(drones, (255, 255, 255))
-        return np.concatenate([p for p, _ in lines]) if lines else np.empty((0, 3))
+def _positions(drones: Sequence[PlannedTrajectory]) -> FloatArray:
+    """Positions of every drone's whole flight, 400 samples each (M, 3)."""
     return np.concatenate(
         [d.trajectory.evaluate(np.linspace(0.0, d.trajectory.duration, 400)) for d in drones]
     )
