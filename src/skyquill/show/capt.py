@@ -27,6 +27,7 @@ it exactly (bisection over the distances, a bipartite matching at each).
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
@@ -81,35 +82,52 @@ def straight(a: FloatArray, b: FloatArray, limits: LegLimits, d: float) -> Trans
 
 
 def straight_to(
-    a: FloatArray, targets: FloatArray, limits: LegLimits, d: float
+    a: FloatArray, targets: FloatArray, limits: LegLimits, d: float, matching: Matching
 ) -> tuple[Transition, IntArray] | None:
     """The fastest one-wave transition to ``targets`` found (unproven), and each drone's target.
 
-    The wave lasts as long as its longest move: the assignment that minimises the
-    squared distances among those whose longest move is the bottleneck distance
-    makes it the lower bound itself; when its paths come too close, the plain
-    minimum-squared-distance assignment (CAPT's, which keeps loose formations apart).
+    ``matching``: :func:`matchings` of ``a`` and ``targets``.
     """
-    for chosen in assignments(a, targets):
+    for chosen in matching.candidates:
         wave = straight(a, targets[chosen], limits, d)
         if wave is not None:
             return wave, chosen
     return None
 
 
-def assignments(a: FloatArray, targets: FloatArray) -> list[IntArray]:
-    """The bottleneck-first and the minimum-squared-distance assignments (the same once)."""
+@dataclass(frozen=True)
+class Matching:
+    """Assignments of starts to targets for one wave, the fastest first.
+
+    Attributes
+    ----------
+    candidates
+        Each an index into the targets per start (N,): the assignment that minimises
+        the squared distances among those whose longest move is the bottleneck
+        distance (the wave is then as fast as any transition can be), and the plain
+        minimum-squared-distance one (CAPT's: it keeps loose formations apart); one
+        when they are the same.
+    bottleneck_m
+        The bottleneck distance (:func:`bottleneck_distance`), m.
+    """
+
+    candidates: tuple[IntArray, ...]
+    bottleneck_m: float
+
+
+def matchings(a: FloatArray, targets: FloatArray) -> Matching:
+    """The assignments of ``a`` (N, 3) to ``targets`` (M, 3) a wave is tried with."""
     plain = assign(a, targets)
     squared = cdist(a, targets, "sqeuclidean")
-    bottleneck = bottleneck_distance(a, targets)
+    bottleneck = bottleneck_distance(a, targets, plain=plain)
     longer = squared > bottleneck**2 * (1.0 + 1e-12)
     if not longer[np.arange(len(a)), plain].any():
-        return [plain]
+        return Matching((plain,), bottleneck)
     # Moves longer than the bottleneck priced out: the cheapest among the fastest.
     rows, cols = linear_sum_assignment(np.where(longer, squared.sum() + 1.0, squared))
     first = np.empty(len(a), dtype=np.intp)
     first[rows] = cols
-    return [first, plain]
+    return Matching((first, plain), bottleneck)
 
 
 def through_layers(
@@ -126,7 +144,7 @@ def through_layers(
     if out is None or into is None:
         return None
     across = None
-    for chosen in assignments(out.points, into.points):
+    for chosen in matchings(out.points, into.points).candidates:
         across = one_wave(out.points, into.points[chosen], limits, d)
         if across is not None:
             break
@@ -154,7 +172,9 @@ def _step(plane: FloatArray, layers: Layers, limits: LegLimits, *, inward: bool 
     return scheduled(start, goal, waves, limits)
 
 
-def bottleneck_distance(starts: FloatArray, targets: FloatArray) -> float:
+def bottleneck_distance(
+    starts: FloatArray, targets: FloatArray, *, plain: IntArray | None = None
+) -> float:
     """The smallest, over assignments of starts to distinct targets, of the longest distance, m.
 
     Parameters
@@ -163,6 +183,8 @@ def bottleneck_distance(starts: FloatArray, targets: FloatArray) -> float:
         (N, 3), m.
     targets
         (M, 3), M >= N, m.
+    plain
+        The minimum-squared-distance assignment, if the caller has it (an upper end).
     """
     n = len(starts)
     if n == 0:
@@ -172,7 +194,8 @@ def bottleneck_distance(starts: FloatArray, targets: FloatArray) -> float:
     nearest = np.asarray(cKDTree(targets).query(starts)[0])
     low = float(nearest.max())
     distance = cdist(starts, targets)
-    high = float(distance[np.arange(n), assign(starts, targets)].max())
+    chosen = assign(starts, targets) if plain is None else plain
+    high = float(distance[np.arange(n), chosen].max())
     values = np.unique(distance[(distance >= low) & (distance <= high)])
     lo, hi = 0, values.size - 1
     while lo < hi:
@@ -190,7 +213,6 @@ def _matches_all(allowed: NDArray[np.bool_]) -> bool:
     return bool((matching >= 0).all())
 
 
-def lower_bound_s(starts: FloatArray, targets: FloatArray, limits: LegLimits) -> float:
-    """The shortest any transition from ``starts`` to distinct ``targets`` can last, s."""
-    length = bottleneck_distance(starts, targets)
-    return profile(length, limits, 0.0).end_s if length > STILL_M else 0.0
+def lower_bound_s(length_m: float, limits: LegLimits) -> float:
+    """The shortest any transition whose bottleneck distance is ``length_m`` can last, s."""
+    return profile(length_m, limits, 0.0).end_s if length_m > STILL_M else 0.0

@@ -31,7 +31,7 @@ from numpy.typing import NDArray
 
 from skyquill.errors import InfeasibleError, InputError
 from skyquill.optimize.legs import LegLimits
-from skyquill.show.capt import lower_bound_s, straight, straight_to, through_layers
+from skyquill.show.capt import lower_bound_s, matchings, straight, straight_to, through_layers
 from skyquill.show.formation import grid_formation
 from skyquill.show.script import ShowScript
 from skyquill.show.transition import Transition, assign, plan_transition, prove
@@ -117,9 +117,10 @@ def route_to(start: FloatArray, targets: FloatArray, script: ShowScript) -> Rout
     """
     limits, d = leg_limits(script), script.safety_m
     names = [f"drone {i}" for i in range(len(targets))]
-    bound = lower_bound_s(start, targets, limits)
+    matching = matchings(start, targets)
+    bound = lower_bound_s(matching.bottleneck_m, limits)
     options: list[_Option] = []
-    direct = straight_to(start, targets, limits, d)
+    direct = straight_to(start, targets, limits, d, matching)
     if direct is not None:
         route = Route((direct[0],), direct[1], "straight", bound)
         options.append((route.duration, _proving(route, d, names)))
