@@ -20,7 +20,6 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import cast
 
 import matplotlib
 
@@ -52,6 +51,8 @@ PREVIEW_FPS = 12
 TRAIL_RATE_HZ = 25.0
 #: Colour of a drone whose light is off (RGB 0..1).
 DARK = (0.35, 0.35, 0.35)
+#: The photograph keeps a sample where the light has moved on by this much, px.
+THIN_PX = 0.5
 #: Longest trail segment rasterised, px (a segment across the whole preview).
 MAX_SEGMENT_PX = 2000
 DPI = 100
@@ -116,18 +117,33 @@ def lit_polylines(drones: Sequence[PlannedTrajectory], default: RGB) -> list[Pol
     return out
 
 
-def _segments(camera: Camera, points: FloatArray) -> FloatArray:
-    """Image segments (M, 2, 2) of a polyline, the parts behind the camera left out."""
+def _image_runs(camera: Camera, points: FloatArray) -> list[FloatArray]:
+    """The visible runs (K, 2) of a polyline in the image, thinned to :data:`THIN_PX`.
+
+    The parts behind the camera are left out. A sample is kept where the path has
+    moved on by another :data:`THIN_PX` along the image, and at both ends: the
+    photograph cannot show the samples in between (a formation's drones hold still
+    for seconds at 100 samples a second).
+    """
     uv, front = camera.project(points)
-    keep = front[:-1] & front[1:]
-    return np.stack([uv[:-1], uv[1:]], axis=1)[keep]
+    runs = []
+    cuts = np.flatnonzero(np.diff(front.astype(np.int8))) + 1
+    for run, seen in zip(np.split(uv, cuts), np.split(front, cuts), strict=True):
+        if not seen[0]:
+            continue
+        arc = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(run, axis=0).T))])
+        step = np.floor(arc / THIN_PX)
+        keep = np.concatenate([[True], step[1:] != step[:-1]])
+        keep[-1] = True
+        runs.append(run[keep])
+    return runs
 
 
-def _extent_px(segs: FloatArray) -> float:
-    """Largest side of the image box of ``segs`` (M, 2, 2), px; inf when none is visible."""
-    if segs.size == 0:
+def _extent_px(runs: Sequence[FloatArray]) -> float:
+    """Largest side of the image box of ``runs``, px; inf when none is visible."""
+    if not runs:
         return math.inf
-    points = segs.reshape(-1, 2)
+    points = np.concatenate(runs)
     return float(np.max(points.max(axis=0) - points.min(axis=0)))
 
 
@@ -174,24 +190,22 @@ def long_exposure(
         raise InputError("drones: got none, expected at least one to photograph")
     lines = lit_polylines(drones, default_rgb) if lines is None else lines
     fig, ax = _black_figure(camera)
-    segments = [_segments(camera, points) for points, _ in lines]
+    runs = [_image_runs(camera, points) for points, _ in lines]
     rgb = np.array([c for _, c in lines]).reshape(-1, 3)
-    extent = np.array([_extent_px(s) for s in segments])
-    counts = np.array([len(s) for s in segments], dtype=np.intp)
-    every = np.concatenate(segments) if segments else np.empty((0, 2, 2))
+    extent = np.array([_extent_px(r) for r in runs])
+    counts = np.array([len(r) for r in runs], dtype=np.intp)
+    every = [run for window in runs for run in window]
     centres = np.array(
-        [s.reshape(-1, 2).mean(axis=0) if len(s) else (np.nan, np.nan) for s in segments]
+        [np.concatenate(r).mean(axis=0) if r else (np.nan, np.nan) for r in runs]
     ).reshape(-1, 2)
-    # One collection per glow pass (not one per window: a thousand drones' windows
-    # were thousands of artists); the core of a light trace is whiter than its halo.
+    # One collection per glow pass, one path per lit window (not one artist per window,
+    # nor one path per sample: a thousand drones were a million segments); the core of
+    # a light trace is whiter than its halo.
     for width, alpha in GLOW:
         colour = 0.6 * rgb + 0.4 if alpha == 1.0 else rgb
         ax.add_collection(
             LineCollection(
-                cast("Sequence[FloatArray]", every),  # an (M, 2, 2) array is what it draws
-                colors=np.repeat(colour, counts, axis=0),
-                linewidths=width,
-                alpha=alpha,
+                every, colors=np.repeat(colour, counts, axis=0), linewidths=width, alpha=alpha
             )
         )
         still = extent < width  # a light held still (a formation place): a dot
