@@ -51,6 +51,8 @@ PREVIEW_FPS = 12
 TRAIL_RATE_HZ = 25.0
 #: Colour of a drone whose light is off (RGB 0..1).
 DARK = (0.35, 0.35, 0.35)
+#: Colour of the preview's clock (RGB 0..255).
+STAMP = (204, 204, 204)
 #: The photograph keeps a sample where the light has moved on by this much, px.
 THIN_PX = 0.5
 #: Longest trail segment rasterised, px (a segment across the whole preview).
@@ -272,8 +274,14 @@ def animate_show(
             pixels.paint(frame, int(np.searchsorted(pixels.t, t - trail)), end)
         _paint_dots(frame, uv[:, k], np.where(lit[:, k, None], colors[:, k], DARK))
         image = Image.fromarray(frame)
-        ImageDraw.Draw(image).text((10, 10), f"t = {t:5.1f} s", fill=(204, 204, 204))
+        draw = ImageDraw.Draw(image)
+        draw.fontmode = "1"  # no antialiasing: the frame keeps the palette's colours
+        draw.text((10, 10), f"t = {t:5.1f} s", fill=STAMP)
         images.append(image)
+    # One palette for every frame (the lights' colours, dark, the stamp), instead of
+    # Pillow's median cut per frame: the frames hold only these colours.
+    palette = _palette(colors)
+    images = [im.quantize(palette=palette, dither=Image.Dither.NONE) for im in images]
     images[0].save(
         str(path),
         format="GIF",
@@ -328,6 +336,18 @@ def _trail_pixels(
         points[keep, 1].astype(np.intp)[order],
         rgb[keep][order],
     )
+
+
+def _palette(colors: FloatArray) -> Image.Image:
+    """A P-mode image whose palette holds black, dark, the stamp and every light colour."""
+    lights = np.unique(np.clip(np.round(255 * colors.reshape(-1, 3)), 0, 255), axis=0)
+    fixed = np.array([(0, 0, 0), [round(255 * c) for c in DARK], STAMP], dtype=float)
+    every = np.unique(np.concatenate([fixed, lights]), axis=0)[:256].astype(np.uint8)
+    flat = np.zeros(768, dtype=np.uint8)
+    flat[: every.size] = every.ravel()
+    image = Image.new("P", (1, 1))
+    image.putpalette(flat.tolist())
+    return image
 
 
 def _paint_dots(frame: NDArray[np.uint8], uv: FloatArray, rgb: FloatArray) -> None:
