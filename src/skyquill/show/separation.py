@@ -296,11 +296,26 @@ def _grid_intervals(
 
     Returns the intervals still open (their bound below what is asked for), the
     lowest bound of those already proven, and how many intervals were bounded.
-    Every chunk's samples are recorded in ``closest`` first.
+    Every chunk's samples are recorded in ``closest`` first. Memory holds one chunk
+    (some 500 bytes per interval while both drones' motions are compared) and the
+    intervals still open (~60 bytes each).
+
+    Raises
+    ------
+    SolverError
+        More than :data:`MAX_INTERVALS` grid intervals to examine (drones crowding
+        closer than the distance asked for over much of the show): refused before
+        the work, not swapped.
     """
     pair, window = candidates
     n_int = t.size - 1
     lengths = np.minimum(WINDOW, n_int - window * WINDOW)
+    total = int(lengths.sum())
+    if total > MAX_INTERVALS:
+        raise SolverError(
+            f"separation: got {total:,} grid intervals where drones come close, expected at "
+            f"most {MAX_INTERVALS:,} (fewer drones, or drones that keep farther apart)"
+        )
     kept: list[_Intervals] = []
     lower = (math.inf, -1, math.nan)
     count = 0
