@@ -561,6 +561,27 @@ def route_length(
     return drawn + moves + legs + 2.0 * len(strokes_world) * board.lift_m
 
 
+def initial_flight_time(
+    strokes: Strokes, board: Board, opts: WritingOptions, home: FloatArray | None = None
+) -> float:
+    """The flight time :func:`plan_writing` starts from, s, in milliseconds and without a solve.
+
+    The route of ``strokes`` (scaled to ``opts.size_m``) on ``board`` from and to
+    the vehicle's ``home`` (3,), m, timed by :func:`route_times`: the plan's
+    duration when the first timing needs no stretch (a pre-plan estimate: the
+    studio's). A route above :data:`MAX_ROUTE_SAMPLES` is refused as by
+    :func:`plan_writing`.
+    """
+    home_pos = None if home is None else as_array("home", home, shape=(3,))
+    if home_pos is not None:
+        home_pos = home_pos - tip_offset(board, opts)  # the tip's home
+    scaled = strokes.scaled(opts.size_m)
+    strokes_world = tuple(board.to_world(path) for path in scaled.paths)
+    _check_route_size(strokes_world, board, home_pos)
+    points, roles = _route(strokes_world, board, home_pos)
+    return float(route_times(points, roles, board, opts)[-1])
+
+
 def route_times(
     points: FloatArray, roles: FloatArray, board: Board, opts: WritingOptions
 ) -> FloatArray:
