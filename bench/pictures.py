@@ -12,8 +12,9 @@ itself in this process (``CliRunner``, BLAS on one thread), with pictures and wi
   with them: the same share seen from outside the command (``1 - share`` up to noise).
 
 Written to ``bench/results/pictures.json``. Run: ``.venv/bin/python bench/pictures.py``
-(about 10 minutes on two free cores); ``--runs 1`` for a quick look, ``--only write``
-for the workloads whose name starts with that.
+(about 10 minutes on two free cores with ``--runs 3``, the default); ``--runs 1`` on a busy
+machine (``runs`` is recorded), ``--only write`` for the workloads whose name starts with that
+(written to ``pictures_quick.json``).
 """
 
 from __future__ import annotations
@@ -115,12 +116,13 @@ def main() -> None:
         "goal": f"pictures at most {GOAL_SHARE:.0%} of each command's wall time",
         "workloads": rows,
         "worst_share": max(r["share"] for r in rows) if rows else None,
+        "runs": args.runs,
         "note": "share = median of summary.json's pictures.time_s / wall over runs with "
         "pictures; the machine is shared (load in machine.loadavg_at_start), so read the "
         "shares, not the seconds",
     }
     RESULTS.mkdir(exist_ok=True)
-    name = "pictures.json" if not args.only and args.runs >= 3 else "pictures_quick.json"
+    name = "pictures.json" if not args.only else "pictures_quick.json"
     (RESULTS / name).write_text(json.dumps(jsonable(report), indent=2) + "\n")
 
 
