@@ -73,8 +73,8 @@ def test_a_brush_or_board_the_vehicle_cannot_write_with_is_refused(
 
 
 def test_drones_are_bounded() -> None:
-    with pytest.raises(InputError, match=r"^drones: got 101, expected an integer from 1 to 100"):
-        layout(101, 0.5, 1.0)
+    with pytest.raises(InputError, match=r"^drones: got 1001, expected an integer from 1 to 1000"):
+        layout(1001, 0.5, 1.0)
 
 
 def test_a_far_home_is_refused_by_the_route_estimate() -> None:

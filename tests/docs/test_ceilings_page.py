@@ -30,7 +30,7 @@ def test_the_numbers_a_user_meets_are_on_the_page() -> None:
     from skyquill.optimize.fit import MAX_SPANS
 
     page = (ROOT / "docs" / "ceilings.md").read_text(encoding="utf-8")
-    assert f"{MAX_DRONES} drones (`--grid`" in page
+    assert f"{MAX_DRONES:,} drones (`--grid`" in page
     assert f"{CHECK_DRONES:,} drones" in page
     assert f"{MAX_SPANS:,} knot spans" in page
 

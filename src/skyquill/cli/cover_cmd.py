@@ -23,6 +23,7 @@ from skyquill.cli.main import (
     upload_target,
     user_errors,
 )
+from skyquill.cli.pictures import NoPictures, Pictures
 from skyquill.coverage import DEFAULT_MIN_COVERAGE
 from skyquill.errors import InputError
 from skyquill.limits import VehicleLimits
@@ -124,6 +125,7 @@ def cover(
     ] = None,
     target: Target = None,
     force: Force = False,
+    no_pictures: NoPictures = False,
 ) -> None:
     """Plan a coverage flight of REGION; write summary.json, trajectory.csv and plot.png.
 
@@ -187,10 +189,12 @@ def cover(
             console.status("writing and checking the plan"),
             staged_output(out, "cover", force=force, inputs=[region]) as stage,
         ):
+            drawn = Pictures(not no_pictures)
             fields = (
                 plan.summary()
                 | {"region": str(region), "min_coverage": min_coverage or None}
                 | geo.summary()
+                | {"pictures": drawn.entry}
             )
             if geo.frame is not None:
                 fields["path_geojson"] = _write_geojson(stage, geo.frame, plan, planned)
@@ -201,7 +205,7 @@ def cover(
                 # The refit for a target holds the limits through the hull; the LP does not.
                 guaranteed=plan.delivered is not None,
                 summary=fields,
-                plot=lambda path: plot_coverage(plan, path),
+                plot=drawn.plot(lambda path: plot_coverage(plan, path)),
             )
     uploads = "" if plan.delivered is None else f", {len(plan.delivered.budget.uploads)} upload(s)"
     say_done(

@@ -28,6 +28,7 @@ from skyquill.cli.main import (
     upload_target,
     user_errors,
 )
+from skyquill.cli.pictures import NoPictures, Pictures
 from skyquill.errors import InputError
 from skyquill.io.outputs import staged_output
 from skyquill.io.plan_dir import write_plan
@@ -90,13 +91,18 @@ def run_fit(
     rate: float,
     source: Path,
     force: bool = False,
+    pictures: bool = True,
 ) -> dict[str, Any]:
-    """Fit the points of ``source``, then write the plan directory ``out``."""
+    """Fit the points of ``source``, then write the plan directory ``out``.
+
+    ``pictures``: draw ``plot.png`` (``--no-pictures`` skips it).
+    """
     from skyquill.viz.fit_plot import plot_fit
 
     title = source.stem
     with console.status(f"fitting {points.shape[0]} points ({escape(title)})"):
         fit = fit_points(points, times, options)
+    drawn = Pictures(pictures)
     with (
         console.status("writing and checking the plan"),
         staged_output(out, "fit", force=force, inputs=[source]) as stage,
@@ -106,8 +112,8 @@ def run_fit(
             [PlannedTrajectory(lifted(fit.trajectory, 0.0), limits=fit.limits)],
             rate=rate,
             guaranteed=True,
-            summary=fit_summary(fit, options, rate),
-            plot=lambda path: plot_fit(fit, path, title),
+            summary=fit_summary(fit, options, rate) | {"pictures": drawn.entry},
+            plot=drawn.plot(lambda path: plot_fit(fit, path, title)),
         )
     uploads = "" if fit.budget is None else f", {len(fit.budget.uploads)} upload(s)"
     say_done(
@@ -155,6 +161,7 @@ def fit(
     ] = False,
     target: Target = None,
     force: Force = False,
+    no_pictures: NoPictures = False,
 ) -> None:
     """Fit a smooth trajectory to POINTS_CSV that starts and ends at rest.
 
@@ -187,7 +194,9 @@ def fit(
             raise InputError(f"--timing: got 'given', but {points_csv.name} has no t column")
         if timing in ("path", "segments"):
             times = None
-        run_fit(points, times, options, out, positive_rate(rate), points_csv, force)
+        run_fit(
+            points, times, options, out, positive_rate(rate), points_csv, force, not no_pictures
+        )
 
 
 def _hull(name: str) -> Any:

@@ -20,6 +20,7 @@ from skyquill.cli.main import (
     say_done,
     user_errors,
 )
+from skyquill.cli.pictures import NoPictures, Pictures
 from skyquill.errors import InputError
 from skyquill.io.atomic import write_json
 from skyquill.io.outputs import staged_output
@@ -65,6 +66,7 @@ def fly(
         typer.Option(help="Fly a trajectory that does not start and end at rest (a cut-out)."),
     ] = False,
     force: Force = False,
+    no_pictures: NoPictures = False,
 ) -> None:
     """Fly every trajectory of PLAN in closed loop; write summary.json, flight.csv, plot.png."""
     import numpy as np
@@ -95,9 +97,11 @@ def fly(
                 check_rest_ends(planned.trajectory)
         disturbances = Disturbances(wind_mps=wind_mps, gust_std_mps=gust, position_noise_m=noise)
         setup = _Setup(loop, sim, disturbances, seed, rate)
+        drawn = Pictures(not no_pictures)
         with staged_output(out, "fly", force=force, inputs=plan_files(plan)) as stage:
             flights = [
-                _fly_drone(name, p.trajectory, setup, stage, len(plans) > 1) for name, p in plans
+                _fly_drone(name, p.trajectory, setup, stage, (len(plans) > 1, drawn))
+                for name, p in plans
             ]
             summary = _worst(flights) | {
                 "plan": str(plan),
@@ -107,6 +111,7 @@ def fly(
                 "position_noise_m": noise,
                 "seed": seed,
                 "drones": flights,
+                "pictures": drawn.entry,
             }
             write_json(stage / "summary.json", summary)
     say_done(
@@ -125,9 +130,13 @@ class _Setup:
 
 
 def _fly_drone(
-    name: str, trajectory: Trajectory, setup: _Setup, out: Path, several: bool
+    name: str, trajectory: Trajectory, setup: _Setup, out: Path, pictures: tuple[bool, Pictures]
 ) -> dict[str, Any]:
-    """Fly one trajectory; write its flight CSV and plot; its summary entry."""
+    """Fly one trajectory; write its flight CSV and plot; its summary entry.
+
+    ``pictures``: whether the plan has several drones (files named after each), and
+    what to draw.
+    """
     import numpy as np
 
     from skyquill.errors import SolverError
@@ -143,10 +152,12 @@ def _fly_drone(
             f"{setup.sim}: the flight of {name} diverged (non-finite state), nothing written; "
             "lower the disturbances"
         )
+    several, drawn = pictures
     suffix = f"_{name}" if several else ""
     rows = write_flight_csv(out / f"flight{suffix}.csv", flight)
-    with console.status("plotting"):
-        plot_flight(flight, out / f"plot{suffix}.png", name)
+    if drawn.drawn:
+        with console.status("plotting"), drawn.timing(f"plot{suffix}.png"):
+            plot_flight(flight, out / f"plot{suffix}.png", name)
     summary = flight.summary()
     return summary | {
         "name": name,

@@ -27,6 +27,7 @@ from skyquill.cli.main import (
     say_done,
     user_errors,
 )
+from skyquill.cli.pictures import NoPictures, Pictures
 from skyquill.errors import InputError
 
 if TYPE_CHECKING:  # the painting package is imported lazily
@@ -107,6 +108,7 @@ def paint(
     seed: Annotated[int, typer.Option(help="Seed of the random generator.")] = 0,
     rate: Annotated[float, typer.Option(help="Sample rate of trajectory.csv, Hz.")] = 100.0,
     force: Force = False,
+    no_pictures: NoPictures = False,
 ) -> None:
     """Paint DOTS.csv (or a stippled --image) on a wall; write summary.json, painted.csv, plot."""
     import numpy as np
@@ -198,6 +200,8 @@ def paint(
         ):
             _write_painted(stage / "painted.csv", result)
             flown = painting_flight(result)
+            drawn = Pictures(not no_pictures)
+            name = (dots_csv or image or Path("")).name
             write_plan(
                 stage,
                 [PlannedTrajectory(flown.trajectory, flown.pen_windows_s, flown.limits)],
@@ -212,8 +216,9 @@ def paint(
                     "gamma_deg": gamma,
                     "offset_m": [float(v) for v in delta],
                     "trajectory_duration_s": flown.trajectory.duration,
+                    "pictures": drawn.entry,
                 },
-                plot=lambda path: plot_mission(result, path, (dots_csv or image or Path("")).name),
+                plot=drawn.plot(lambda path: plot_mission(result, path, name)),
             )
     say_done(
         f"{out}: {result.painted.sum()} of {len(result.reference)} dots, RMSE "

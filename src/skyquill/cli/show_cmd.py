@@ -19,6 +19,7 @@ from skyquill.cli.main import (
     stage_progress,
     user_errors,
 )
+from skyquill.cli.pictures import NoPictures, Pictures
 from skyquill.errors import InfeasibleError, InputError
 from skyquill.io.atomic import write_json
 from skyquill.io.outputs import staged_output
@@ -48,6 +49,7 @@ def show(
         typer.Option(help="dask.distributed scheduler address (or 'local') for the writing."),
     ] = None,
     force: Force = False,
+    no_pictures: NoPictures = False,
 ) -> None:
     """Plan a show script: formations, transitions, writing, take-off and landing.
 
@@ -68,7 +70,7 @@ def show(
             report = _check(plan, show_script)
         stages["check"] = time.perf_counter() - clock
         with staged_output(out, "show", force=force, inputs=[script]) as stage:
-            summary = _write(stage, plan, show_script, report, stages)
+            summary = _write(stage, plan, show_script, report, stages, Pictures(not no_pictures))
     say_done(
         f"{out}: {summary['drones']} drones, {summary['duration_s']:.1f} s, no two closer than "
         f"{summary['min_separation_m']['guaranteed']:.3f} m (guaranteed; "
@@ -123,6 +125,7 @@ def _write(
     script: ShowScript,
     report: ShowReport,
     stages: dict[str, float],
+    drawn: Pictures,
 ) -> dict[str, Any]:
     from skyquill.viz.light_painting import write_pictures
 
@@ -134,9 +137,10 @@ def _write(
     clock = time.perf_counter()
     studio = _studio_csv(stage, plans, script)
     stages["skybrush_csv"] = time.perf_counter() - clock
-    clock = time.perf_counter()
-    pictures = write_pictures(plan.drones, stage)
-    stages["pictures"] = time.perf_counter() - clock
+    if drawn.drawn:
+        with drawn.timing("long_exposure.png", "preview.gif"):
+            drawn.entry |= write_pictures(plan.drones, stage)
+    stages["pictures"] = drawn.entry["time_s"]
     sep = report.separation
     summary = {
         "command": "show",
@@ -164,7 +168,7 @@ def _write(
         ],
         "skyc": skyc,
         "skybrush_csv": studio,
-        "pictures": pictures,
+        "pictures": drawn.entry,
     }
     clock = time.perf_counter()
     for drone in plan.drones:  # the script's rate, named as written there (show has no --rate)

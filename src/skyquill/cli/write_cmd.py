@@ -36,6 +36,7 @@ from skyquill.cli.main import (
     upload_target,
     user_errors,
 )
+from skyquill.cli.pictures import NoPictures, Pictures
 from skyquill.colors import RGB
 from skyquill.errors import InputError
 from skyquill.io.atomic import atomic_path, write_json
@@ -226,6 +227,7 @@ def write(
     ] = "drone",
     target: Target = None,
     force: Force = False,
+    no_pictures: NoPictures = False,
 ) -> None:
     """Plan pen-up / pen-down writing flights; write CSVs, input_strokes.json, plot, summary.
 
@@ -285,7 +287,14 @@ def write(
             )
         inputs = [p for p in (strokes, svg, hanzi) if p is not None]
         summary = write_outputs(
-            show, out, rate, force=force, inputs=inputs, extra=extra(show), palette=palette
+            show,
+            out,
+            rate,
+            force=force,
+            inputs=inputs,
+            extra=extra(show),
+            palette=palette,
+            pictures=not no_pictures,
         )
     say_done(
         f"{out}: {summary['duration_s']:.1f} s of flight, planned in "
@@ -485,8 +494,12 @@ def write_outputs(
     inputs: Sequence[Path] = (),
     extra: dict[str, Any] | None = None,
     palette: tuple[Sequence[RGB], str] | None = None,
+    pictures: bool = True,
 ) -> dict[str, Any]:
     """The plan directory: trajectories, ``input_strokes.json``, ``plot.png``, ``summary.json``.
+
+    ``pictures``: draw them (``--no-pictures`` skips every picture; ``summary.json``'s
+    ``pictures`` says which were drawn and how long they took).
 
     ``extra``: more top-level sections of ``summary.json`` (``--split``'s balance).
     ``palette``: the light colours and how they are given out (``"drone"`` or
@@ -526,10 +539,13 @@ def write_outputs(
         "first_stroke_of_drone": firsts,
     }
     closest = show.min_separation_m if len(missions) > 1 else None
+    drawn = Pictures(pictures)
     with staged_output(out, "write", force=force, inputs=inputs) as stage:
         write_json(stage / "input_strokes.json", payload, indent=None)
-        _write_ink_pictures(stage, inks)
-        pictures = _light_pictures(stage, missions, planned)
+        if drawn.drawn:
+            with drawn.timing(*inks):
+                _write_ink_pictures(stage, inks)
+            _light_pictures(stage, missions, planned, drawn)
         return write_plan(
             stage,
             planned,
@@ -540,10 +556,10 @@ def write_outputs(
                 "vehicle_limits": missions[0].options.limits.as_dict(),
                 "min_separation_m": closest,
                 "drones": per_drone,
+                "pictures": drawn.entry,
             }
-            | pictures
             | (extra or {}),
-            plot=lambda path: plot_missions(missions, path, "skyquill write"),
+            plot=drawn.plot(lambda path: plot_missions(missions, path, "skyquill write")),
         )
 
 
@@ -566,15 +582,16 @@ def _window_colors(
 
 
 def _light_pictures(
-    stage: Path, missions: Sequence[Any], planned: Sequence[PlannedTrajectory]
-) -> dict[str, Any]:
+    stage: Path, missions: Sequence[Any], planned: Sequence[PlannedTrajectory], drawn: Pictures
+) -> None:
     """Light painting (sky boards): the long exposure and the preview; else nothing."""
     if missions[0].board.kind != "sky":
-        return {}
+        return
     from skyquill.viz.light_painting import write_pictures
 
     # The preview keeps every light on screen: it builds up the photograph.
-    return {"pictures": write_pictures(planned, stage, trail_s=math.inf)}
+    with drawn.timing("long_exposure.png", "preview.gif"):
+        drawn.entry |= write_pictures(planned, stage, trail_s=math.inf)
 
 
 def _ink_fidelity(mission: Any, flight: Any) -> InkFidelity | None:

@@ -25,10 +25,10 @@ from skyquill.show.geofence import Geofence, read_geofence
 from skyquill.validation import FloatArray, as_array, as_float, as_int
 
 RGB = tuple[int, int, int]
-#: Most drones in one show: every pair's transitions are proven apart (n^2 / 2 pairs).
-#: Measured (bench/show.py): 100 drones plan, prove and write in 43 s, growing about
-#: linearly; 200 is the ceiling a user waits a few minutes for.
-MAX_DRONES = 200
+#: Most drones in one show. The separation proof looks only at neighbours (sweep and
+#: prune over space-time boxes), so planning, proving and writing grow about linearly
+#: with the drones (bench/show.py: a thousand drones in about two minutes on two cores).
+MAX_DRONES = 1000
 #: Most scenes, and the longest a show may hold still in all (holds, formations' holds,
 #: take-off and landing staggers), s: the CSVs and the check grow with the show's length.
 MAX_SCENES = 64
