@@ -31,16 +31,11 @@ from typing import Any
 import numpy as np
 
 from skyquill.calligraphy.board import Board
-from skyquill.calligraphy.mission import (
-    Mission,
-    RoutePlan,
-    RouteSamples,
-    WritingOptions,
-    fidelity,
-    plan_route,
-    resegmented,
-    route_times,
-)
+from skyquill.calligraphy.mission import Mission
+from skyquill.calligraphy.options import WritingOptions
+from skyquill.calligraphy.planning import RoutePlan, fidelity, plan_route, resegmented
+from skyquill.calligraphy.route import RouteSamples
+from skyquill.calligraphy.timing import route_times
 from skyquill.errors import InfeasibleError
 from skyquill.targets import (
     Strategy,
