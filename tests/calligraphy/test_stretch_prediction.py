@@ -6,8 +6,8 @@ import math
 
 import pytest
 
+from skyquill.calligraphy.allocation import DEVIATION_EXPONENT, _stretches_needed
 from skyquill.calligraphy.options import WritingOptions
-from skyquill.calligraphy.planning import DEVIATION_EXPONENT, _stretches_needed
 
 
 @pytest.mark.parametrize(

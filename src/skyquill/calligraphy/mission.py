@@ -53,6 +53,7 @@ stroke to the last, so the drawing keeps its shape seen from the side.
 The work is split by job: :mod:`~skyquill.calligraphy.options` (the knobs),
 :mod:`~skyquill.calligraphy.route` (the samples and their roles),
 :mod:`~skyquill.calligraphy.timing` (when each sample is reached),
+:mod:`~skyquill.calligraphy.allocation` (the fastest faithful timing),
 :mod:`~skyquill.calligraphy.problem` (the smoothing problem),
 :mod:`~skyquill.calligraphy.planning` (solve, measure, stretch, re-segment) and
 :mod:`~skyquill.calligraphy.separation` (drones writing at once); this module
@@ -69,6 +70,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from skyquill.calligraphy.allocation import plan_route
 from skyquill.calligraphy.board import Board
 from skyquill.calligraphy.fidelity import (
     BOARD_MARGIN_M,
@@ -88,7 +90,6 @@ from skyquill.calligraphy.planning import (
     fidelity,
     fidelity_error,
     logger,
-    plan_route,
     resegmented,
 )
 from skyquill.calligraphy.problem import MAX_SPANS
@@ -396,13 +397,12 @@ def plan_writing(
     strokes_world = tuple(board.to_world(path) for path in scaled.paths)
     threshold = opts.turning_threshold_m or 0.25 * opts.tolerance
     samples = build_route(strokes_world, board, home_pos, threshold)
-    times = route_times(samples.points, samples.roles, board, opts)
     if opts.target is not None:
         # budget builds on this module's route planning, hence imported here.
         from skyquill.calligraphy.budget import plan_for_target
 
-        return plan_for_target(samples, times, board, opts, start)
-    plan = plan_route(samples, times, board, opts)
+        return plan_for_target(samples, board, opts, start)
+    plan = plan_route(samples, board, opts)
     if not plan.faithful(opts) and not opts.best_effort:
         raise fidelity_error(plan, opts)
     if opts.resegment != "off" and opts.resegment_iterations > 0:

@@ -1,17 +1,17 @@
 """Planning a writing route: solve, measure how faithfully it writes, stretch, re-segment.
 
-:func:`plan_route` solves the route's smoothing problem
-(:mod:`skyquill.calligraphy.problem`) at its timing, and stretches the timing
-while the limits cannot be met or the plan is not faithful; fitting the swung
-tip, each solve is polished against the swing's second-order part
-(:func:`_plan_at`). :func:`resegmented` then moves time between the samples
-(paper 000 §5.4) with the total kept, if that keeps the plan faithful.
+:func:`plan_at` solves the route's smoothing problem
+(:mod:`skyquill.calligraphy.problem`) at one timing and measures how
+faithfully the plan writes; fitting the swung tip, the solve is polished
+against the swing's second-order part. The time allocation
+(:mod:`skyquill.calligraphy.allocation`) calls it for each timing it tries.
+:func:`resegmented` then moves time between the samples (paper 000 §5.4) with
+the total kept, if that keeps the plan faithful.
 """
 
 from __future__ import annotations
 
 import logging
-import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -43,10 +43,6 @@ POLISH_WITHIN = 1.2
 #: rise (<= L amax^2 / 2 g^2) vertically, and each pass shrinks what is left by
 #: about that ratio again, so two leave well under 0.1 mm.
 TIP_POLISH_PASSES = 2
-#: How fast the pen-down deviation falls with the timing stretch, ``deviation ~ scale^-p``,
-#: taken on the fast side of what is measured (p ~ 3.1) so that a predicted stretch never
-#: overshoots (:func:`_stretches_needed`).
-DEVIATION_EXPONENT = 3.5
 
 
 @dataclass(frozen=True)
@@ -84,55 +80,6 @@ class RoutePlan:
         """Whether the pen-down path is within ``opts.tolerance`` (and the contact holds)."""
         held = self.contact is None or self.contact.holds
         return self.deviation.max_m <= opts.tolerance and held
-
-
-def plan_route(
-    samples: RouteSamples, times: FloatArray, board: Board, opts: WritingOptions
-) -> RoutePlan:
-    """One rest-to-rest spline along ``samples`` at ``times`` over ``board``, stretched to fit.
-
-    The timing is stretched by ``opts.stretch_factor`` while the limits cannot
-    be met or the plan is not faithful (:meth:`RoutePlan.faithful`), at most
-    ``opts.max_stretches`` times; the last plan is returned even if it is not
-    faithful (the caller decides). No re-segmentation (:func:`resegmented`).
-
-    Raises
-    ------
-    InfeasibleError
-        The limits cannot be met even after ``max_stretches`` stretches.
-    """
-    scale, stretches = 1.0, 0
-    while True:
-        last = stretches >= opts.max_stretches
-        logger.debug("solving at %.3gx the first timing (stretch %d)", scale, stretches)
-        try:
-            plan = _plan_at(samples, times * scale, board, opts, scale)
-        except InfeasibleError:
-            if last:
-                raise
-            scale, stretches = scale * opts.stretch_factor, stretches + 1
-            continue
-        if plan.faithful(opts) or last:
-            return plan
-        # Slower: less tracking error and less brush swing. Skip the stretches
-        # that cannot reach the tolerance (a contact that fails: one at a time).
-        off = plan.deviation.max_m
-        k = _stretches_needed(off, opts) if off > opts.tolerance else 1
-        k = min(k, opts.max_stretches - stretches)
-        scale, stretches = scale * opts.stretch_factor**k, stretches + k
-
-
-def _stretches_needed(deviation_m: float, opts: WritingOptions) -> int:
-    """Stretches predicted to bring ``deviation_m`` within the tolerance (at least 1).
-
-    The pen-down deviation falls about as ``scale^-p`` with ``p ~ 3.1`` (it
-    halves per x1.25 on the bundled characters: 永 12.3 -> 6.1 -> 4.2 mm). The
-    prediction uses :data:`DEVIATION_EXPONENT` = 3.5, a faster fall than seen,
-    so it predicts too few stretches rather than too many: the plan lands on
-    the same stretch as one step at a time, with the attempts between skipped.
-    """
-    per_stretch = DEVIATION_EXPONENT * math.log(opts.stretch_factor)
-    return max(1, math.ceil(math.log(deviation_m / opts.tolerance) / per_stretch))
 
 
 def fidelity_error(plan: RoutePlan, opts: WritingOptions) -> InfeasibleError:
@@ -205,7 +152,7 @@ def resegmented(
     return new
 
 
-def _plan_at(
+def plan_at(
     samples: RouteSamples, times: FloatArray, board: Board, opts: WritingOptions, scale: float
 ) -> RoutePlan:
     """Solve at ``times``; with the swung tip fitted, polish the targets against the swing."""

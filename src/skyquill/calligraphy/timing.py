@@ -1,13 +1,20 @@
 """The timing of a writing route: when the flight reaches each of its samples.
 
-:func:`route_times` is the first timing, one rest-to-rest profile along the
-whole route within the limits (paper 003 §3.5's allocation run along the arc
-length, :func:`~skyquill.optimize.timing.allocate_path_times`), with the lifts
-timed for the jerk limit and the legs from and to a home kept off the speed
-limit.
+:func:`route_times` is one rest-to-rest profile along the whole route (paper
+003 §3.5's allocation run along the arc length,
+:func:`~skyquill.optimize.timing.allocate_path_times`), with the lifts timed
+for the jerk limit and the legs from and to a home kept off the speed limit.
+It is timed with the vehicle's limits, or, for the writing between the legs,
+with those limits capped at a *pace* (:class:`TimingBounds`): the one knob
+the time allocation (:mod:`skyquill.calligraphy.allocation`) turns to find
+the fastest faithful flight. Every step of the timing is non-increasing in
+every limit and in the pace, which is what makes looser limits never slower.
 """
 
 from __future__ import annotations
+
+import math
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -15,6 +22,7 @@ from skyquill.calligraphy.board import Board
 from skyquill.calligraphy.fidelity import contact_runs
 from skyquill.calligraphy.options import WritingOptions
 from skyquill.calligraphy.route import LIFT
+from skyquill.limits import VehicleLimits
 from skyquill.optimize.timing import allocate_path_times
 from skyquill.validation import FloatArray
 
@@ -37,8 +45,54 @@ HOME_LEG_SPEED = 0.9
 SETTLE_S = 1.0
 
 
+#: The shape of the caps on the writing's timing (:meth:`TimingBounds.at_pace`):
+#: (speed, acceleration, jerk) = (1 m/s, 2 m/s^2, 10 m/s^3) at pace 1 -- the
+#: CLI's default limits -- and (p, 2 p^2, 10 p^3) at pace p, as one motion
+#: played p times faster. One shape for every vehicle: below a vehicle's limits
+#: the timing at a pace is the same whatever the limits, so a plan found there
+#: is found again at looser limits (docs/calligraphy-timing.md).
+PACE_SHAPE = (1.0, 2.0, 10.0)
+
+
+@dataclass(frozen=True)
+class TimingBounds:
+    """What a route is timed with: speed m/s, acceleration m/s^2, jerk m/s^3 (``None``: none).
+
+    The vehicle's (:meth:`of`), or those capped at a pace (:meth:`at_pace`).
+    """
+
+    vmax: float
+    amax: float
+    jmax: float | None
+
+    @classmethod
+    def of(cls, limits: VehicleLimits) -> TimingBounds:
+        """The limits a time allocation may plan with (norms, else per-axis bounds)."""
+        vmax, amax = limits.timing_bounds()
+        return cls(vmax, amax, limits.jmax if limits.jmax is not None else limits.jmax_axis)
+
+    def at_pace(self, pace: float) -> TimingBounds:
+        """These bounds capped at ``pace`` (:data:`PACE_SHAPE` played ``pace`` times faster)."""
+        v, a, j = PACE_SHAPE
+        jmax = None if self.jmax is None else min(self.jmax, j * pace**3)
+        return TimingBounds(min(self.vmax, v * pace), min(self.amax, a * pace**2), jmax)
+
+    @property
+    def full_pace(self) -> float:
+        """The slowest pace at which :meth:`at_pace` gives these bounds back."""
+        v, a, j = PACE_SHAPE
+        paces = [self.vmax / v, math.sqrt(self.amax / a)]
+        if self.jmax is not None:
+            paces.append((self.jmax / j) ** (1.0 / 3.0))
+        return max(paces)
+
+
 def route_times(
-    points: FloatArray, roles: FloatArray, board: Board, opts: WritingOptions
+    points: FloatArray,
+    roles: FloatArray,
+    board: Board,
+    opts: WritingOptions,
+    pace: float | None = None,
 ) -> FloatArray:
     """Times (N,), s, for the route ``points`` (N, 3) with ``roles`` (N,).
 
@@ -55,10 +109,17 @@ def route_times(
     Coming from a home, the legs from and to it are flown at
     :data:`HOME_LEG_SPEED` of the speed limit, and fitting the tip the vehicle
     pauses :data:`SETTLE_S` above the first stroke before it touches down.
+
+    With a ``pace``, the writing -- everything between the legs from and to
+    home -- is timed with the limits capped at it (:meth:`TimingBounds.at_pace`);
+    the legs keep the speed limit (far from the board, the brush's swing leaves
+    no ink) but accelerate as the writing does: at 50 m/s^2 the smoothed start
+    of the leg home pulled the last stroke 15-30 mm off (巡 at 20 m/s, 50 m/s^2).
     """
-    vmax, amax = opts.limits.timing_bounds()
+    full = TimingBounds.of(opts.limits)
+    writing = full if pace is None else full.at_pace(pace)
     share = TIP_TIMING_ACC if opts.follows_tip(board) else 0.5
-    steps = np.diff(allocate_path_times(points, vmax, share * amax))
+    steps = np.diff(allocate_path_times(points, writing.vmax, share * writing.amax))
     lifts = contact_runs(roles == LIFT)
     # Where the legs from and to home end and start: above the first and last
     # stroke, or with no lifts (a sky board) on them.
@@ -69,18 +130,22 @@ def route_times(
         first, last = pen[0][0], pen[-1][1] - 1
     from_home = first > 0  # else the route starts right above the first stroke
     if from_home:
+        if writing.vmax != full.vmax:
+            # Cruising at the speed limit, but accelerating as the writing does: the
+            # smoothing carries a leg's acceleration into the first and last stroke.
+            home_legs = np.diff(allocate_path_times(points, full.vmax, share * writing.amax))
+            steps[:first], steps[last:] = home_legs[:first], home_legs[last:]
         # The legs from and to home are long and straight, timed at the speed
         # limit: the smoothed spline would brush past it there and make every
         # solve a conic one. A margin keeps them off it.
         steps[:first] /= HOME_LEG_SPEED
         steps[last:] /= HOME_LEG_SPEED
-    jmax = opts.limits.jmax or opts.limits.jmax_axis
-    if not opts.follows_tip(board) or jmax is None:
+    if not opts.follows_tip(board) or writing.jmax is None:
         return np.concatenate([[0.0], np.cumsum(steps)])
     lengths = np.linalg.norm(np.diff(points, axis=0), axis=1)
     for start, stop in lifts:
         legs = slice(max(start - 1, 0), stop)  # into the lift's first sample, out of its last
-        needed = (LIFT_JERK_FACTOR * float(lengths[legs].sum()) / jmax) ** (1.0 / 3.0)
+        needed = (LIFT_JERK_FACTOR * float(lengths[legs].sum()) / writing.jmax) ** (1.0 / 3.0)
         steps[legs] *= max(1.0, needed / max(float(steps[legs].sum()), 1e-12))
     if from_home:  # settle above the first stroke
         steps[lifts[0][0] - 1] += SETTLE_S
