@@ -8,8 +8,9 @@ an ``n``-th derivative map by ``alpha**n`` and a Gram matrix of order ``n`` by
 
 Every map returned is a sparse matrix acting on the control points of one
 axis, shape ``(rows, M)``; the axis-coupled problem uses their Kronecker
-product with ``I_d`` (paper 003 eq. 9). Evaluation of basis functions is
-delegated to :meth:`scipy.interpolate.BSpline.design_matrix`.
+product with ``I_d`` (paper 003 eq. 9). The rows at sample parameters come
+from the span polynomials of :mod:`skyquill.spline.local`; the Gram matrices
+from :meth:`scipy.interpolate.BSpline.design_matrix` at Gauss nodes.
 """
 
 from __future__ import annotations
@@ -24,6 +25,7 @@ from numpy.typing import NDArray
 from scipy.interpolate import BSpline
 
 from skyquill.errors import InputError
+from skyquill.spline.local import LocalBasis, uniform_local_basis
 
 FloatArray = NDArray[np.float64]
 HullKind = Literal["bspline", "bezier"]
@@ -146,10 +148,22 @@ class ClampedUniformBasis:
             )
         if s.size == 0:
             return sp.csr_array((0, self.n_ctrl))
-        basis = self._derivative_basis(s, order)
-        if order == 0:
-            return basis
-        return sp.csr_array(basis @ self.derivative_map(order))
+        local = self.local_values(s, order)
+        return self.rows(local.first, local.values[order])
+
+    def local_values(self, s: FloatArray, max_order: int) -> LocalBasis:
+        """The ``k + 1`` nonzero basis functions and their ``s``-derivatives up to
+        ``max_order`` at parameters ``s`` (N,) in ``[0, L]`` (validated by the caller):
+        first columns (N,) and values (max_order + 1, N, k + 1)
+        (:func:`skyquill.spline.local.uniform_local_basis`)."""
+        return uniform_local_basis(self.degree, self.n_spans, np.asarray(s, dtype=float), max_order)
+
+    def rows(self, first: NDArray[np.intp], values: FloatArray) -> sp.csr_array:
+        """Sparse rows (N, M) whose nonzeros are ``values`` (N, k + 1) from columns ``first``."""
+        n, width = values.shape
+        indices = (first[:, None] + np.arange(width)).ravel()
+        indptr = np.arange(0, n * width + 1, width)
+        return sp.csr_array((values.ravel(), indices, indptr), shape=(n, self.n_ctrl))
 
     def _derivative_basis(self, s: FloatArray, order: int) -> sp.csr_array:
         """Basis of the ``order``-th derivative spline (degree k - n, knots eq. 35) at ``s``."""
