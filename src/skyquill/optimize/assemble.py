@@ -18,6 +18,7 @@ evaluated term by term by :func:`problem_cost`, never from these matrices.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from functools import lru_cache
 
@@ -34,6 +35,7 @@ from skyquill.optimize.problem import (
     SmoothingProblem,
 )
 from skyquill.spline import HullKind, basis_for
+from skyquill.spline.local import LocalBasis
 from skyquill.validation import FloatArray
 
 
@@ -156,8 +158,11 @@ class AssemblyCache:
         self._key: tuple[object, ...] | None = None
         self._fixed: _Fixed | None = None
         self._design: dict[tuple[object, ...], tuple[FloatArray, sp.csr_array]] = {}
-        #: How often the blocks were re-used (for tests and benchmarks).
+        self._local: dict[tuple[object, ...], tuple[FloatArray, LocalBasis]] = {}
+        self._band: tuple[sp.csr_array, int, FloatArray] | None = None
+        #: How often the blocks were re-used, and built (for tests and benchmarks).
         self.hits = 0
+        self.builds = 0
 
     def design_matrix(
         self, problem: SmoothingProblem, times: FloatArray, order: int = 0
@@ -174,9 +179,37 @@ class AssemblyCache:
             return held[1]
         if len(self._design) >= _DESIGN_ENTRIES:
             self._design.clear()
-        matrix = problem.basis.design_matrix(_params(problem, times), order)
+        if order > min(_LOCAL_ORDERS, problem.degree):
+            matrix = problem.basis.design_matrix(_params(problem, times), order)
+        else:
+            local = self.local_basis(problem, times)
+            matrix = problem.basis.rows(local.first, local.values[order])
         self._design[key] = (times, matrix)
         return matrix
+
+    def local_basis(self, problem: SmoothingProblem, times: FloatArray) -> LocalBasis:
+        """The nonzero basis functions and their ``s``-derivatives 0 to 3 (at most the
+        degree) at a term's ``times``: what its design matrices, its banded normal
+        matrix (:mod:`skyquill.optimize.banded`) and its time gradient are made of.
+        Kept like :meth:`design_matrix`."""
+        key = (id(times), problem.alpha, problem.degree, problem.n_ctrl)
+        held = self._local.get(key)
+        if held is not None and held[0] is times:
+            return held[1]
+        if len(self._local) >= _DESIGN_ENTRIES:
+            self._local.clear()
+        local = local_basis(problem, times)
+        self._local[key] = (times, local)
+        return local
+
+    def band(
+        self, matrix: sp.csr_array, k: int, build: Callable[[sp.csr_array, int], FloatArray]
+    ) -> FloatArray:
+        """``build(matrix, k)`` (a band of the smoothness block), kept while ``matrix`` is the
+        very object :meth:`fixed` hands out again."""
+        if self._band is None or self._band[0] is not matrix or self._band[1] != k:
+            self._band = (matrix, k, build(matrix, k))
+        return self._band[2]
 
     def fixed(self, problem: SmoothingProblem) -> _Fixed:
         """The time-independent blocks of ``problem``, built or re-used."""
@@ -185,11 +218,23 @@ class AssemblyCache:
             self.hits += 1
             return self._fixed
         self._key, self._fixed = key, _build_fixed(problem)
+        self.builds += 1
         return self._fixed
 
 
 #: Design matrices an :class:`AssemblyCache` keeps (a few terms of one or two problems).
 _DESIGN_ENTRIES = 16
+
+
+#: Derivatives of the basis kept per term (:meth:`AssemblyCache.local_basis`): the tip's
+#: first-order model needs the acceleration, its time gradient the jerk.
+_LOCAL_ORDERS = 3
+
+
+def local_basis(problem: SmoothingProblem, times: FloatArray) -> LocalBasis:
+    """The nonzero basis rows and their ``s``-derivatives up to 3 (or the degree) at ``times``."""
+    order = min(_LOCAL_ORDERS, problem.degree)
+    return problem.basis.local_values(_params(problem, times), order)
 
 
 def design_matrix(
