@@ -357,15 +357,49 @@ def problem_cost(
     deviation = 0.0
     for term in problem.deviations:
         if isinstance(term, PointDeviation):
-            for mask, H in point_rows(problem, term, cache):
-                residual = (H @ C - term.points) * mask
-                deviation += term.weight * float(np.sum(residual**2))
+            residual = point_model(problem, term, C, cache) - term.points
+            deviation += term.weight * float(np.sum(residual**2))
         else:
             Q, w = term.quadratic()
             active = _window_controls(problem, term.t_start, term.t_end) > 0
             diff = C[active] - w
             deviation += term.weight * float(np.sum(diff * (diff @ Q)))
     return {"smoothness": smooth, "deviation": deviation, "total": smooth + deviation}
+
+
+def curve_at(
+    problem: SmoothingProblem,
+    times: FloatArray,
+    C: FloatArray,
+    order: int,
+    cache: AssemblyCache | None = None,
+) -> FloatArray:
+    """The ``order``-th ``s``-derivative of the curve of ``C`` (M, d) at ``times``: (N, d).
+
+    From the local basis rows (:meth:`AssemblyCache.local_basis`, kept per
+    term), the same numbers as ``design_matrix(problem, times, order) @ C``
+    without the sparse matrix.
+    """
+    local = cache.local_basis(problem, times) if cache is not None else local_basis(problem, times)
+    if order >= local.values.shape[0]:
+        return np.asarray(design_matrix(problem, times, order) @ C)
+    width = local.values.shape[2]
+    gathered = C[local.first[:, None] + np.arange(width)]  # (N, k + 1, d)
+    return np.asarray(np.einsum("nr,nrd->nd", local.values[order], gathered))
+
+
+def point_model(
+    problem: SmoothingProblem,
+    term: PointDeviation,
+    C: FloatArray,
+    cache: AssemblyCache | None = None,
+) -> FloatArray:
+    """What ``term`` compares with its points: ``p + c a`` at its times (N, d), m."""
+    position = curve_at(problem, term.times, C, 0, cache)
+    if term.accel_gain is None:
+        return position
+    acc = problem.alpha**2 * curve_at(problem, term.times, C, 2, cache)
+    return np.asarray(position + term.accel_gain * acc)
 
 
 def point_rows(

@@ -92,18 +92,23 @@ def banded_closed_form(
     smooth = cache.band(fixed.smooth, problem.degree, _band)
     M, d = problem.n_ctrl, problem.dim
     terms = [t for t in problem.deviations if isinstance(t, PointDeviation) and t.weight > 0]
+    if not terms:
+        return None  # a smoothness cost alone is singular but for the equalities
     locals_ = [cache.local_basis(problem, t.times) for t in terms]
     F = np.zeros((M, d))
     C = np.zeros((M, d))
     Y = np.zeros((fixed.E.shape[0], d))
     E = fixed.E.toarray()
+    first = np.concatenate([local.first for local in locals_])
+    points = np.concatenate([t.points for t in terms])
+    weights = np.concatenate([np.full(t.times.size, t.weight) for t in terms])
     for axes in _axis_groups(terms, d):
-        band = smooth.copy()
-        for term, local in zip(terms, locals_, strict=True):
-            rows = _rows(problem, term, local, axes[0])
-            _add_gram(band, local.first, rows, term.weight)
-            pulled = _transpose_times(local.first, rows, term.points[:, axes], M)
-            F[:, axes] -= 2.0 * term.weight * pulled
+        # Every term's rows at once (N, k + 1): one sum for the band, one per axis for F.
+        rows = np.concatenate(
+            [_rows(problem, t, local, axes[0]) for t, local in zip(terms, locals_, strict=True)]
+        )
+        band = smooth + _gram_band(first, rows, weights, M)
+        F[:, axes] = -2.0 * _transpose_times(first, rows * weights[:, None], points[:, axes], M)
         try:
             factor = scipy.linalg.cholesky_banded(band, lower=False, check_finite=False)
         except np.linalg.LinAlgError:
@@ -156,29 +161,27 @@ def _rows(
     return np.asarray(local.values[0] + gain * problem.alpha**2 * local.values[2])
 
 
-def _add_gram(band: FloatArray, first: NDArray[np.intp], rows: FloatArray, weight: float) -> None:
-    """``band += weight R'R`` in upper band storage, ``R`` the rows (N, k + 1) at ``first``.
-
-    Entry ``(i, j)``, ``j >= i``, of the matrix is ``band[k + i - j, j]``.
-    """
-    k = band.shape[0] - 1
-    M = band.shape[1]
-    for a in range(k + 1):
-        for b in range(a, k + 1):
-            band[k + a - b] += np.bincount(
-                first + b, weights=weight * rows[:, a] * rows[:, b], minlength=M
-            )
+def _gram_band(
+    first: NDArray[np.intp], rows: FloatArray, weights: FloatArray, M: int
+) -> FloatArray:
+    """``sum_n w_n R_n' R_n`` in upper band storage (k + 1, M) for the rows ``R`` (N, k + 1)
+    at columns ``first`` (N,): entry ``(i, j)``, ``j >= i``, is ``band[k + i - j, j]``."""
+    k = rows.shape[1] - 1
+    a, b = np.triu_indices(k + 1)
+    products = weights[:, None] * rows[:, a] * rows[:, b]
+    where = (k + a - b) * M + (first[:, None] + b)
+    sums = np.bincount(where.ravel(), weights=products.ravel(), minlength=(k + 1) * M)
+    return np.asarray(sums.reshape(k + 1, M))
 
 
 def _transpose_times(
     first: NDArray[np.intp], rows: FloatArray, points: FloatArray, M: int
 ) -> FloatArray:
     """``R' P`` (M, g) for the rows ``R`` (N, k + 1) at ``first`` and points ``P`` (N, g)."""
-    out = np.zeros((M, points.shape[1]))
-    for r in range(rows.shape[1]):
-        for j in range(points.shape[1]):
-            out[:, j] += np.bincount(first + r, weights=rows[:, r] * points[:, j], minlength=M)
-    return out
+    columns = (first[:, None] + np.arange(rows.shape[1])).ravel()
+    return np.column_stack(
+        [np.bincount(columns, weights=(rows * p[:, None]).ravel(), minlength=M) for p in points.T]
+    )
 
 
 def _band(matrix: sp.csr_array, k: int) -> FloatArray:

@@ -76,6 +76,9 @@ class _Search:
     n_ctrl: int
     interior: bool = False
     n_solves: int = 0
+    #: Trial points of the last line search rejected as infeasible (or, ``interior``,
+    #: where a limit would bind).
+    rejected: int = 0
     grad_time: float = 0.0
     #: Every solve of the run shares it: the problems differ only in the times.
     workspace: Workspace = field(default_factory=Workspace)
@@ -116,9 +119,11 @@ class _Search:
         """Backtracking (Armijo) along ``-g`` from the step ``trial`` (0: a first guess).
 
         No segment may shrink by more than half in one step, which keeps
-        ``T > 0``. Infeasible trial points are rejected like costlier ones.
+        ``T > 0``. Infeasible trial points are rejected like costlier ones
+        (and counted in :attr:`rejected`, which the next first trial heeds).
         Returns ``(T, t, result, F, step)`` or ``None`` when no decrease is found.
         """
+        self.rejected = 0
         direction = -g
         shrinking = direction < 0
         cap = math.inf
@@ -133,6 +138,7 @@ class _Search:
             if self.mode == "fixed":
                 T_new = T_new * (self.total / T_new.sum())
             out = self.evaluate(T_new)
+            self.rejected += out is None
             if out is not None:
                 F_new = self.objective(*out)
                 if F_new <= F + _ARMIJO * trial * slope:
@@ -304,6 +310,11 @@ def resegment(
             curvature = float(s_k @ y_k)
             if curvature > 0.0:
                 trial = float(s_k @ s_k) / curvature
+            if search.rejected:
+                # Where the feasible (or limit-free) region, not the curvature, held
+                # the step, Barzilai-Borwein overshoots it again: 5-11 rejected solves
+                # per step on a writing route (职). Twice the step that was taken.
+                trial = min(trial, 2.0 * step)
         if decrease <= ftol * abs(F):
             status = "converged"
             break
