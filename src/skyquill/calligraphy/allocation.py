@@ -77,7 +77,9 @@ class _Ladder:
         if u not in self.timings:
             pace = None if u >= self.top else self.opts.stretch_factor**u
             s = self.samples
-            self.timings[u] = route_times(s.points, s.roles, self.board, self.opts, pace)
+            self.timings[u] = route_times(
+                s.points, s.roles, self.board, self.opts, pace, legs=s.legs, lead_in=s.lead_in
+            )
         return self.timings[u]
 
     def scale(self, u: float) -> float:

@@ -102,6 +102,7 @@ from skyquill.calligraphy.route import (
     build_route,
     densify,
     route_length,
+    writing_end,
 )
 from skyquill.calligraphy.separation import check_separation
 from skyquill.calligraphy.timing import (
@@ -117,7 +118,12 @@ from skyquill.limits import DerivativeLimit
 from skyquill.optimize.solve import FitResult
 from skyquill.strokes import Strokes
 from skyquill.strokes.model import MAX_STROKES
-from skyquill.trajectory import RestToRestSequence, SplineTrajectory, Trajectory
+from skyquill.trajectory import (
+    PiecewisePolynomial,
+    RestToRestSequence,
+    SplineTrajectory,
+    Trajectory,
+)
 from skyquill.validation import FloatArray, as_array
 from skyquill.verify import Verification, verify
 
@@ -182,11 +188,15 @@ class Mission:
     ----------
     fits
         The engine's results, one per planned part of the flight in flight
-        order (one unless the plan was split into uploads).
+        order (one unless the plan was split into uploads or strokes were
+        appended).
     trajectory
         The brush-tip trajectory: the one fit's spline, or, split into
         uploads, a :class:`~skyquill.trajectory.RestToRestSequence` of the
-        fits' splines with hovers between them.
+        fits' splines with hovers between them, or, with strokes appended
+        (:func:`~skyquill.calligraphy.incremental.append_stroke`), a
+        :class:`~skyquill.trajectory.PiecewisePolynomial` continuous to the
+        jerk where each part joins the last.
     board
         Where it writes.
     strokes_world
@@ -208,6 +218,13 @@ class Mission:
         without a target.
     contact
         The swung tip against the board when it is fitted; ``None`` otherwise.
+    home
+        Where the brush tip takes off and lands (3,), m; ``None`` when the
+        flight starts and ends above the strokes.
+    join_s
+        When the writing ends -- the brush back up after the last stroke --
+        where :func:`~skyquill.calligraphy.incremental.append_stroke` joins the
+        next stroke; ``None`` for a flight split into uploads.
     """
 
     fits: tuple[FitResult, ...]
@@ -221,6 +238,8 @@ class Mission:
     options: WritingOptions
     target: TargetPlan | None = None
     contact: Contact | None = None
+    home: FloatArray | None = None
+    join_s: float | None = None
 
     @property
     def limits(self) -> tuple[DerivativeLimit, ...]:
@@ -305,9 +324,13 @@ def offset_trajectory(traj: Trajectory, offset: FloatArray) -> Trajectory:
         return SplineTrajectory(traj.control_points + offset, traj.degree, traj.duration)
     if isinstance(traj, RestToRestSequence):
         return RestToRestSequence(tuple(offset_trajectory(p, offset) for p in traj.pieces))
+    if isinstance(traj, PiecewisePolynomial):
+        coeffs = traj.coeffs.copy()
+        coeffs[:, 0, :] += offset  # the constant term of each piece
+        return PiecewisePolynomial(traj.breaks, coeffs, traj.yaw_coeffs)
     raise InputError(
-        f"traj: got a {type(traj).__name__}, expected a SplineTrajectory or a "
-        "RestToRestSequence of them"
+        f"traj: got a {type(traj).__name__}, expected a SplineTrajectory, a "
+        "PiecewisePolynomial or a RestToRestSequence of them"
     )
 
 
@@ -418,6 +441,8 @@ def plan_writing(
         time.perf_counter() - start,
         opts,
         contact=plan.contact,
+        home=home_pos,
+        join_s=float(plan.times[writing_end(samples.roles)]),
     )
 
 

@@ -15,7 +15,7 @@ import numpy as np
 
 from skyquill.calligraphy.board import Board
 from skyquill.calligraphy.options import WritingOptions
-from skyquill.calligraphy.route import LIFT, TRANSIT, RouteSamples
+from skyquill.calligraphy.route import BRAKE, LIFT, TRANSIT, RouteSamples
 from skyquill.errors import InputError
 from skyquill.optimize import Boundary, PlaneDeviation, PointDeviation, SmoothingProblem
 from skyquill.validation import FloatArray
@@ -57,12 +57,13 @@ def route_problem(
     # Fitting the tip, the lifts are held (lift_weight): a lift the smoothing
     # cuts short leaves the brush on the board between strokes, and the ink
     # joins them. Fitting the path (paper 000) they are transits.
-    transit = ~stroke if gain is None else samples.roles == TRANSIT
+    transit = (~stroke & (samples.roles != BRAKE)) if gain is None else samples.roles == TRANSIT
     terms = [
         (stroke, opts.data_weight),
         (samples.corners, opts.turning_weight),
         (transit, opts.transit_weight),
         (lift if gain is not None else np.zeros_like(lift), opts.lift_weight),
+        (samples.roles == BRAKE, opts.lift_weight),  # a continuing flight's braking
     ]
     deviations = tuple(
         PointDeviation(times[which], targets[which], weight, gain)
@@ -76,9 +77,20 @@ def route_problem(
         duration=duration,
         smoothness={3: 1.0},
         deviations=deviations + plane_terms(samples.roles, times, board, opts),
-        boundary=Boundary.rest(targets[0], targets[-1], 3),
+        boundary=_boundary(samples, targets, opts.degree),
         limits=opts.derivative_limits(),
     )
+
+
+def _boundary(samples: RouteSamples, targets: FloatArray, degree: int) -> tuple[Boundary, ...]:
+    """At rest at both ends (paper 003 eqs. 40-42), or, continuing a flight
+    (``samples.start``), in its motion at the start: position to jerk (to the
+    acceleration on a cubic, whose jerk jumps at every knot anyway)."""
+    if samples.start is None:
+        return Boundary.rest(targets[0], targets[-1], 3)
+    rest = Boundary.rest(samples.start[0], targets[-1], 3)
+    moving = tuple(Boundary(b.order, samples.start[b.order], b.end) if b.order else b for b in rest)
+    return (*moving, Boundary(3, samples.start[3], None)) if degree > 3 else moving
 
 
 def plane_terms(

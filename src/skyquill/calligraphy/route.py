@@ -28,6 +28,9 @@ TRANSIT_SPACING_M = 0.01
 #: index): the brush going straight down to a stroke or up from it, and the
 #: moves between, above the board.
 LIFT, TRANSIT = -2, -1
+#: Route role of the samples of a continuing flight braking from its motion
+#: (:func:`skyquill.calligraphy.incremental.braking`): held like the lifts.
+BRAKE = -3
 #: Most route samples (stroke points plus lifts and transits every
 #: TRANSIT_SPACING_M), estimated from the route's length before it is built:
 #: each is a row of the QP's deviation block (~1 kB with its factors).
@@ -39,10 +42,18 @@ class RouteSamples:
     """A route to fly: samples (N, 3), roles (N,), corner indices, the input strokes.
 
     ``roles[i]`` is the index into ``strokes_world`` of the stroke sample ``i``
-    belongs to, or -1 for lifts and transits; ``max_spans`` caps the knot spans
+    belongs to, or :data:`LIFT` / :data:`TRANSIT`; ``max_spans`` caps the knot spans
     of its spline (``None``: as many as ``knot_interval`` asks). ``workspace``
     carries the assembly and the QP setup from one solve of the route to the
     next (stretches, re-segmentation steps): only the times change between them.
+
+    ``start``: a route that continues a flight (:mod:`skyquill.calligraphy.incremental`)
+    starts in motion -- the position, velocity, acceleration and jerk (each (3,))
+    the flight has there; ``None``: at rest. ``lead_in``: the times of its first
+    samples, fixed (the flight braking from that motion). ``legs``: the samples
+    ``(first, last)`` between which it writes, before and after them the legs
+    from and to home (:func:`~skyquill.calligraphy.timing.route_times`);
+    ``None``: found from the roles.
     """
 
     points: FloatArray
@@ -51,6 +62,9 @@ class RouteSamples:
     strokes_world: tuple[FloatArray, ...]
     max_spans: int | None = None
     workspace: Workspace = field(default_factory=Workspace, compare=False, repr=False)
+    start: tuple[FloatArray, ...] | None = None
+    legs: tuple[int, int] | None = None
+    lead_in: FloatArray | None = None
 
 
 def build_route(
@@ -58,16 +72,22 @@ def build_route(
     board: Board,
     home: FloatArray | None,
     turning_threshold_m: float,
+    start: FloatArray | None = None,
 ) -> RouteSamples:
     """The route of ``strokes_world`` (each (K, 3), m) on ``board`` from ``home`` (3,) or a hover.
 
     Refused before it is built when it would exceed :data:`MAX_ROUTE_SAMPLES`;
     the turning points are found by split-and-merge at ``turning_threshold_m``.
+    ``start`` (3,): the route continues a flight from there instead of taking
+    off; it writes from its first sample, and ends at ``home`` if one is given.
     """
     check_route_size(strokes_world, board, home)
-    points, roles = route_points(strokes_world, board, home)
+    points, roles = route_points(strokes_world, board, home, start=start)
     corners = _turning_samples(strokes_world, board, points, roles, turning_threshold_m)
-    return RouteSamples(points, roles, corners, strokes_world)
+    if start is None:
+        return RouteSamples(points, roles, corners, strokes_world)
+    legs = (0, writing_end(roles) if home is not None else len(points) - 1)
+    return RouteSamples(points, roles, corners, strokes_world, legs=legs)
 
 
 def _segment(a: FloatArray, b: FloatArray) -> FloatArray:
@@ -114,13 +134,23 @@ class _Route:
 
 
 def route_points(
-    strokes_world: tuple[FloatArray, ...], board: Board, home: FloatArray | None
+    strokes_world: tuple[FloatArray, ...],
+    board: Board,
+    home: FloatArray | None,
+    start: FloatArray | None = None,
 ) -> tuple[FloatArray, FloatArray]:
-    """All samples (N, 3) and their roles (N,): take-off, strokes with lifts, landing."""
+    """All samples (N, 3) and their roles (N,): take-off, strokes with lifts, landing.
+
+    ``start`` (3,): the route begins there instead (where an earlier flight's
+    writing ended: :mod:`skyquill.calligraphy.incremental`), then goes to the
+    first stroke as between strokes; it ends at ``home`` if one is given.
+    """
     lift = board.lift_m * board.normal
     route = _Route()
     first = strokes_world[0][0] + lift
-    if home is not None:
+    if start is not None:
+        route.add(np.asarray(start, dtype=float)[None, :], TRANSIT)
+    elif home is not None:
         route.add(home[None, :], -1)
         route.go_to(np.array([home[0], home[1], first[2]]))  # climb straight up
         route.go_to(first)
@@ -187,3 +217,12 @@ def _turning_samples(
         gaps = np.linalg.norm(points[where][:, None, :] - corners[None, :, :], axis=2)
         picked.append(where[np.argmin(gaps, axis=0)])
     return np.concatenate(picked)
+
+
+def writing_end(roles: FloatArray) -> int:
+    """Index of the sample where the writing ends: the top of the lift off the last
+    stroke (the last stroke sample on a board without lifts); after it, the leg home."""
+    lifts = np.flatnonzero(roles == LIFT)
+    if lifts.size:
+        return int(lifts[-1])
+    return int(np.flatnonzero(roles >= 0)[-1])

@@ -93,6 +93,9 @@ def route_times(
     board: Board,
     opts: WritingOptions,
     pace: float | None = None,
+    *,
+    legs: tuple[int, int] | None = None,
+    lead_in: FloatArray | None = None,
 ) -> FloatArray:
     """Times (N,), s, for the route ``points`` (N, 3) with ``roles`` (N,).
 
@@ -115,21 +118,30 @@ def route_times(
     the legs keep the speed limit (far from the board, the brush's swing leaves
     no ink) but accelerate as the writing does: at 50 m/s^2 the smoothed start
     of the leg home pulled the last stroke 15-30 mm off (巡 at 20 m/s, 50 m/s^2).
+
+    ``legs``: the samples ``(first, last)`` between which the route writes (the
+    legs from and to home outside them); ``None``: found from the roles, the
+    leg from home ending above the first stroke, the leg home starting above
+    the last. A route with no leg from home (``first == 0``) does not settle.
+
+    ``lead_in``: the times of the route's first samples (n,), fixed -- a
+    continuing flight braking from its motion
+    (:mod:`skyquill.calligraphy.incremental`); the rest is timed from rest at
+    the last of them.
     """
+    if lead_in is not None:
+        n = lead_in.size
+        shifted = None if legs is None else (max(legs[0] - n + 1, 0), legs[1] - n + 1)
+        rest = route_times(points[n - 1 :], roles[n - 1 :], board, opts, pace, legs=shifted)
+        return np.concatenate([lead_in, lead_in[-1] + rest[1:]])
     full = TimingBounds.of(opts.limits)
     writing = full if pace is None else full.at_pace(pace)
     share = TIP_TIMING_ACC if opts.follows_tip(board) else 0.5
     steps = np.diff(allocate_path_times(points, writing.vmax, share * writing.amax))
     lifts = contact_runs(roles == LIFT)
-    # Where the legs from and to home end and start: above the first and last
-    # stroke, or with no lifts (a sky board) on them.
-    if lifts:
-        first, last = lifts[0][0] - 1, lifts[-1][1]
-    else:
-        pen = contact_runs(roles >= 0)
-        first, last = pen[0][0], pen[-1][1] - 1
+    first, last = legs if legs is not None else _legs(roles, lifts)
     from_home = first > 0  # else the route starts right above the first stroke
-    if from_home:
+    if from_home or last < steps.size:
         if writing.vmax != full.vmax:
             # Cruising at the speed limit, but accelerating as the writing does: the
             # smoothing carries a leg's acceleration into the first and last stroke.
@@ -143,10 +155,19 @@ def route_times(
     if not opts.follows_tip(board) or writing.jmax is None:
         return np.concatenate([[0.0], np.cumsum(steps)])
     lengths = np.linalg.norm(np.diff(points, axis=0), axis=1)
-    for start, stop in lifts:
-        legs = slice(max(start - 1, 0), stop)  # into the lift's first sample, out of its last
-        needed = (LIFT_JERK_FACTOR * float(lengths[legs].sum()) / writing.jmax) ** (1.0 / 3.0)
-        steps[legs] *= max(1.0, needed / max(float(steps[legs].sum()), 1e-12))
+    for down, up in lifts:
+        moves = slice(max(down - 1, 0), up)  # into the lift's first sample, out of its last
+        needed = (LIFT_JERK_FACTOR * float(lengths[moves].sum()) / writing.jmax) ** (1.0 / 3.0)
+        steps[moves] *= max(1.0, needed / max(float(steps[moves].sum()), 1e-12))
     if from_home:  # settle above the first stroke
         steps[lifts[0][0] - 1] += SETTLE_S
     return np.concatenate([[0.0], np.cumsum(steps)])
+
+
+def _legs(roles: FloatArray, lifts: list[tuple[int, int]]) -> tuple[int, int]:
+    """Where the legs from and to home end and start: above the first and last
+    stroke, or with no lifts (a sky board) on them."""
+    if lifts:
+        return lifts[0][0] - 1, lifts[-1][1]
+    pen = contact_runs(roles >= 0)
+    return pen[0][0], pen[-1][1] - 1

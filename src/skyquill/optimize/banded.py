@@ -32,13 +32,14 @@ assembling the sparse matrices and factoring the KKT system took ~30 ms.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 import scipy.linalg
 import scipy.sparse as sp
 from numpy.typing import NDArray
 
-from skyquill.optimize.assemble import AssemblyCache, _Fixed
+from skyquill.optimize.assemble import AssemblyCache, _Fixed, point_model
 from skyquill.optimize.problem import PointDeviation, SmoothingProblem
 from skyquill.spline.local import LocalBasis
 from skyquill.validation import FloatArray
@@ -125,6 +126,43 @@ def banded_closed_form(
     return BandedSolution(C, Y.ravel(), fixed)
 
 
+def stationarity_residual(
+    problem: SmoothingProblem, C: FloatArray, y: FloatArray, cache: AssemblyCache | None = None
+) -> float | None:
+    """``|2 G C + F + E'Y| / max(|2 G C|, |F|)`` of a banded problem's closed form; ``None``
+    for a problem of another form.
+
+    The closed form's own check (the KKT route measures the same on its
+    assembled matrices, :func:`skyquill.optimize.resegment.multipliers.multipliers`),
+    without assembling them: ``2 G C + F = 2 S C + 2 sum_n w_n R_n' (R_n C - p_n)``
+    with ``S`` the smoothness block and ``R_n`` each point's row (with its gain).
+    """
+    if problem.interpolation or not all(isinstance(t, PointDeviation) for t in problem.deviations):
+        return None
+    cache = cache if cache is not None else AssemblyCache()
+    fixed = cache.fixed(problem)
+    M, d = C.shape
+    quad = 2.0 * (fixed.smooth @ C)
+    linear = np.zeros((M, d))
+    for term in problem.deviations:
+        assert isinstance(term, PointDeviation)
+        if term.weight <= 0:
+            continue
+        local = cache.local_basis(problem, term.times)
+        model = point_model(problem, term, C, cache)
+        for mask, _ in term.axis_groups():
+            axes = np.flatnonzero(mask)
+            rows = _rows(problem, term, local, int(axes[0]))
+            both = np.hstack([model[:, axes], term.points[:, axes]])
+            pull = 2.0 * term.weight * _transpose_times(local.first, rows, both, M)
+            quad[:, axes] += pull[:, : axes.size]
+            linear[:, axes] -= pull[:, axes.size :]
+    Y = y.reshape(-1, d)
+    stationarity = quad + linear + np.asarray(Y.T @ fixed.E).T
+    size = max(float(np.linalg.norm(quad)), float(np.linalg.norm(linear)), 1e-300)
+    return float(np.linalg.norm(stationarity)) / size
+
+
 def _solve(
     factor: FloatArray, F: FloatArray, E: FloatArray, e: FloatArray
 ) -> tuple[FloatArray, FloatArray] | None:
@@ -167,11 +205,18 @@ def _gram_band(
     """``sum_n w_n R_n' R_n`` in upper band storage (k + 1, M) for the rows ``R`` (N, k + 1)
     at columns ``first`` (N,): entry ``(i, j)``, ``j >= i``, is ``band[k + i - j, j]``."""
     k = rows.shape[1] - 1
-    a, b = np.triu_indices(k + 1)
+    a, b = _pairs(k)
     products = weights[:, None] * rows[:, a] * rows[:, b]
     where = (k + a - b) * M + (first[:, None] + b)
     sums = np.bincount(where.ravel(), weights=products.ravel(), minlength=(k + 1) * M)
     return np.asarray(sums.reshape(k + 1, M))
+
+
+@lru_cache(maxsize=8)
+def _pairs(k: int) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
+    """The index pairs ``a <= b`` of a (k + 1)-square's upper triangle."""
+    a, b = np.triu_indices(k + 1)
+    return a, b
 
 
 def _transpose_times(
@@ -193,4 +238,4 @@ def _band(matrix: sp.csr_array, k: int) -> FloatArray:
     return band
 
 
-__all__ = ["MAX_EQUALITY_ROWS", "BandedSolution", "banded_closed_form"]
+__all__ = ["MAX_EQUALITY_ROWS", "BandedSolution", "banded_closed_form", "stationarity_residual"]

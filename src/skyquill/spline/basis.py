@@ -232,14 +232,14 @@ class ClampedUniformBasis:
         scipy.sparse.csr_array, shape (M, M), symmetric positive semi-definite.
         """
         self._check_order(order)
+        if order not in self._grams:  # built on first use: a problem needs one or two orders
+            D = self.derivative_map(order)
+            self._grams[order] = sp.csr_array(D.T @ self.reduced_gram(order) @ D)
         return self._grams[order]
 
     @cached_property
-    def _grams(self) -> tuple[sp.csr_array, ...]:
-        return tuple(
-            sp.csr_array(self.derivative_map(n).T @ self.reduced_gram(n) @ self.derivative_map(n))
-            for n in range(self.degree + 1)
-        )
+    def _grams(self) -> dict[int, sp.csr_array]:
+        return {}
 
     def reduced_gram(self, order: int) -> sp.csr_array:
         """Gram matrix ``W_n`` of the derivative spline's own basis, shape (M - n, M - n).
@@ -250,12 +250,7 @@ class ClampedUniformBasis:
         (large ``C`` nearly in the polynomial null space of ``V_n``).
         """
         self._check_order(order)
-        return self._reduced_grams[order]
-
-    @cached_property
-    def _reduced_grams(self) -> tuple[sp.csr_array, ...]:
-        grams = []
-        for order in range(self.degree + 1):
+        if order not in self._reduced_grams:
             n_nodes = self.degree - order + 1
             nodes, weights = np.polynomial.legendre.leggauss(n_nodes)
             u = 0.5 * (nodes + 1.0)  # on [0, 1]
@@ -263,8 +258,12 @@ class ClampedUniformBasis:
             s = (spans[:, None] + u[None, :]).ravel()
             w = np.tile(0.5 * weights, self.n_spans)
             B = self._derivative_basis(s, order)
-            grams.append(sp.csr_array(B.T @ sp.diags_array(w) @ B))
-        return tuple(grams)
+            self._reduced_grams[order] = sp.csr_array(B.T @ sp.diags_array(w) @ B)
+        return self._reduced_grams[order]
+
+    @cached_property
+    def _reduced_grams(self) -> dict[int, sp.csr_array]:
+        return {}
 
     def hull_map(
         self,
