@@ -103,3 +103,36 @@ def test_timing_bounds_are_monotone_in_the_pace_and_the_limits(
         assert a <= limit and a <= b and a <= c
     assert full.at_pace(full.full_pace) == full  # the full pace gives the limits back
     assert full.at_pace(0.5 * full.full_pace) != full  # and no slower pace does
+
+
+def test_the_initial_flight_time_is_the_unstretched_plans_duration() -> None:
+    """The studio's estimate (no solve) is what plan_writing starts from: equal when unstretched."""
+    from skyquill.calligraphy.mission import initial_flight_time
+    from skyquill.calligraphy.show import layout
+    from skyquill.strokes import text_strokes
+
+    strokes = text_strokes("L")
+    board, home = layout(1, 0.5, 1.0)[0]
+    opts = WritingOptions(resegment="off")
+    mission = plan_writing(strokes, board, opts, home=home)
+    assert mission.time_scale == 1.0
+    estimate = initial_flight_time(strokes, board, opts, home)
+    assert estimate == pytest.approx(mission.trajectory.duration, rel=1e-9)
+
+
+@settings(max_examples=4, deadline=None)
+@given(char=st.sampled_from(SMALL), tight=limits)
+def test_the_initial_flight_time_bounds_the_planned_duration_from_below(
+    char: str, tight: tuple[float, float, float]
+) -> None:
+    """A cheap lower bound for any limits: the search only slows the writing down."""
+    from skyquill.calligraphy.mission import initial_flight_time
+
+    opts = dataclasses.replace(WritingOptions(), limits=VehicleLimits(*tight))
+    try:
+        mission = plan_writing(hanzi_strokes(char), Board(), opts, home=HOME)
+    except InfeasibleError:
+        return
+    bound = initial_flight_time(hanzi_strokes(char), Board(), opts, HOME)
+    assert bound <= mission.trajectory.duration * (1.0 + 1e-9)
+    assert mission.trajectory.duration == pytest.approx(bound * mission.time_scale, rel=1e-9)

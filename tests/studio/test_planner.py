@@ -12,7 +12,7 @@ from skyquill.studio.planner import run_plan
 
 
 def test_progress_follows_the_solves_the_flight_and_the_files() -> None:
-    """Each solve of the route is a stage (mission.py's DEBUG records); the bar only rises."""
+    """Each solve of the route is a stage (the planning's DEBUG records); the bar only rises."""
     seen: list[tuple[float, str]] = []
     output = run_plan(
         PlanRequest(text="L"),
@@ -23,7 +23,7 @@ def test_progress_follows_the_solves_the_flight_and_the_files() -> None:
     fractions = [f for f, _ in seen]
     stages = [s for _, s in seen]
     assert fractions == sorted(fractions) and fractions[0] > 0.0 and fractions[-1] < 1.0
-    assert "drone 1 of 1: solving at 1x the first timing (stretch 0)" in stages
+    assert "drone 1 of 1: solving at 1x the first timing" in stages
     assert "flying drone 1 of 1 in simulation" in stages
     assert stages[-1] == "writing the show (file 3 of 3)"
     assert output.result.plan_id == "0123456789ab"

@@ -100,8 +100,10 @@ from skyquill.calligraphy.route import (
     TRANSIT_SPACING_M,
     RouteSamples,
     build_route,
+    check_route_size,
     densify,
     route_length,
+    route_points,
     writing_end,
 )
 from skyquill.calligraphy.separation import check_separation
@@ -159,6 +161,7 @@ __all__ = [
     "densify",
     "fidelity",
     "fidelity_error",
+    "initial_flight_time",
     "logger",
     "offset_trajectory",
     "plan_route",
@@ -332,6 +335,31 @@ def offset_trajectory(traj: Trajectory, offset: FloatArray) -> Trajectory:
         f"traj: got a {type(traj).__name__}, expected a SplineTrajectory, a "
         "PiecewisePolynomial or a RestToRestSequence of them"
     )
+
+
+def initial_flight_time(
+    strokes: Strokes, board: Board, opts: WritingOptions, home: FloatArray | None = None
+) -> float:
+    """The flight time :func:`plan_writing` starts from, s, in milliseconds and without a solve.
+
+    The route of ``strokes`` (scaled to ``opts.size_m``) on ``board`` from and to
+    the vehicle's ``home`` (3,), m, timed with the limits
+    (:func:`~skyquill.calligraphy.timing.route_times`): a lower bound of the
+    planned duration -- the time allocation only slows the writing from there
+    (:mod:`skyquill.calligraphy.allocation`) and re-segmentation keeps the
+    total -- and the planned duration itself when the first timing is faithful
+    (``Mission.time_scale == 1``: most characters at the CLI's limits). Without
+    a target. A route above :data:`MAX_ROUTE_SAMPLES` is refused as by
+    :func:`plan_writing`.
+    """
+    home_pos = None if home is None else as_array("home", home, shape=(3,))
+    if home_pos is not None:
+        home_pos = home_pos - tip_offset(board, opts)  # the tip's home
+    scaled = strokes.scaled(opts.size_m)
+    strokes_world = tuple(board.to_world(path) for path in scaled.paths)
+    check_route_size(strokes_world, board, home_pos)
+    points, roles = route_points(strokes_world, board, home_pos)
+    return float(route_times(points, roles, board, opts)[-1])
 
 
 def check_reach(board: Board, opts: WritingOptions) -> None:

@@ -69,7 +69,7 @@ Progress = Callable[[float, str], None]
 PLAN_WEIGHT, FLY_WEIGHT = 3.0, 1.0
 #: The bar's span for :func:`plan_show` (the rest: reading the input, writing files).
 SHOW_START, SHOW_END = 0.05, 0.9
-#: Each solve of a drone's route (mission.py logs one per stretch or re-segmentation)
+#: Each solve of a drone's route (the planning logs one per timing tried or re-segmentation)
 #: moves the bar this fraction of the way to the end of the drone's share: how many
 #: solves a drone takes is not known in advance, so the bar slows, never stops or jumps back.
 SOLVE_STEP = 0.35
@@ -260,7 +260,7 @@ def _plan_show(
 
 
 class _SolveHandler(logging.Handler):
-    """Passes each of mission.py's per-solve DEBUG records to a callback, as its message."""
+    """Passes each of the planning's per-solve DEBUG records to a callback, as its message."""
 
     def __init__(self, callback: Callable[[str], None]) -> None:
         super().__init__(logging.DEBUG)
