@@ -43,6 +43,10 @@ POLISH_WITHIN = 1.2
 #: rise (<= L amax^2 / 2 g^2) vertically, and each pass shrinks what is left by
 #: about that ratio again, so two leave well under 0.1 mm.
 TIP_POLISH_PASSES = 2
+#: Samples per stroke of the deviation that decides whether to polish (against
+#: :data:`POLISH_WITHIN` tolerances): a gate, not the plan's fidelity (that is
+#: measured on the ink, :func:`fidelity`), so a quarter of the usual 400.
+GATE_SAMPLES = 100
 #: The re-segmentation ends at a step that lowers the jerk cost by less than this
 #: fraction. Measured on 职 from a home: three steps take it from 250.7 to 213.4,
 #: then the home leg's speed limit holds every step to ~1e-6 s and five more
@@ -173,7 +177,12 @@ def plan_at(
     fit = solve(problem, workspace=samples.workspace)
     windows = pen_windows(samples.roles, times, len(samples.strokes_world))
     first = measure_deviation(
-        fit.trajectory, windows, samples.strokes_world, opts.brush.length_m, plane=board
+        fit.trajectory,
+        windows,
+        samples.strokes_world,
+        opts.brush.length_m,
+        GATE_SAMPLES,
+        plane=board,
     )
     # The polish moves the tip by the model's second-order part (~0.1 mm in the
     # plane): a plan this far off is stretched without it.

@@ -77,8 +77,12 @@ def route_problem(
         duration=duration,
         smoothness={3: 1.0},
         deviations=deviations + plane_terms(samples.roles, times, board, opts),
-        boundary=_boundary(samples, targets, opts.degree),
-        limits=opts.derivative_limits(),
+        # The same objects for every solve of the route (re-segmentation, the ladder):
+        # built and checked once, and the engine's caches know them by identity.
+        boundary=samples.workspace.memo(
+            "boundary", (targets,), lambda: _boundary(samples, targets, opts.degree)
+        ),
+        limits=samples.workspace.memo("limits", (opts,), opts.derivative_limits),
     )
 
 

@@ -211,6 +211,22 @@ class AssemblyCache:
             self._band = (matrix, k, build(matrix, k))
         return self._band[2]
 
+    def local_bases(self, problem: SmoothingProblem, times: list[FloatArray]) -> list[LocalBasis]:
+        """:meth:`local_basis` of several terms' ``times`` at once (one evaluation for
+        those not kept yet: the terms of a writing route are four views of its samples)."""
+        key = (problem.alpha, problem.degree, problem.n_ctrl)
+        held = [self._local.get((id(t), *key)) for t in times]
+        missing = [t for t, h in zip(times, held, strict=True) if h is None or h[0] is not t]
+        if missing:
+            if len(self._local) + len(missing) > _DESIGN_ENTRIES:
+                self._local.clear()
+            fresh = _split_local(
+                local_basis(problem, np.concatenate(missing)), [t.size for t in missing]
+            )
+            for t, local in zip(missing, fresh, strict=True):
+                self._local[(id(t), *key)] = (t, local)
+        return [self.local_basis(problem, t) for t in times]
+
     def fixed(self, problem: SmoothingProblem) -> _Fixed:
         """The time-independent blocks of ``problem``, built or re-used."""
         key = _fixed_key(problem)
@@ -229,6 +245,14 @@ _DESIGN_ENTRIES = 16
 #: Derivatives of the basis kept per term (:meth:`AssemblyCache.local_basis`): the tip's
 #: first-order model needs the acceleration, its time gradient the jerk.
 _LOCAL_ORDERS = 3
+
+
+def _split_local(local: LocalBasis, sizes: list[int]) -> list[LocalBasis]:
+    """``local`` of concatenated times cut back into one per part of ``sizes``."""
+    cuts = np.cumsum(sizes)[:-1]
+    firsts = np.split(local.first, cuts)
+    values = np.split(local.values, cuts, axis=1)
+    return [LocalBasis(f, v) for f, v in zip(firsts, values, strict=True)]
 
 
 def local_basis(problem: SmoothingProblem, times: FloatArray) -> LocalBasis:
@@ -386,6 +410,23 @@ def curve_at(
     width = local.values.shape[2]
     gathered = C[local.first[:, None] + np.arange(width)]  # (N, k + 1, d)
     return np.asarray(np.einsum("nr,nrd->nd", local.values[order], gathered))
+
+
+def curves_at(
+    problem: SmoothingProblem,
+    times: FloatArray,
+    C: FloatArray,
+    orders: int,
+    cache: AssemblyCache | None = None,
+) -> FloatArray:
+    """The ``s``-derivatives ``0 .. orders - 1`` of the curve of ``C`` at ``times``:
+    (orders, N, d), from one gather of the control points (:func:`curve_at`'s)."""
+    local = cache.local_basis(problem, times) if cache is not None else local_basis(problem, times)
+    if orders > local.values.shape[0]:
+        return np.stack([curve_at(problem, times, C, n, cache) for n in range(orders)])
+    width = local.values.shape[2]
+    gathered = C[local.first[:, None] + np.arange(width)]  # (N, k + 1, d)
+    return np.asarray(np.einsum("onr,nrd->ond", local.values[:orders], gathered))
 
 
 def point_model(

@@ -95,7 +95,7 @@ def banded_closed_form(
     terms = [t for t in problem.deviations if isinstance(t, PointDeviation) and t.weight > 0]
     if not terms:
         return None  # a smoothness cost alone is singular but for the equalities
-    locals_ = [cache.local_basis(problem, t.times) for t in terms]
+    locals_ = cache.local_bases(problem, [t.times for t in terms])
     F = np.zeros((M, d))
     C = np.zeros((M, d))
     Y = np.zeros((fixed.E.shape[0], d))
@@ -110,9 +110,8 @@ def banded_closed_form(
         )
         band = smooth + _gram_band(first, rows, weights, M)
         F[:, axes] = -2.0 * _transpose_times(first, rows * weights[:, None], points[:, axes], M)
-        try:
-            factor = scipy.linalg.cholesky_banded(band, lower=False, check_finite=False)
-        except np.linalg.LinAlgError:
+        factor, info = scipy.linalg.lapack.dpbtrf(band, lower=0)
+        if info != 0:
             return None  # not positive definite: the KKT route decides
         pivots = factor[-1] ** 2
         if not pivots.min() >= MIN_PIVOT_RATIO * pivots.max():
@@ -168,7 +167,9 @@ def _solve(
 ) -> tuple[FloatArray, FloatArray] | None:
     """``C`` (M, g) and ``Y`` (m, g) of ``min C'GC + F'C s.t. E C = e`` from ``G = U'U``."""
     m = E.shape[0]
-    W = scipy.linalg.cho_solve_banded((factor, False), np.hstack([F, E.T]), check_finite=False)
+    W, info = scipy.linalg.lapack.dpbtrs(factor, np.hstack([F, E.T]), lower=0)
+    if info != 0:
+        return None
     W_F, W_E = 0.5 * W[:, : F.shape[1]], 0.5 * W[:, F.shape[1] :]  # (2G)^-1 F, (2G)^-1 E'
     if m == 0:
         return -W_F, np.zeros((0, F.shape[1]))

@@ -189,20 +189,21 @@ class ClampedUniformBasis:
         scipy.sparse.csr_array, shape (M - order, M)
         """
         self._check_order(order)
-        return self._derivative_maps[order]
-
-    @cached_property
-    def _derivative_maps(self) -> tuple[sp.csr_array, ...]:
-        maps = [sp.csr_array(sp.eye_array(self.n_ctrl, format="csr"))]
+        maps = self._derivative_maps
         knots = self.knots
-        for j in range(1, self.degree + 1):
+        # Built up to the order asked for (a problem needs those of its limits and cost).
+        for j in range(len(maps), order + 1):
             p = self.degree - j + 1  # degree before this differentiation
             m = self.n_ctrl - j + 1  # control points before it
             t = knots[j - 1 : len(knots) - j + 1]
             scale = p / (t[p + 1 : p + m] - t[1:m])  # eq. (34): k / (s_{i+k+1} - s_{i+1})
             step = sp.diags_array([-scale, scale], offsets=[0, 1], shape=(m - 1, m), format="csr")  # type: ignore[call-overload]  # scipy-stubs reject a list of float arrays
             maps.append(sp.csr_array(step @ maps[-1]))
-        return tuple(maps)
+        return maps[order]
+
+    @cached_property
+    def _derivative_maps(self) -> list[sp.csr_array]:
+        return [sp.csr_array(sp.eye_array(self.n_ctrl, format="csr"))]
 
     def end_rows(self, order: int) -> tuple[FloatArray, FloatArray]:
         """First and last rows of :meth:`derivative_map`, dense, each (M,): the
