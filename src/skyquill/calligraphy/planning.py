@@ -15,6 +15,7 @@ import logging
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import NDArray
 
 from skyquill.calligraphy.board import Board
 from skyquill.calligraphy.fidelity import (
@@ -27,6 +28,7 @@ from skyquill.calligraphy.fidelity import (
 from skyquill.calligraphy.options import WritingOptions
 from skyquill.calligraphy.problem import route_problem
 from skyquill.calligraphy.route import RouteSamples
+from skyquill.calligraphy.timing import writing_span
 from skyquill.errors import InfeasibleError
 from skyquill.optimize import SmoothingProblem, resegment, solve
 from skyquill.optimize.solve import FitResult
@@ -149,6 +151,7 @@ def resegmented(
             workspace=samples.workspace,
             interior=True,  # each conic solve costs 10-50 closed forms
             ftol=RESEGMENT_FTOL,
+            frozen=_legs_frozen(samples),
         )
     except InfeasibleError:
         return plan
@@ -160,6 +163,16 @@ def resegmented(
     if new.deviation.max_m > max(opts.tolerance, plan.deviation.max_m):
         return plan
     return new
+
+
+def _legs_frozen(samples: RouteSamples) -> NDArray[np.bool_]:
+    """The route's segments on the legs from and to home (N - 1,): their timing stays."""
+    first, last = writing_span(samples.roles, samples.legs)
+    frozen = np.zeros(samples.points.shape[0] - 1, dtype=bool)
+    frozen[:first] = frozen[last:] = True
+    if samples.lead_in is not None:  # a continuing flight's braking keeps its timing
+        frozen[: samples.lead_in.size - 1] = True
+    return frozen
 
 
 def plan_at(

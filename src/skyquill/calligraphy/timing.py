@@ -166,6 +166,12 @@ def route_times(
     return np.concatenate([[0.0], np.cumsum(steps)])
 
 
+def writing_span(roles: FloatArray, legs: tuple[int, int] | None = None) -> tuple[int, int]:
+    """The samples ``(first, last)`` between which a route writes: ``legs`` if given,
+    else found from the roles (:func:`route_times`); before and after, the legs."""
+    return legs if legs is not None else _legs(roles, contact_runs(roles == LIFT))
+
+
 def _legs(roles: FloatArray, lifts: list[tuple[int, int]]) -> tuple[int, int]:
     """Where the legs from and to home end and start: above the first and last
     stroke, or with no lifts (a sky board) on them."""
