@@ -39,6 +39,18 @@ adaptive grid, which ``plan_speed`` solves, and a uniform one):
    velocity constraint is per axis, ours on the norm; so only the per-axis
    acceleration limit binds), same 2,001-point uniform grid: duration ratio and
    solve-time ratio (``TOPPRA(...).compute_trajectory`` vs ``plan_speed``).
+5. ``scaling`` (issue 27 part 3): ``plan_speed`` (default: the reachability
+   passes without jerk, refinement on) against toppra on the same path and
+   grid, 500 to 32,000 points, interleaved (toppra, ours, toppra, ...), medians
+   of :data:`SCALE_RUNS`: ``speed_norm`` (vmax 3 m/s as the speed: toppra gets
+   the equivalent per-axis bounds ``vmax |C'_i| / |C'|`` through
+   ``JointVelocityConstraintVarying``; amax 5 m/s^2 per axis for both) and
+   ``acceleration_only`` (vmax 100 m/s); the grid LP (``method="lp"``) as
+   the reference up to :data:`LP_MAX_POINTS`; with jerk (jmax 3 m/s^3, the
+   pseudo-jerk LP, the only jerk method) up to :data:`JERK_MAX_POINTS`.
+   Log-log slopes from 2,000 to 32,000 points, time ratios ours / toppra,
+   duration ratios.  Goals: ours <= toppra at 32,000 points, slope <= 1.1,
+   jerk on <= 3x jerk off.
 """
 
 from __future__ import annotations
@@ -52,6 +64,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from rich.progress import track
 from threadpoolctl import threadpool_info, threadpool_limits
 
 from common import jsonable, machine_info, time_calls, time_stats, toppra_path
@@ -79,6 +92,17 @@ VMAX, AMAX, JMAX = 3.0, 5.0, 3.0
 N = 2000
 DELTAS = (1.0, 0.3)
 TARGETS = {"lp_s": 0.100, "plan_s": 0.5, "max_excess": 0.02}
+SCALE_POINTS = (500, 1000, 2000, 4000, 8000, 16000, 32000)
+SCALE_RUNS = 3
+#: The grid LP is timed as the reference up to this many points (52 s at 32,000).
+LP_MAX_POINTS = 8000
+#: The jerk-limited plan (pseudo-jerk LP) is timed up to this many points (85 s at 32,000).
+JERK_MAX_POINTS = 8000
+SCALE_GOALS = {
+    "time_ratio_ours_over_toppra_at_32000": 1.0,
+    "slope_2000_32000": 1.1,
+    "jerk_on_over_jerk_off": 3.0,
+}
 
 
 def spiral(delta: float) -> Any:
@@ -262,9 +286,105 @@ def toppra_case(curve: Any, runs: int) -> dict[str, Any] | None:
     }
 
 
+def _toppra_solver(curve: Any, n: int, vmax: float) -> Callable[[], float] | None:
+    """toppra on ``curve``'s ``n``-point grid: the speed norm ``vmax`` (as equivalent per-axis
+    bounds along the path) and ``AMAX`` per axis; returns a call giving the duration."""
+    path = toppra_path(curve)
+    if path is None:
+        return None
+    import toppra.algorithm as algo
+    from toppra import constraint
+
+    def vlim(s: float) -> Any:
+        c1 = np.asarray(curve(min(max(float(s), 0.0), 1.0), 1), dtype=float)
+        bound = vmax * np.abs(c1) / max(float(np.linalg.norm(c1)), 1e-300) + 1e-9
+        return np.column_stack([-bound, bound])
+
+    speed = (
+        constraint.JointVelocityConstraint(np.array([[-vmax, vmax]] * 2))
+        if vmax >= 100.0
+        else constraint.JointVelocityConstraintVarying(vlim)
+    )
+    accel = constraint.JointAccelerationConstraint(np.array([[-AMAX, AMAX]] * 2))
+    grid = np.linspace(0.0, 1.0, n)
+
+    def run() -> float:
+        inst = algo.TOPPRA([speed, accel], path, gridpoints=grid,
+                           parametrizer="ParametrizeConstAccel")  # fmt: skip
+        return float(inst.compute_trajectory(0, 0).duration)
+
+    return run
+
+
+def _interleaved(calls: dict[str, Callable[[], Any]], runs: int) -> dict[str, Any]:
+    """Each call once untimed, then ``runs`` rounds of one timed call each, in turn."""
+    out = {name: fn() for name, fn in calls.items()}
+    times: dict[str, list[float]] = {name: [] for name in calls}
+    for _ in range(runs):
+        for name, fn in calls.items():
+            t, out[name] = time_calls(fn, 1)
+            times[name].append(float(t[0]))
+    return {"median_s": {k: float(np.median(v)) for k, v in times.items()}, "results": out}
+
+
+def _slope(points: list[int], seconds: list[float], low: int = 2000) -> float:
+    keep = [k for k, n in enumerate(points) if n >= low]
+    x = np.log([points[k] for k in keep])
+    return float(np.polyfit(x, np.log([seconds[k] for k in keep]), 1)[0])
+
+
+def scaling_case(runs: int, points: tuple[int, ...]) -> dict[str, Any]:
+    """Case 5: the default planner against toppra (and the LP, and with jerk) by grid size."""
+    curve = spiral(1.0)
+    rows: list[dict[str, Any]] = []
+    for n in track(points, description="scaling"):
+        row: dict[str, Any] = {"grid_points": n}
+        for label, vmax in (("speed_norm", VMAX), ("acceleration_only", 100.0)):
+            calls: dict[str, Callable[[], Any]] = {
+                "ours": lambda v=vmax, k=n: plan_speed(curve, v, AMAX, None, n=k)
+            }
+            peer = _toppra_solver(curve, n, vmax)
+            if peer is not None:
+                calls["toppra"] = peer
+            if n <= LP_MAX_POINTS:
+                calls["lp"] = lambda v=vmax, k=n: plan_speed(curve, v, AMAX, None, n=k, method="lp")
+            got = _interleaved(calls, runs)
+            med, res = got["median_s"], got["results"]
+            entry: dict[str, Any] = {"median_s": med, "ours_duration_s": res["ours"].duration,
+                                     "ours_method": res["ours"].method}  # fmt: skip
+            if "toppra" in med:
+                entry["toppra_duration_s"] = res["toppra"]
+                entry["time_ratio_ours_over_toppra"] = med["ours"] / med["toppra"]
+                entry["duration_ratio_ours_over_toppra"] = res["ours"].duration / res["toppra"]
+            if "lp" in med:
+                entry["lp_duration_s"] = res["lp"].duration
+                entry["duration_ratio_ours_over_lp"] = res["ours"].duration / res["lp"].duration
+                entry["time_ratio_lp_over_ours"] = med["lp"] / med["ours"]
+            row[label] = entry
+        if n <= JERK_MAX_POINTS:
+            jerk = {"jerk": lambda k=n: plan_speed(curve, VMAX, AMAX, JMAX, n=k)}
+            got = _interleaved(jerk, runs)
+            row["jerk_on"] = {
+                "median_s": got["median_s"]["jerk"],
+                "duration_s": got["results"]["jerk"].duration,
+                "over_jerk_off": got["median_s"]["jerk"] / row["speed_norm"]["median_s"]["ours"],
+            }
+        rows.append(row)
+    ns = [r["grid_points"] for r in rows]
+    slopes = {
+        f"{label}_{who}": _slope(ns, [r[label]["median_s"][who] for r in rows])
+        for label in ("speed_norm", "acceleration_only")
+        for who in ("ours", "toppra")
+        if all(who in r[label]["median_s"] for r in rows)
+    }
+    return {"id": "scaling", "goals": SCALE_GOALS, "rows": rows, "loglog_slope_2000_up": slopes}
+
+
 def print_summary(out: dict[str, Any]) -> None:
     for e in out["cases"]:
-        if e["id"].startswith("lp_first_jerk"):
+        if e["id"] == "scaling":
+            print_scaling(e)
+        elif e["id"].startswith("lp_first_jerk"):
             print(f"{e['id']:<44} highspy {1e3 * e['highspy']['median_s']:8.1f} ms")
         elif e["id"].startswith("lp_"):
             print(
@@ -287,17 +407,44 @@ def print_summary(out: dict[str, Any]) -> None:
             )
 
 
+def print_scaling(case: dict[str, Any]) -> None:
+    """One line per grid size: ours and toppra, both cases; jerk on."""
+    for r in case["rows"]:
+        line = f"n={r['grid_points']:>6}"
+        for label in ("speed_norm", "acceleration_only"):
+            e = r[label]
+            line += f"  {label}: ours {e['median_s']['ours']:.3f} s"
+            if "toppra" in e["median_s"]:
+                ratio = e["time_ratio_ours_over_toppra"]
+                line += f" toppra {e['median_s']['toppra']:.3f} s (x{ratio:.2f})"
+            if "lp" in e["median_s"]:
+                line += f" lp {e['median_s']['lp']:.3f} s"
+        if "jerk_on" in r:
+            line += (
+                f"  jerk on {r['jerk_on']['median_s']:.3f} s (x{r['jerk_on']['over_jerk_off']:.1f})"
+            )
+        print(line)
+    print(f"log-log slopes from 2,000 points: {case['loglog_slope_2000_up']}")
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--quick", action="store_true", help="3 timed runs per measurement")
     parser.add_argument("--out", type=Path, default=None, help="JSON output path")
+    parser.add_argument(
+        "--scaling-only", action="store_true", help="only case 5 (merged into the JSON)"
+    )
     args = parser.parse_args(argv)
     runs = 3 if args.quick else MIN_RUNS
     out_path: Path = args.out or (QUICK_RESULTS if args.quick else RESULTS)
     wall = time.perf_counter()
     entries: list[dict[str, Any]] = []
+    points = SCALE_POINTS[:3] if args.quick else SCALE_POINTS
     with threadpool_limits(limits=1):
         blas = threadpool_info()
+        if args.scaling_only:
+            return _scaling_only(out_path, runs, points)
+        entries.append(scaling_case(SCALE_RUNS if not args.quick else 1, points))
         for grid in ("adaptive", "uniform"):
             entries += lp_cases(spiral(1.0), runs, grid)
         for delta in DELTAS:
@@ -321,6 +468,19 @@ def main(argv: list[str] | None = None) -> int:
     out_path.write_text(json.dumps(jsonable(out), indent=2) + "\n")
     print_summary(out)
     print(f"wrote {out_path} in {out['total_wall_s']:.1f} s")
+    return 0
+
+
+def _scaling_only(out_path: Path, runs: int, points: tuple[int, ...]) -> int:
+    """Case 5 alone, replacing its entry in an existing results file."""
+    case = scaling_case(min(runs, SCALE_RUNS), points)
+    out = json.loads(out_path.read_text()) if out_path.exists() else {"schema": 1, "cases": []}
+    out["cases"] = [c for c in out["cases"] if c.get("id") != "scaling"] + [case]
+    out["scaling_generated_utc"] = datetime.now(UTC).isoformat(timespec="seconds")
+    out["scaling_machine"] = machine_info(("scipy", "highspy", "toppra"))
+    out_path.write_text(json.dumps(jsonable(out), indent=2) + "\n")
+    print_scaling(case)
+    print(f"wrote {out_path}")
     return 0
 
 

@@ -1,10 +1,13 @@
 """skyquill: aerial drawing and painting with quadrotors.
 
 The public surface of the trajectory engine is re-exported here; see the
-README for a tour.
+documentation site (``docs/``, ``make docs``) for a tour.
 """
+
+from importlib.metadata import version
 
 from skyquill.errors import InfeasibleError, InputError, SkyquillError, SolverError
 
 __all__ = ["InfeasibleError", "InputError", "SkyquillError", "SolverError"]
-__version__ = "0.1.0"
+# One version, pyproject.toml's, as installed (what ``skyquill --version`` prints).
+__version__ = version("skyquill")

@@ -6,7 +6,8 @@ import pytest
 from shapely.geometry import box
 
 from skyquill.coverage.paths import contours, zigzag
-from skyquill.coverage.plan import CoverageOptions, _fitting_epsilons, plan_coverage, plan_tuned
+from skyquill.coverage.plan import CoverageOptions, plan_coverage, plan_tuned
+from skyquill.coverage.plan.tuning import _fitting_epsilons
 from skyquill.coverage.regions import MAX_PATH_LENGTH_M, check_width, estimate_path_length
 from skyquill.errors import InputError
 

@@ -11,13 +11,12 @@ from hypothesis import HealthCheck, given, settings
 from shapely.geometry import box
 
 from skyquill.coverage.deadline import Deadline, check_time_limit, is_time_limit
-from skyquill.coverage.paths import merge_close
+from skyquill.coverage.paths import merge_close, spiral_curve
 from skyquill.coverage.plan import (
     CoverageOptions,
     covering_waypoints,
     plan_coverage,
     plan_tuned,
-    spiral_curve,
 )
 from skyquill.coverage.regions import region_from_vertices
 from skyquill.errors import InfeasibleError, InputError, SkyquillError

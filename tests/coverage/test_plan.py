@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import time
+
 import numpy as np
 import pytest
 import shapely
@@ -10,7 +12,7 @@ from hypothesis import HealthCheck, Phase, given, settings
 from hypothesis import strategies as st
 from shapely.geometry import MultiPoint, Polygon
 
-from skyquill.coverage.plan import CoverageOptions, plan_coverage, tune_coverage
+from skyquill.coverage.plan import CoverageOptions, plan_coverage, plan_tuned, tune_coverage
 from skyquill.coverage.regions import region_from_vertices
 from skyquill.errors import InfeasibleError, InputError
 from skyquill.limits import VehicleLimits
@@ -205,3 +207,12 @@ def test_norm_limits_hold_as_norms(pattern: str) -> None:
     box = plan_coverage(region, CoverageOptions(pattern=pattern, limits=PAPER_LIMITS))  # type: ignore[arg-type]
     assert box.limits["max_excess"] <= 0.02
     assert box.duration <= plan.duration
+
+
+def test_planning_time_counts_every_candidate() -> None:
+    # The tuning plans several candidates and estimates; the summary counts them all.
+    region = region_from_vertices([[0, 0], [12, 0], [12, 8], [0, 8]])
+    start = time.perf_counter()
+    plan = plan_tuned(region, CoverageOptions(), 0.97)
+    wall = time.perf_counter() - start
+    assert wall * 0.95 <= plan.planning_time <= wall

@@ -4,11 +4,14 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from ruckig import InputParameter, Ruckig, Trajectory
 
 from skyquill.errors import InputError
 from skyquill.limits import vehicle_limits
-from skyquill.optimize.legs import LegLimits, leg_pieces, stop_and_go
+from skyquill.optimize.legs import LegLimits, leg_pieces, legs_pieces, stop_and_go
+from skyquill.trajectory import PiecewisePolynomial
 from skyquill.verify import verify
 
 
@@ -108,3 +111,48 @@ def test_bad_input() -> None:
         stop_and_go(np.eye(3)[:, :2], [LegLimits(1.0, 1.0, 1.0)])
     with pytest.raises(InputError, match="vmax"):
         stop_and_go(np.eye(2), LegLimits(-1.0, 1.0, 1.0))
+
+
+def _one_by_one(length: float, v: float, a: float, j: float, speeds: tuple[float, float]) -> float:
+    """Ruckig called for one 1-D leg on its own: the reference for the batched call."""
+    inp = InputParameter(1)
+    inp.current_position, inp.current_velocity = [0.0], [speeds[0]]
+    inp.target_position, inp.target_velocity = [length], [speeds[1]]
+    inp.max_velocity, inp.max_acceleration, inp.max_jerk = [v], [a], [j]
+    out = Trajectory(1)
+    Ruckig(1).calculate(inp, out)
+    return float(out.duration)
+
+
+@settings(max_examples=25, deadline=None)
+@given(st.integers(1, 40), st.integers(0, 2**32 - 1), st.booleans())
+def test_batched_legs_are_the_legs_timed_one_by_one(k: int, seed: int, per_axis: bool) -> None:
+    rng = np.random.default_rng(seed)
+    starts, ends = rng.uniform(-20, 20, (k, 3)), rng.uniform(-20, 20, (k, 3))
+    lims = [
+        LegLimits(
+            float(rng.uniform(0.5, 5)),
+            rng.uniform(0.5, 5, 3) if per_axis else float(rng.uniform(0.5, 5)),
+            rng.uniform(1, 20, 3) if per_axis else float(rng.uniform(1, 20)),
+            per_axis=per_axis,
+        )
+        for _ in range(k)
+    ]
+    speeds = rng.uniform(0, 1, (k, 2)) * np.array([[lim.vmax for lim in lims]]).T
+    legs = legs_pieces(starts, ends, lims, speeds)
+    for i in range(k):
+        u = (ends[i] - starts[i]) / np.linalg.norm(ends[i] - starts[i])
+        ref = _one_by_one(
+            float(np.linalg.norm(ends[i] - starts[i])), *lims[i].along(u), tuple(speeds[i])
+        )
+        assert legs.leg_durations[i] == pytest.approx(ref, rel=1e-12, abs=1e-12)
+    # The phases chain into each leg's end, at its end speed.
+    ends_at = np.cumsum(legs.durations)
+    traj = PiecewisePolynomial(np.r_[0.0, ends_at], legs.coeffs)
+    leg_ends = np.cumsum(legs.leg_durations)
+    last_piece = np.searchsorted(ends_at, leg_ends - 1e-12)
+    for i, piece in enumerate(last_piece):
+        tau = legs.durations[piece]
+        c = traj.coeffs[piece]
+        end = c[0] + tau * (c[1] + tau * (c[2] + tau * c[3]))
+        assert np.allclose(end, ends[i], atol=1e-9 * 40)

@@ -73,3 +73,10 @@ def test_empty_text(text: str) -> None:
 def test_missing_characters_are_named() -> None:
     with pytest.raises(InputError, match=r"characters 'éø' \(U\+00E9, U\+00F8\) are not in"):
         text_strokes("Héllø")
+
+
+def test_missing_glyphs_names_what_the_font_cannot_write() -> None:
+    from skyquill.strokes.hershey import missing_glyphs
+
+    assert missing_glyphs("Hello, world!\n42") == ""
+    assert missing_glyphs("é😀aé") == "é😀"

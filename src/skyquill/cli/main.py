@@ -82,8 +82,34 @@ def upload_target(name: str | None) -> UploadTarget | None:
     return TARGETS[name]
 
 
+def installed_version() -> str:
+    """skyquill's version as installed (the package metadata, i.e. ``pyproject.toml``)."""
+    from importlib.metadata import version
+
+    return version("skyquill")
+
+
+def _print_version(asked: bool) -> None:
+    if asked:
+        typer.echo(f"skyquill {installed_version()}")
+        raise typer.Exit()
+
+
 @app.callback()
-def main(verbose: Annotated[bool, typer.Option("--verbose", "-v")] = False) -> None:
+def main(
+    verbose: Annotated[
+        bool, typer.Option("--verbose", "-v", help="Log what the planners do (INFO level).")
+    ] = False,
+    version: Annotated[
+        bool,
+        typer.Option(
+            "--version",
+            help="Print the installed version and exit.",
+            callback=_print_version,
+            is_eager=True,
+        ),
+    ] = False,
+) -> None:
     """skyquill: aerial drawing and painting with quadrotors."""
     logging.basicConfig(level=logging.INFO if verbose else logging.WARNING)
 

@@ -16,11 +16,12 @@ scalar profile's own limits) or per-axis boxes, which along ``d`` become
 
 from __future__ import annotations
 
+import threading
 from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from ruckig import InputParameter, Result, Ruckig, Trajectory
+from ruckig import InputParameter, Result, Ruckig, Synchronization, Trajectory
 
 from skyquill.errors import InputError, SolverError
 from skyquill.trajectory import PiecewisePolynomial
@@ -69,7 +70,8 @@ def leg_pieces(
     """The time-optimal straight move from ``start`` to ``end`` (d,) as cubic pieces.
 
     ``speeds`` are the speeds along the move at its start and end, m/s (rest to
-    rest by default; a coverage lane enters and leaves at speed).
+    rest by default; a coverage lane enters and leaves at speed). One leg of
+    :func:`legs_pieces`, which times many legs in one call.
 
     Returns
     -------
@@ -78,32 +80,159 @@ def leg_pieces(
     coeffs : numpy.ndarray, shape (P, 4, d)
         Power-basis coefficients of each phase in local time, lowest first.
     """
-    length = float(np.linalg.norm(end - start))
-    direction = (end - start) / length
-    vmax, amax, jmax = limits.along(direction)
-    inp = InputParameter(1)
-    inp.current_position, inp.current_velocity = [0.0], [speeds[0]]
-    inp.target_position, inp.target_velocity = [length], [speeds[1]]
-    inp.max_velocity = [vmax]
-    inp.max_acceleration = [amax]
-    inp.max_jerk = [jmax]
-    profile = Trajectory(1)
-    result = Ruckig(1).calculate(inp, profile)
+    legs = legs_pieces(
+        np.asarray(start, dtype=float)[None],
+        np.asarray(end, dtype=float)[None],
+        [limits],
+        np.asarray([speeds], dtype=float),
+    )
+    return legs.durations, legs.coeffs
+
+
+@dataclass(frozen=True)
+class Legs:
+    """Straight legs, each time-optimal, as the cubic phases of their profiles.
+
+    Attributes
+    ----------
+    durations
+        Phase durations of every leg in turn, shape (P,), s (zero-length phases dropped).
+    coeffs
+        Power-basis coefficients of each phase in its local time, lowest first, (P, 4, d).
+    leg_durations
+        Each leg's duration, shape (K,), s.
+    """
+
+    durations: FloatArray
+    coeffs: FloatArray
+    leg_durations: FloatArray
+
+
+def legs_pieces(
+    starts: FloatArray,
+    ends: FloatArray,
+    limits: Sequence[LegLimits],
+    speeds: FloatArray | None = None,
+) -> Legs:
+    """Time ``K`` straight legs at once: Ruckig calls with a degree of freedom per leg.
+
+    Each leg is a scalar move along its own direction; Ruckig's unsynchronised mode
+    (``Synchronization.No``) gives every degree of freedom its own time-optimal profile,
+    the same as ``K`` one-dimensional calls. Crossing into Ruckig and building its objects
+    is what cost 24 us a leg when legs were timed one by one: here the objects are built
+    once per thread and block size (:func:`_ruckig`) and reused, and a block of up to
+    :data:`BLOCK` legs is one call. The phases are integrated from Ruckig's durations and
+    jerks as Ruckig integrates them.
+
+    Parameters
+    ----------
+    starts, ends
+        ``(K, d)`` leg ends, m; every leg of positive length.
+    limits
+        One :class:`LegLimits` per leg (checked by the caller).
+    speeds
+        ``(K, 2)`` speeds along each leg at its start and end, m/s (rest by default).
+    """
+    starts, ends = np.asarray(starts, dtype=float), np.asarray(ends, dtype=float)
+    k = starts.shape[0]
+    delta = ends - starts
+    lengths = np.linalg.norm(delta, axis=1)
+    directions = delta / lengths[:, None]
+    bounds = _bounds(limits, directions)
+    v_ends = np.zeros((k, 2)) if speeds is None else np.asarray(speeds, dtype=float)
+    t, jerk = np.empty((k, 7)), np.empty((k, 7))
+    for first in range(0, k, BLOCK):
+        block = slice(first, min(first + BLOCK, k))
+        t[block], jerk[block] = _time_block(lengths[block], v_ends[block], bounds[block])
+    scalar = _integrate(t, jerk, v_ends[:, 0])  # (K, 7, 4) in the leg's own coordinate
+    keep = t > 1e-12  # sub-picosecond phases only add round-off
+    coeffs = scalar[:, :, :, None] * directions[:, None, None, :]
+    coeffs[:, :, 0, :] += starts[:, None, :]
+    return Legs(t[keep], coeffs[keep], t.sum(axis=1))
+
+
+#: Most legs timed in one Ruckig call (the objects of each power-of-two size up to it are kept).
+BLOCK = 256
+_SOLVERS = threading.local()
+
+
+def _ruckig(size: int) -> tuple[InputParameter, Trajectory, Ruckig]:
+    """Ruckig's input, output and generator for ``size`` legs, built once per thread."""
+    cache: dict[int, tuple[InputParameter, Trajectory, Ruckig]] = _SOLVERS.__dict__.setdefault(
+        "by_size", {}
+    )
+    if size not in cache:
+        inp = InputParameter(size)
+        inp.synchronization = Synchronization.No
+        cache[size] = (inp, Trajectory(size), Ruckig(size))
+    return cache[size]
+
+
+def _time_block(
+    lengths: FloatArray, v_ends: FloatArray, bounds: FloatArray
+) -> tuple[FloatArray, FloatArray]:
+    """Phase durations and jerks (k, 7) of up to :data:`BLOCK` legs, in one Ruckig call.
+
+    The call is sized to the next power of two; the spare degrees of freedom carry a
+    unit move that is timed and dropped.
+    """
+    k = lengths.size
+    size = 1 << (k - 1).bit_length()
+    pad = size - k
+    inp, out, otg = _ruckig(size)
+    inp.current_position = [0.0] * size
+    inp.target_position = lengths.tolist() + [1.0] * pad
+    inp.current_velocity = v_ends[:, 0].tolist() + [0.0] * pad
+    inp.target_velocity = v_ends[:, 1].tolist() + [0.0] * pad
+    inp.max_velocity = bounds[:, 0].tolist() + [1.0] * pad
+    inp.max_acceleration = bounds[:, 1].tolist() + [1.0] * pad
+    inp.max_jerk = bounds[:, 2].tolist() + [1.0] * pad
+    result = otg.calculate(inp, out)
     if result != Result.Working:
-        raise SolverError(f"Ruckig failed on a {length:.3g} m leg: {result}")
-    phases = profile.profiles[0][0]
-    keep = np.asarray(phases.t) > 1e-12  # sub-picosecond phases only add round-off
-    scalar = np.column_stack(
-        [
-            np.asarray(phases.p[:-1]),
-            np.asarray(phases.v[:-1]),
-            np.asarray(phases.a[:-1]) / 2.0,
-            np.asarray(phases.j) / 6.0,
-        ]
-    )[keep]
-    coeffs = scalar[:, :, None] * direction[None, None, :]
-    coeffs[:, 0, :] += start
-    return np.asarray(phases.t)[keep], coeffs
+        raise SolverError(f"Ruckig failed on a leg of {lengths.min():.3g} m or more: {result}")
+    phases = out.profiles[0][:k]
+    return np.array([p.t for p in phases]), np.array([p.j for p in phases])
+
+
+def _bounds(limits: Sequence[LegLimits], directions: FloatArray) -> FloatArray:
+    """Speed, acceleration and jerk limits along each leg, (K, 3).
+
+    :meth:`LegLimits.along` for every leg, vectorised over the legs that share one
+    :class:`LegLimits` (usually all of them).
+    """
+    out = np.empty((directions.shape[0], 3))
+    groups: dict[int, list[int]] = {}
+    for i, lim in enumerate(limits):
+        groups.setdefault(id(lim), []).append(i)
+    for rows in groups.values():
+        lim = limits[rows[0]]
+        out[rows, 0] = lim.vmax
+        if lim.per_axis:
+            with np.errstate(divide="ignore"):
+                mag = np.abs(directions[rows])
+                out[rows, 1] = np.min(np.asarray(lim.amax) / mag, axis=1)
+                out[rows, 2] = np.min(np.asarray(lim.jmax) / mag, axis=1)
+        else:
+            out[rows, 1], out[rows, 2] = np.min(lim.amax), np.min(lim.jmax)
+    return out
+
+
+def _integrate(t: FloatArray, jerk: FloatArray, v0: FloatArray) -> FloatArray:
+    """Cubic coefficients (p, v, a/2, j/6) of each constant-jerk phase, (K, 7, 4).
+
+    Each leg starts at position 0 with speed ``v0`` and no acceleration.
+    """
+    out = np.empty((*t.shape, 4))
+    out[:, :, 3] = jerk / 6.0
+    p, v, a = out[:, 0, 0], out[:, 0, 1], out[:, 0, 2]
+    p[:], v[:], a[:] = 0.0, v0, 0.0
+    for i in range(t.shape[1] - 1):
+        dt, j = t[:, i], jerk[:, i]
+        out[:, i + 1, 0] = p + dt * (v + dt * (a + dt * j / 6.0))
+        out[:, i + 1, 1] = v + dt * (2.0 * a + dt * j / 2.0)
+        out[:, i + 1, 2] = a + dt * j / 2.0
+        p, v, a = out[:, i + 1, 0], out[:, i + 1, 1], out[:, i + 1, 2]
+    return out
 
 
 @dataclass(frozen=True)
@@ -140,22 +269,19 @@ def stop_and_go(waypoints: FloatArray, limits: LegLimits | Sequence[LegLimits]) 
     per_leg = [limits] * (pts.shape[0] - 1) if isinstance(limits, LegLimits) else list(limits)
     if len(per_leg) != pts.shape[0] - 1:
         raise InputError(f"limits: got {len(per_leg)}, expected one per leg ({pts.shape[0] - 1})")
-    for lim in per_leg:
+    for lim in {id(lim): lim for lim in per_leg}.values():
         _check(lim, pts.shape[1])
     steps = np.linalg.norm(np.diff(pts, axis=0), axis=1)
     moving = steps > REPEAT_TOLERANCE * max(1.0, float(np.abs(pts).max()))
     if not np.any(moving):
         raise InputError("waypoints: got coincident points, expected a path of positive length")
-    durations, coeffs = [], []
+    idx = np.flatnonzero(moving)
+    legs = legs_pieces(pts[idx], pts[idx + 1], [per_leg[k] for k in idx])
     leg_time = np.zeros(pts.shape[0] - 1)
-    for k in np.flatnonzero(moving):
-        d, c = leg_pieces(pts[k], pts[k + 1], per_leg[k])
-        durations.append(d)
-        coeffs.append(c)
-        leg_time[k] = d.sum()
-    breaks = np.concatenate([[0.0], np.cumsum(np.concatenate(durations))])
+    leg_time[idx] = legs.leg_durations
+    breaks = np.concatenate([[0.0], np.cumsum(legs.durations)])
     arrivals = np.concatenate([[0.0], np.cumsum(leg_time)])
-    return StopAndGo(PiecewisePolynomial(breaks, np.concatenate(coeffs)), arrivals)
+    return StopAndGo(PiecewisePolynomial(breaks, legs.coeffs), arrivals)
 
 
 def _check(limits: LegLimits, dim: int) -> None:

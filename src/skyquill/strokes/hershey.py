@@ -34,6 +34,21 @@ def _load(font: str) -> HersheyFonts:
     return hf
 
 
+def missing_glyphs(text: str, font: str = "futural") -> str:
+    """The characters of ``text`` (line breaks aside) that ``font`` has no glyph for.
+
+    Each once, sorted by code point; ``""`` when :func:`text_strokes` can write all of it.
+    """
+    if not isinstance(text, str):
+        raise InputError(f"text: got {type(text).__name__}, expected a str")
+    return "".join(_missing(text, _load(font)))
+
+
+def _missing(text: str, hf: HersheyFonts) -> list[str]:
+    glyphs = hf.all_glyphs
+    return sorted({c for c in text if c != "\n" and c not in glyphs})
+
+
 def line_extent(font: str = "futural") -> tuple[float, float]:
     """The bottom and top of a line of text, font units, y up from the baseline.
 
@@ -106,7 +121,7 @@ def text_strokes(text: str, font: str = "futural") -> Strokes:
         raise InputError(f"text: got {text!r}, expected at least one visible character")
     hf = _load(font)
     glyphs = hf.all_glyphs
-    missing = sorted({c for c in text if c != "\n" and c not in glyphs})
+    missing = _missing(text, hf)
     if missing:
         codes = ", ".join(f"U+{ord(c):04X}" for c in missing)
         raise InputError(

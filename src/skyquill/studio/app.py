@@ -4,6 +4,9 @@ Routes
 ------
 ``GET /``
     The page (``static/index.html``; its script and style under ``/static``).
+``GET /api/limits``
+    The request's bounds (strokes, points, characters, drones) and the vehicles,
+    which the page states up front and checks before sending.
 ``POST /api/estimate``
     A :class:`~skyquill.studio.models.PlanRequest`; answers its
     :class:`~skyquill.studio.models.Estimate` (route length, flight time,
@@ -22,9 +25,10 @@ Routes
     FastAPI's OpenAPI description (``/docs`` loads Swagger UI's assets from
     its CDN; ``/openapi.json`` works offline).
 
-Errors are JSON ``{"detail": "<one readable line>", "field": <name or null>}``
-(``field``: the request field it is about, for the page to point at): 422 for anything the
-person sent that cannot be planned, 413 for a body over the size limit, 429
+Errors are JSON ``{"detail": "<one readable line>", "field": <name or null>,
+"user_message": "<the same in the page's words>"}`` (``field``: the request field it
+is about, for the page to point at; ``user_message``: :mod:`skyquill.studio.messages`):
+422 for anything the person sent that cannot be planned, 413 for a body over the size limit, 429
 when busy, 404 for an unknown job or file. No route takes a file-system path.
 """
 
@@ -48,7 +52,16 @@ from starlette.types import ASGIApp, Message, Receive, Scope, Send
 from skyquill.errors import SkyquillError
 from skyquill.studio.estimate import estimate
 from skyquill.studio.jobs import BusyError, Job, JobManager
-from skyquill.studio.models import Estimate, JobAccepted, JobStatus, PlanRequest, field_of
+from skyquill.studio.messages import StudioInputError, for_person, validation_message
+from skyquill.studio.models import (
+    Estimate,
+    JobAccepted,
+    JobStatus,
+    PageLimits,
+    PlanRequest,
+    TargetChoice,
+    field_of,
+)
 
 #: Largest request body, bytes: 20,000 points of two 20-character numbers, with room.
 MAX_BODY_BYTES = 1_000_000
@@ -57,6 +70,25 @@ PAGE_CSP = (
     "default-src 'self'; img-src 'self' data: blob:; style-src 'self'; script-src 'self'; "
     "connect-src 'self'; object-src 'none'; base-uri 'none'; frame-ancestors 'none'"
 )
+#: The vehicles the page offers, in its words.
+TARGET_CHOICES = [
+    TargetChoice(
+        name="generic",
+        label="Any drone (setpoint file)",
+        help="Positions, velocities and accelerations 100 times a second, for any flight stack.",
+    ),
+    TargetChoice(
+        name="crazyflie",
+        label="Crazyflie",
+        help="Planned to fit a Crazyflie's trajectory memory: the Crazyswarm files and a fly "
+        "script to download.",
+    ),
+    TargetChoice(
+        name="skybrush",
+        label="Skybrush show",
+        help="A show file for Skybrush Live and Studio, checked as Skybrush plays it.",
+    ),
+]
 #: Validation problems listed in one message before "and N more".
 MAX_LISTED_ERRORS = 4
 
@@ -178,6 +210,11 @@ def _add_routes(app: FastAPI, manager: JobManager) -> None:
         html = resources.files("skyquill.studio").joinpath("static", "index.html")
         return HTMLResponse(html.read_text(encoding="utf-8"))
 
+    @app.get("/api/limits")
+    def limits() -> PageLimits:
+        """What the page states up front: the most strokes, points, characters and drones."""
+        return PageLimits(targets=TARGET_CHOICES)
+
     @app.post(
         "/api/estimate",
         responses={422: {"description": "Malformed request; `detail` says why."}},
@@ -210,7 +247,7 @@ def _add_routes(app: FastAPI, manager: JobManager) -> None:
         await manager.wait(job)
         done = job.status()
         if done.state != "done":
-            raise _UnplannableError(done.message or "the plan did not finish")
+            raise _UnplannableError(done)
         return JSONResponse(done.model_dump(mode="json"))
 
     @app.get("/api/jobs/{job_id}", responses={404: {"description": "Unknown job."}})
@@ -252,18 +289,31 @@ def _job(manager: JobManager, job_id: str) -> Job:
 class _UnplannableError(Exception):
     """A ``?wait=true`` plan that failed: its message goes back as a 422."""
 
+    def __init__(self, job: JobStatus) -> None:
+        super().__init__(job.message or "the plan did not finish")
+        self.job = job
+
 
 def _add_error_handlers(app: FastAPI) -> None:
     async def validation(_: Request, exc: Exception) -> JSONResponse:
         errors = exc.errors() if isinstance(exc, RequestValidationError) else []
         message = describe_errors(errors)
-        return _detail(422, message, field=_field(errors, message), errors=_plain(errors))
+        field = _field(errors, message)
+        person = validation_message(errors)
+        return _detail(422, message, field=field, user_message=person, errors=_plain(errors))
 
     async def user_error(_: Request, exc: Exception) -> JSONResponse:
-        return _detail(422, str(exc), field=field_of(str(exc)))
+        if isinstance(exc, StudioInputError):
+            return _detail(422, str(exc), field=exc.field, user_message=exc.person)
+        if isinstance(exc, _UnplannableError):
+            job = exc.job
+            return _detail(422, str(exc), field=job.field, user_message=job.user_message)
+        field = field_of(str(exc))
+        return _detail(422, str(exc), field=field, user_message=for_person(str(exc), field))
 
     async def busy(_: Request, exc: Exception) -> JSONResponse:
-        return _detail(429, str(exc), headers={"Retry-After": "5"})
+        person = "The studio is busy with other plans; press Plan again in a moment"
+        return _detail(429, str(exc), user_message=person, headers={"Retry-After": "5"})
 
     app.add_exception_handler(RequestValidationError, validation)
     app.add_exception_handler(SkyquillError, user_error)

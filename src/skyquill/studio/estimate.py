@@ -2,42 +2,40 @@
 
 Milliseconds of arithmetic on the route (no solve), so the page can ask on every
 Plan press and warn before a person waits minutes for a 27-minute flight. The
-numbers are lower bounds or rough sizes, said so where they are shown: the
-planner stretches the timing where the limits or the tolerance need it.
+flight time is the timing the planner itself starts from
+(:func:`~skyquill.calligraphy.mission.initial_flight_time`: the route at the
+speed limit, slowing to a stop at corners, the lifts within the jerk limit):
+the plan's duration when it needs no stretch, and what ``bench/studio_estimate.py``
+measures against the planned flights. Warnings are about the chosen vehicle only.
 """
 
 from __future__ import annotations
 
 import math
 
-from skyquill.calligraphy.board import Board
-from skyquill.calligraphy.mission import WritingOptions, route_length
+from skyquill.calligraphy.mission import WritingOptions, initial_flight_time, route_length
 from skyquill.calligraphy.show import layout
 from skyquill.limits import VehicleLimits
-from skyquill.strokes import Strokes
+from skyquill.show.limits import ShowLimits
 from skyquill.studio.models import Estimate, PlanRequest
 from skyquill.studio.planner import CSV_RATE_HZ, SEPARATION_M, parts_of
-from skyquill.targets import CRAZYFLIE
-from skyquill.validation import FloatArray
 
 #: A flight longer than this is worth a second thought, s: paper 000's characters
 #: take well under a minute, and a Crazyflie's battery lasts about seven.
 WARN_FLIGHT_S = 300.0
-#: More Crazyflie uploads than this is a show nobody wants to upload by hand: each
-#: one is a hover and a radio write (a 0.5 m character at 1 m/s needs about five).
+#: More Crazyflie uploads than this is a flight nobody wants to upload by hand: each
+#: one is a hover and a radio write.
 WARN_UPLOADS = 20
 #: Setpoint CSV bytes per row at :data:`~skyquill.studio.planner.CSV_RATE_HZ`
 #: (14 columns of about 10 characters; measured 130-150 on the bundled examples).
 CSV_ROW_BYTES = 150
+#: What Skybrush Studio's safety check allows when a show does not say
+#: (:class:`~skyquill.show.limits.ShowLimits`' defaults).
+SKYBRUSH = ShowLimits()
 
 
 def estimate(request: PlanRequest) -> Estimate:
-    """The longest drone's route, flight time, Crazyflie uploads and the CSVs' size.
-
-    The flight time is the route's length at the speed limit plus, per stroke,
-    a stop and a start at the acceleration limit (``2 vmax / amax``): a lower
-    bound of what the planner returns. Uploads assume the mission spline's knot
-    span every ``WritingOptions.knot_interval`` seconds, one polynomial piece each.
+    """The longest drone's route and flight time, uploads (Crazyflie) and the CSVs' size.
 
     Raises
     ------
@@ -45,49 +43,69 @@ def estimate(request: PlanRequest) -> Estimate:
         The request cannot be turned into strokes (as :func:`parts_of`).
     """
     parts = parts_of(request)
-    options = WritingOptions(
-        size_m=request.size_m, limits=VehicleLimits(request.vmax, request.amax, request.jmax)
-    )
+    limits = VehicleLimits(request.vmax, request.amax, request.jmax)
+    options = WritingOptions(size_m=request.size_m, limits=limits)
     places = layout(len(parts), request.size_m, SEPARATION_M, kind=request.board)
     lengths, times = [], []
     for part, (board, home) in zip(parts, places, strict=True):
-        length = _length(part, options, board, home)
-        lengths.append(length)
-        stops = part.n_strokes * 2.0 * request.vmax / request.amax
-        times.append(length / request.vmax + stops)
+        tip_home = home - options.brush.length_m * board.normal  # the route is the tip's
+        scaled = part.scaled(options.size_m)
+        lengths.append(route_length(tuple(map(board.to_world, scaled.paths)), board, tip_home))
+        times.append(initial_flight_time(part, board, options, home))
     flight = max(times)
-    pieces = math.ceil(flight / options.knot_interval)
-    uploads = math.ceil(pieces / CRAZYFLIE.max_pieces)
+    uploads = None
+    if request.target == "crazyflie":
+        # The planner fits the Crazyflie's memory with one upload when it can, else
+        # cuts where the brush is lifted: at most one upload per stroke, each after a hover.
+        uploads = max(p.n_strokes for p in parts)
     rows = sum(math.ceil(t * CSV_RATE_HZ) + 1 for t in times)
     return Estimate(
+        target=request.target,
         path_length_m=round(max(lengths), 3),
         flight_time_s=round(flight, 1),
         crazyflie_uploads=uploads,
         setpoint_bytes=rows * CSV_ROW_BYTES,
-        warnings=_warnings(flight, uploads, max(lengths), request.vmax),
+        warnings=_warnings(request, flight, uploads, max(lengths)),
     )
 
 
-def _length(part: Strokes, options: WritingOptions, board: Board, home: FloatArray) -> float:
-    """One drone's route length, m (:func:`route_length`; ``home`` (3,) is the vehicle's)."""
-    scaled = part.scaled(options.size_m)
-    strokes_world = tuple(board.to_world(path) for path in scaled.paths)
-    tip_home = home - options.brush.length_m * board.normal  # the route is the tip's
-    return route_length(strokes_world, board, tip_home)
-
-
-def _warnings(flight_s: float, uploads: int, length_m: float, vmax: float) -> list[str]:
-    """The thresholds crossed, each with what makes the plan long."""
+def _warnings(
+    request: PlanRequest, flight_s: float, uploads: int | None, length_m: float
+) -> list[str]:
+    """The thresholds crossed for the chosen vehicle, each with what to change in the page."""
     out = []
     if flight_s > WARN_FLIGHT_S:
         out.append(
-            f"a flight of at least {flight_s / 60:.1f} min ({length_m:.1f} m of route at "
-            f"{vmax:g} m/s); more than {WARN_FLIGHT_S / 60:g} min is longer than a battery "
-            "and slow to plan: raise the speed or draw less"
+            f"a flight of about {flight_s / 60:.1f} min ({length_m:.1f} m of route at "
+            f"{request.vmax:g} m/s); more than {WARN_FLIGHT_S / 60:g} min is longer than a "
+            "battery lasts and slow to plan: raise the Speed or draw less"
         )
-    if uploads > WARN_UPLOADS:
+    if uploads is not None and uploads > WARN_UPLOADS:
         out.append(
-            f"about {uploads:,} Crazyflie uploads (more than {WARN_UPLOADS}): each is a hover "
-            "and a radio write"
+            f"up to {uploads:,} Crazyflie uploads (one per stroke when the flight does not fit "
+            f"one), more than {WARN_UPLOADS}: the drone hovers while each is sent; draw fewer "
+            "strokes"
         )
+    if request.target == "skybrush":
+        out.extend(_skybrush_warnings(request))
     return out
+
+
+def _skybrush_warnings(request: PlanRequest) -> list[str]:
+    """Limits above what Skybrush Studio's safety check allows a show by default."""
+    vertical = min(SKYBRUSH.max_speed_up or math.inf, SKYBRUSH.max_speed_down or math.inf)
+    over = []
+    if request.vmax > vertical:
+        over.append(
+            f"Speed {request.vmax:g} m/s (it takes off and lands at up to {vertical:g} m/s, "
+            f"and flies at up to {SKYBRUSH.max_speed_xy:g} m/s)"
+        )
+    if SKYBRUSH.max_acceleration is not None and request.amax > SKYBRUSH.max_acceleration:
+        over.append(f"Acceleration {request.amax:g} m/s² (it allows {SKYBRUSH.max_acceleration:g})")
+    if not over:
+        return []
+    return [
+        "Skybrush Studio's safety check may refuse the show: "
+        + " and ".join(over)
+        + f"; lower them to plan a show it accepts (e.g. Speed {vertical:g})"
+    ]

@@ -36,6 +36,7 @@ from typing import Any
 
 from skyquill.errors import SkyquillError
 from skyquill.studio.estimate import WARN_FLIGHT_S
+from skyquill.studio.messages import StudioInputError, for_person
 from skyquill.studio.models import Estimate, JobState, JobStatus, PlanRequest, field_of
 from skyquill.studio.planner import PlanOutput, run_plan
 
@@ -80,6 +81,9 @@ class Job:
     future: Future[None] | None = None
     estimate: Estimate | None = None
     cancel_requested: bool = False
+    progress_known: bool = True
+    field: str | None = None
+    user_message: str = ""
 
     @property
     def active(self) -> bool:
@@ -100,10 +104,23 @@ class Job:
             progress=self.progress,
             stage=self.stage,
             message=self.message,
-            field=field_of(self.message) if self.state == "error" else None,
+            field=self._error_field(),
+            user_message=self._user_message(),
+            progress_known=self.progress_known,
             elapsed_s=round(end - self.created, 3),
             result=self.output.result if self.output is not None else None,
         )
+
+    def _error_field(self) -> str | None:
+        if self.state != "error":
+            return None
+        return self.field or field_of(self.message)
+
+    def _user_message(self) -> str:
+        """The error in the page's words (the studio's own, else the field's label put in)."""
+        if self.state != "error":
+            return ""
+        return self.user_message or for_person(self.message, self._error_field())
 
 
 class JobManager:
@@ -248,9 +265,13 @@ class JobManager:
                 continue
             kind, *payload = message
             if kind == "progress":
-                job.progress, job.stage = payload
+                job.progress, job.stage, job.progress_known = payload
                 continue
-            self._end(job, kind, *payload)
+            if kind == "error":
+                detail, job.field, job.user_message = payload
+                self._end(job, "error", detail)
+            else:
+                self._end(job, "done", "", payload[0])
             return
 
     def _begin(self, job: Job) -> bool:
@@ -287,7 +308,7 @@ class JobManager:
         if guess is None:
             return f"{limit}; draw or type less, use fewer drones or raise the limits"
         flight = (
-            f"a flight of at least {guess.flight_time_s:,.0f} s "
+            f"a flight of about {guess.flight_time_s:,.0f} s "
             f"({guess.path_length_m:.1f} m of route at {request.vmax:g} m/s)"
         )
         if guess.flight_time_s > WARN_FLIGHT_S:  # long because slow: the speed is the cause
@@ -322,18 +343,21 @@ def _child_main(
 ) -> None:
     """The child process: plan, sending progress and then one end message."""
 
-    def progress(fraction: float, stage: str) -> None:
-        sender.send(("progress", fraction, stage))
+    def progress(fraction: float, stage: str, known: bool = True) -> None:
+        sender.send(("progress", fraction, stage, known))
 
     try:
         output = planner(request, progress=progress, file_url=_file_url(job_id), plan_id=plan_id)
+    except StudioInputError as exc:  # the person's input, in the page's words too
+        sender.send(("error", str(exc), exc.field, exc.person))
     except SkyquillError as exc:  # the person's input: say why, in their terms
-        sender.send(("error", str(exc)))
+        sender.send(("error", str(exc), None, ""))
     except Exception as exc:  # a bug: traceback to the server's log, a short line to the page
         traceback.print_exc()
-        sender.send(("error", f"internal error while planning ({type(exc).__name__}: {exc})"))
+        message = f"internal error while planning ({type(exc).__name__}: {exc})"
+        sender.send(("error", message, None, ""))
     else:
-        sender.send(("done", "", output))
+        sender.send(("done", output))
     finally:
         sender.close()
 

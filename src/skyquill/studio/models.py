@@ -26,6 +26,9 @@ MAX_DRONES = 8
 #: Largest coordinate magnitude of a drawn point, in the page's units.
 MAX_COORDINATE = 1e6
 
+#: The vehicles the page offers (:data:`TARGETS`).
+Target = Literal["generic", "crazyflie", "skybrush"]
+
 Coordinate = Annotated[float, Field(ge=-MAX_COORDINATE, le=MAX_COORDINATE, strict=True)]
 Point = tuple[Coordinate, Coordinate]
 Stroke = Annotated[list[Point], Field(min_length=2, max_length=MAX_STROKE_POINTS)]
@@ -99,6 +102,11 @@ class PlanRequest(BaseModel):
     fly: bool = Field(
         default=True, strict=True, description="Also fly every drone in closed-loop simulation."
     )
+    target: Target = Field(
+        default="generic",
+        description="The vehicle the flight is for: its files, estimates and warnings "
+        "(``crazyflie``: planned to fit its uploads; ``skybrush``: a show file).",
+    )
 
     @model_validator(mode="after")
     def _one_input(self) -> PlanRequest:
@@ -134,6 +142,7 @@ FIELD_LABELS = {
     "amax": "Acceleration, m/s²",
     "jmax": "Jerk, m/s³",
     "fly": "Fly it in simulation",
+    "target": "Vehicle",
     "limits": "Limits",  # not a field: the three limits together (an infeasible plan)
 }
 
@@ -152,19 +161,23 @@ def field_of(message: str) -> str | None:
 
 
 class Estimate(BaseModel):
-    """What a request would plan, from its route alone (no solve): seconds to compute.
+    """What a request would plan, from its route alone (no solve): milliseconds to compute.
 
-    The flight time is a lower bound (the route's length at the speed limit,
-    plus a stop at the acceleration limit per stroke); the planner may stretch
-    it. ``warnings`` are the thresholds it crosses
-    (:data:`~skyquill.studio.planner.WARN_FLIGHT_S`, ...), for a person.
+    The flight time is the timing the planner starts from (its fastest try:
+    :func:`~skyquill.calligraphy.mission.initial_flight_time`); the planner may
+    stretch it. ``warnings`` are about the chosen vehicle only
+    (:data:`~skyquill.studio.estimate.WARN_FLIGHT_S`, ...), for a person.
     """
 
+    target: Target = Field(description="The vehicle the estimate is for.")
     path_length_m: float = Field(description="Longest drone's route (strokes, lifts, legs), m.")
-    flight_time_s: float = Field(description="Longest drone's flight at the limits, at least, s.")
-    crazyflie_uploads: int = Field(description="Crazyflie uploads of the longest drone, about.")
+    flight_time_s: float = Field(description="Longest drone's flight as first timed, s.")
+    crazyflie_uploads: int | None = Field(
+        default=None,
+        description="Crazyflie uploads of the longest drone, at most (target crazyflie only).",
+    )
     setpoint_bytes: int = Field(description="Size of the setpoint CSV(s), about, bytes.")
-    warnings: list[str]
+    warnings: list[str] = Field(description="Thresholds crossed, in the page's words.")
 
 
 class Limits(BaseModel):
@@ -199,14 +212,18 @@ class DronePlan(BaseModel):
     t: list[float] = Field(description="Sample times, s.")
     path: list[tuple[float, float, float]] = Field(description="Planned tip (u, v, h), m.")
     pen: list[int] = Field(description="1 where the pen is down at t, else 0.")
-    speed: list[float] = Field(description="Largest |velocity component| at t, m/s.")
-    acc: list[float] = Field(description="Largest |acceleration component| at t, m/s^2.")
-    jerk: list[float] = Field(description="Largest |jerk component| at t, m/s^3.")
+    speed: list[float] = Field(description="Speed (the velocity's norm) at t, m/s.")
+    acc: list[float] = Field(description="Acceleration norm at t, m/s^2.")
+    jerk: list[float] = Field(description="Jerk norm at t, m/s^3.")
     flight: list[tuple[float, float, float]] = Field(
         description="Simulated tip (u, v, h), m, at the same times (empty if not flown)."
     )
     ink: list[list[tuple[float, float]]] = Field(
         description="What the simulated brush drew on the board, m (horizontal board only)."
+    )
+    ink_t: list[list[float]] = Field(
+        default_factory=list,
+        description="When each point of ``ink`` was laid, s (the page lays the ink as it plays).",
     )
     duration_s: float
     planning_time_s: float
@@ -244,6 +261,7 @@ class PlanResult(BaseModel):
     plan_id: str = Field(description="In every download's name and in summary.json.")
     source: Literal["strokes", "text"]
     board: Literal["horizontal", "wall"]
+    target: Target = "generic"
     size_m: float
     limits: Limits
     duration_s: float
@@ -252,6 +270,25 @@ class PlanResult(BaseModel):
     drones: list[DronePlan]
     files: list[DownloadFile]
     notes: list[str]
+
+
+class TargetChoice(BaseModel):
+    """A vehicle the page offers."""
+
+    name: Target
+    label: str
+    help: str
+
+
+class PageLimits(BaseModel):
+    """What the page states up front and checks before sending: the request's bounds."""
+
+    max_strokes: int = MAX_STROKES
+    max_points: int = MAX_POINTS
+    max_stroke_points: int = MAX_STROKE_POINTS
+    max_text: int = MAX_TEXT
+    max_drones: int = MAX_DRONES
+    targets: list[TargetChoice]
 
 
 class JobAccepted(BaseModel):
@@ -271,6 +308,14 @@ class JobStatus(BaseModel):
     message: str = ""
     field: str | None = Field(
         default=None, description="The request field an error is about (None: no one field)."
+    )
+    user_message: str = Field(
+        default="", description="The error in the page's words (the field as labelled)."
+    )
+    progress_known: bool = Field(
+        default=True,
+        description="False while the stage's length cannot be known in advance (a drone's "
+        "solves): the page then shows the stage, not a fraction.",
     )
     elapsed_s: float
     result: PlanResult | None = None

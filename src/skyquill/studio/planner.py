@@ -23,7 +23,7 @@ import zipfile
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
 
@@ -32,25 +32,54 @@ from skyquill.calligraphy.ink import flight_ink
 from skyquill.calligraphy.mission import Mission, WritingOptions
 from skyquill.calligraphy.show import Show, plan_show
 from skyquill.errors import InfeasibleError, InputError, SolverError
-from skyquill.export import EXPORTERS, ExportOptions
+from skyquill.export import EXPORTERS, ExportOptions, ExportReport
 from skyquill.io.plan_dir import write_plan
 from skyquill.io.trajectory_json import PlannedTrajectory
 from skyquill.limits import VehicleLimits
 from skyquill.strokes import Strokes
-from skyquill.studio.models import DownloadFile, DronePlan, LimitReport, Limits, PlanRequest
+from skyquill.strokes.hanzi import bundled_hanzi, missing_hanzi
+from skyquill.strokes.hershey import missing_glyphs
+from skyquill.strokes.text import is_cjk
+from skyquill.studio.messages import StudioInputError, too_many_drones, unwritable_text
+from skyquill.studio.models import (
+    DownloadFile,
+    DronePlan,
+    LimitReport,
+    Limits,
+    PlanRequest,
+    Target,
+)
 from skyquill.studio.models import PlanResult as PlanResultModel
+from skyquill.targets import CRAZYFLIE
 from skyquill.validation import FloatArray
 
 if TYPE_CHECKING:
     from skyquill.sim import Flight
 
+logger = logging.getLogger(__name__)
+
 #: Smallest distance between two drones at any time, m (``skyquill write``'s default).
 SEPARATION_M = 1.0
 #: Rate of the setpoint CSVs, Hz (``skyquill write``'s default).
 CSV_RATE_HZ = 100.0
-#: The registry's formats the studio offers for download (besides the setpoints): the
-#: name of each format's download.
-STUDIO_FORMATS = {"crazyswarm": "crazyswarm", "skyc": "show"}
+#: The registry's formats the studio offers for download besides the setpoints and the
+#: summary, per vehicle (the page's Vehicle choice): the name of each format's download.
+STUDIO_FORMATS: dict[Target, dict[str, str]] = {
+    "generic": {},
+    "crazyflie": {"crazyswarm": "crazyswarm"},
+    "skybrush": {"skyc": "show"},
+}
+#: What each download is, in the page's words.
+DESCRIPTIONS = {
+    "setpoints": "where the drone should be 100 times a second: position (m), velocity, "
+    "acceleration, jerk, yaw and pen up or down, z up",
+    "crazyswarm": "the Crazyflie's uploads as Crazyswarm2 / cflib polynomial files, and a "
+    "Python script that flies them with cflib",
+    "skyc": "the show for Skybrush Live and Studio, the light on while the pen is down",
+    "summary": "what was asked, planned and checked, as JSON",
+}
+#: Who plays each download, for the notes under the downloads.
+CONSUMERS = {"crazyswarm": "a Crazyflie plays it", "skyc": "Skybrush plays it"}
 #: Content types of the downloads, by suffix.
 CONTENT_TYPES = {".csv": "text/csv", ".skyc": "application/zip", ".json": "application/json"}
 #: Rate of the curves sent to the page, Hz, and the most samples per drone.
@@ -58,11 +87,24 @@ VIEW_RATE_HZ = 50.0
 MAX_VIEW_SAMPLES = 3_000
 #: Most points of one simulated ink polyline sent to the page.
 MAX_INK_POINTS = 600
+#: How near the untilted tip passes an ink run's first point when it lays it, m (the
+#: brush's swing is millimetres), and the steps after that approach searched for it.
+INK_MATCH_M = 0.02
+INK_MATCH_STEPS = 200
 #: Decimals of the numbers sent to the page (0.1 mm, 0.1 ms: far below what is drawn).
 DECIMALS = 4
 
-#: ``progress(fraction, stage)``; it may raise to stop the plan (time limit).
-Progress = Callable[[float, str], None]
+
+class Progress(Protocol):
+    """``progress(fraction, stage, known)``; it may raise to stop the plan (time limit).
+
+    ``known`` is False while the stage's length cannot be known in advance (a
+    drone's solves: how many a drawing needs shows only as they happen).
+    """
+
+    def __call__(self, fraction: float, stage: str, known: bool = True) -> None:
+        """Report ``fraction`` (0 to 1) done, now in ``stage``."""
+
 
 #: Share of the progress bar for planning one drone against flying it: the solves
 #: (stretches, re-segmentation) take about three times the closed-loop flight.
@@ -94,10 +136,23 @@ class PlanOutput:
 
 
 def parts_of(request: PlanRequest) -> list[Strokes]:
-    """What each drone writes: the drawing or the text, shared out in consecutive parts."""
+    """What each drone writes: the drawing or the text, shared out in consecutive parts.
+
+    Raises
+    ------
+    StudioInputError
+        Text the studio cannot write, or more drones than strokes, characters or words.
+    """
     from skyquill.strokes import typed_parts
 
     if request.text is not None:
+        check_text(request.text)
+        chinese = is_cjk(request.text)
+        units = len(
+            [c for c in request.text if not c.isspace()] if chinese else request.text.split()
+        )
+        if units < request.drones:
+            raise too_many_drones(request.drones, units, text=True)
         return typed_parts(request.text, request.drones)  # one scale across drones
     assert request.strokes is not None  # the model guarantees exactly one input
     drawing = Strokes(
@@ -112,15 +167,30 @@ def split_strokes(drawing: Strokes, parts: int) -> list[Strokes]:
     """``drawing`` in ``parts`` consecutive groups of whole strokes (one per drone)."""
     n = drawing.n_strokes
     if n < parts:
-        raise InputError(
-            f"drones: got {parts} drones for {n} stroke(s), expected at most one drone per stroke"
-        )
+        raise too_many_drones(parts, n, text=False)
     bounds = np.linspace(0, n, parts + 1).round().astype(int)
     out = []
     for a, b in itertools.pairwise(bounds):
         times = None if drawing.times is None else drawing.times[a:b]
         out.append(Strokes(paths=drawing.paths[a:b], times=times, source=drawing.source))
     return out
+
+
+def check_text(text: str) -> None:
+    """Refuse text with a character the studio cannot write, naming it (:class:`StudioInputError`).
+
+    Chinese characters are written from the bundled hanzi medians, anything else
+    with the Hershey font (:func:`~skyquill.strokes.typed_strokes`); mixed, the
+    Latin characters are not in the hanzi set and are named.
+    """
+    if is_cjk(text):
+        missing = missing_hanzi(text)
+        if missing:
+            raise unwritable_text(text, missing, chinese=True, bundled=len(bundled_hanzi()))
+        return
+    missing = missing_glyphs(text)
+    if missing:
+        raise unwritable_text(text, missing, chinese=False, bundled=0)
 
 
 def run_plan(
@@ -146,9 +216,7 @@ def run_plan(
     """
     progress(0.02, "reading the input")
     parts = parts_of(request)
-    options = WritingOptions(
-        size_m=request.size_m, limits=VehicleLimits(request.vmax, request.amax, request.jmax)
-    )
+    options = writing_options(request)
     show = _plan_show(parts, options, request, progress)
     first_board = show.missions[0].board
     flights = show.flights or (None,) * len(parts)
@@ -158,12 +226,13 @@ def run_plan(
     ]
     flown = [_flight_record(d, request) for d in drones if d.flight]
     record = {"plan_id": plan_id, "request": request_record(request), "simulated_flight": flown}
-    files, notes = _exports(show.missions, record, progress)
+    files, notes = _exports(show.missions, record, progress, STUDIO_FORMATS[request.target])
     named = {f"skyquill-{plan_id}-{kind}": (kind, f) for kind, f in files.items()}
     result = PlanResultModel(
         plan_id=plan_id,
         source="text" if request.text is not None else "strokes",
         board=request.board,
+        target=request.target,
         size_m=request.size_m,
         limits=Limits(vmax=request.vmax, amax=request.amax, jmax=request.jmax),
         duration_s=max(m.trajectory.duration for m in show.missions),
@@ -183,6 +252,19 @@ def run_plan(
         notes=notes,
     )
     return PlanOutput(result, {name: f for name, (_, f) in named.items()})
+
+
+def writing_options(request: PlanRequest) -> WritingOptions:
+    """The mission's options: the size and limits asked for, planned for the chosen vehicle.
+
+    A Crazyflie's flight is planned to fit its trajectory memory (the uploads of
+    ``skyquill write --target crazyflie``), so its Crazyswarm download exists.
+    """
+    return WritingOptions(
+        size_m=request.size_m,
+        limits=VehicleLimits(request.vmax, request.amax, request.jmax),
+        target=CRAZYFLIE if request.target == "crazyflie" else None,
+    )
 
 
 def request_record(request: PlanRequest) -> dict[str, Any]:
@@ -235,7 +317,8 @@ def _plan_show(
         nonlocal solves
         solves += 1
         share = PLAN_WEIGHT * (1.0 - (1.0 - SOLVE_STEP) ** solves)
-        progress(at(PLAN_WEIGHT * planned + share), f"drone {planned + 1} of {n}: {step}")
+        stage = f"drone {planned + 1} of {n}: {_solve_stage(step, solves)}"
+        progress(at(PLAN_WEIGHT * planned + share), stage, False)
 
     try:
         with _solves_reported(solving):
@@ -248,15 +331,60 @@ def _plan_show(
                 fly=request.fly,
                 progress=report,
             )
-    except SolverError as exc:
-        # Seen with tiny jerk limits: the QP backends hit their iteration limit
-        # instead of proving infeasibility. To the person it is the same answer.
+    except (SolverError, InfeasibleError) as exc:
+        # SolverError: seen with tiny jerk limits, the QP backends hit their iteration
+        # limit instead of proving infeasibility. To the person it is the same answer.
         # Drones are planned in order (workers=1): the one that failed is the next.
-        raise InfeasibleError(
-            f"limits: could not plan drone {planned + 1}'s flight within speed "
-            f"{request.vmax:g} m/s, acceleration {request.amax:g} m/s^2 and jerk "
-            f"{request.jmax:g} m/s^3 ({exc}); expected looser limits or a smaller drawing"
-        ) from exc
+        raise _unplannable(request, planned + 1, exc) from exc
+
+
+def _unplannable(request: PlanRequest, drone: int, exc: Exception) -> StudioInputError:
+    """A drone's flight that no timing made fit: the limits, or the drawing's fidelity."""
+    which = f"drone {drone}'s flight" if request.drones > 1 else "the flight"
+    limits = (
+        f"Speed {request.vmax:g} m/s, Acceleration {request.amax:g} m/s² and Jerk "
+        f"{request.jmax:g} m/s³"
+    )
+    detail = (
+        f"limits: could not plan drone {drone}'s flight within speed {request.vmax:g} m/s, "
+        f"acceleration {request.amax:g} m/s^2 and jerk {request.jmax:g} m/s^3 ({exc}); "
+        "expected looser limits or a smaller drawing"
+    )
+    if request.target == "crazyflie" and "upload" in str(exc):
+        person = (
+            f"Vehicle: {which} does not fit a Crazyflie's memory ({CRAZYFLIE.max_pieces} "
+            "pieces per upload, a stroke never split between uploads) and stay within 1 % of "
+            "the size of the strokes. Draw long strokes as several shorter ones, raise Size of "
+            "the writing, or choose another Vehicle"
+        )
+        return StudioInputError(detail, "target", person)
+    if "fidelity" in getattr(exc, "families", ()):
+        person = (
+            f"Limits: {which} could not follow the strokes closely enough (within 1 % of the "
+            f"size) at {limits}, even slowed down. Raise Size of the writing, or draw fewer, "
+            "larger strokes"
+        )
+    else:
+        person = (
+            f"Limits: {which} cannot be planned within {limits}. Raise the Jerk or the "
+            "Acceleration, or draw less"
+        )
+    return StudioInputError(detail, "limits", person)
+
+
+def _solve_stage(step: str, solves: int) -> str:
+    """One of the planning's per-solve records in plain words, with the try's number.
+
+    The time allocation tries its fastest timing first, then slower ones
+    (:mod:`~skyquill.calligraphy.allocation`); re-segmentation comes last.
+    """
+    if step.startswith("re-segmenting"):
+        what = "giving each part of the route the time it needs"
+    elif solves == 1:
+        what = "fitting the flight to the limits"
+    else:
+        what = "fitting again, slower"
+    return f"{what} (solve {solves})"
 
 
 class _SolveHandler(logging.Handler):
@@ -295,7 +423,7 @@ def _solves_reported(callback: Callable[[str], None]) -> Iterator[None]:
 def _next_stage(done: int, n: int) -> str:
     """What :func:`plan_show` does after ``done`` of its steps, for a person."""
     if done < n:
-        return f"planning drone {done + 1} of {n} (solving the spline: the longest step)"
+        return f"planning drone {done + 1} of {n}"
     if done < 2 * n:
         return f"flying drone {done - n + 1} of {n} in simulation"
     return "collecting the results"
@@ -317,7 +445,8 @@ def _drone_plan(
     """One drone's curves for the page, in its board's coordinates (and its flight's)."""
     traj, board = mission.trajectory, mission.board
     t = _view_times(traj.duration)
-    v, a, j = (np.abs(traj.evaluate(t, n)).max(axis=1) for n in (1, 2, 3))
+    # The norms: the limits are norms (the page plots them against the limit lines).
+    v, a, j = (np.linalg.norm(traj.evaluate(t, n), axis=1) for n in (1, 2, 3))
     lo, hi = part.bounds()
     check = mission.verification
     fields: dict[str, Any] = {
@@ -351,15 +480,40 @@ def _flight_fields(mission: Mission, flight: Flight, t: FloatArray) -> dict[str,
     tip = np.column_stack([np.interp(t, flight.t, flight.p[:, k]) for k in range(3)])
     tip = tip - mission.brush_offset
     ink = [s for s in flight.ink if len(s) >= 2]
+    laid = _ink_times(flight, mission, ink)
     fidelity = flight_ink(flight, mission)
     numbers = {} if fidelity is None else fidelity.as_dict()
     return {
         "flight": _round(board.to_board(tip)),
         "ink": [_round(board.to_board(_decimate(s))[:, :2]) for s in ink],
+        "ink_t": [_round(_decimate(t[:, None])[:, 0]) for t in laid],
         "flight_rmse_m": flight.rmse_m,
         "ink_max_deviation_m": numbers.get("max_deviation_m"),
         "ink_iou": numbers.get("iou"),
     }
+
+
+def _ink_times(flight: Flight, mission: Mission, ink: Sequence[FloatArray]) -> list[FloatArray]:
+    """When each point of each ink run was laid, s (N,) per run.
+
+    The simulator appends one ink point per step while the brush touches, so a
+    run is consecutive steps: its first step is the one, after the previous
+    run, where the untilted tip (vehicle minus brush) is nearest the run's first
+    point in 3-D (a transit passes over a point a lift higher, so it is not taken).
+    """
+    tip = flight.p - mission.brush_offset
+    out, start = [], 0
+    for run in ink:
+        gaps = np.linalg.norm(tip[start:] - run[0], axis=1)
+        # The first approach (a later stroke may cross this point), then its closest step.
+        near = np.flatnonzero(gaps < INK_MATCH_M)
+        lo = int(near[0]) if near.size else 0
+        hi = lo + INK_MATCH_STEPS if near.size else len(gaps)
+        first = start + lo + int(np.argmin(gaps[lo:hi]))
+        steps = np.minimum(first + np.arange(len(run)), len(flight.t) - 1)
+        out.append(np.asarray(flight.t[steps], dtype=float))
+        start = min(first + len(run), len(flight.t) - 1)
+    return out
 
 
 def _decimate(points: FloatArray) -> FloatArray:
@@ -369,9 +523,12 @@ def _decimate(points: FloatArray) -> FloatArray:
 
 
 def _exports(
-    missions: Sequence[Mission], record: dict[str, Any], progress: Progress
+    missions: Sequence[Mission],
+    record: dict[str, Any],
+    progress: Progress,
+    formats: dict[str, str],
 ) -> tuple[dict[str, StudioFile], list[str]]:
-    """The plan's setpoint CSV(s) and summary, and the studio's formats from the registry.
+    """The plan's setpoint CSV(s) and summary, and the chosen vehicle's ``formats``.
 
     Everything is written through the same writer and exporters as the command
     line (a plan directory in a temporary folder, then
@@ -386,7 +543,7 @@ def _exports(
         )
         for i, m in enumerate(missions, start=1)
     ]
-    steps = 1 + len(STUDIO_FORMATS)
+    steps = 1 + len(formats)
     with tempfile.TemporaryDirectory(prefix="skyquill-studio-") as tmp:
         out = Path(tmp)
         progress(SHOW_END, f"writing the setpoints (file 1 of {steps})")
@@ -405,12 +562,11 @@ def _exports(
             _bundle(
                 setpoints,
                 "setpoints",
-                f"setpoints at {CSV_RATE_HZ:g} Hz: t, x, y, z, velocity, acceleration, jerk, "
-                "yaw, pen (SI, z up)",
+                DESCRIPTIONS["setpoints"],
             )
         ]
         notes = []
-        for k, (name, stem) in enumerate(STUDIO_FORMATS.items(), start=2):
+        for k, (name, stem) in enumerate(formats.items(), start=2):
             progress(SHOW_END + 0.09 * (k - 1) / steps, f"writing the {stem} (file {k} of {steps})")
             exporter = EXPORTERS[name]
             try:
@@ -418,18 +574,31 @@ def _exports(
                     planned, out / f"{name}{exporter.suffix}", ExportOptions(CSV_RATE_HZ)
                 )
             except InputError as exc:
-                # A plan the format cannot hold (a Crazyswarm export of a plan that does not
-                # fit the Crazyflie's uploads) is a missing download, not a failed plan.
-                notes.append(f"{stem}: download unavailable: {exc}")
+                # A plan the format cannot hold is a missing download, not a failed plan.
+                logger.warning("studio: %s export refused: %s", name, exc)
+                notes.append(f"The {stem} file could not be made for this flight ({exc})")
                 continue
-            notes.append(report.message.replace(str(out) + "/", ""))
+            notes.append(_export_note(name, stem, report))
             parts = [(f.name, f.read_bytes()) for f in report.files]
-            files.append(_bundle(parts, stem, exporter.help))
+            files.append(_bundle(parts, stem, DESCRIPTIONS.get(name, exporter.help)))
         data = json.dumps(summary, indent=2, allow_nan=False).encode()
-    files.append(
-        StudioFile("summary.json", data, "application/json", "what was planned and checked")
-    )
+    files.append(StudioFile("summary.json", data, "application/json", DESCRIPTIONS["summary"]))
     return {f.name: f for f in files}, notes
+
+
+def _export_note(name: str, stem: str, report: ExportReport) -> str:
+    """What the export was checked against, in plain words."""
+    mm = 1e3 * report.max_error_m
+    within = "less than 0.01 mm" if mm < 0.01 else f"{mm:.2g} mm"
+    uploads = report.details.get("drone_uploads")
+    extra = ""
+    if uploads:
+        counts = [len(d.get("uploads", ())) for d in uploads]
+        extra = f"; {max(counts)} upload{'' if max(counts) == 1 else 's'} per drone at most"
+    return (
+        f"The {stem} file, read back as {CONSUMERS.get(name, 'its player reads it')}, stays "
+        f"within {within} of the planned flight{extra}"
+    )
 
 
 def _bundle(parts: Sequence[tuple[str, bytes]], stem: str, description: str) -> StudioFile:
@@ -445,5 +614,5 @@ def _bundle(parts: Sequence[tuple[str, bytes]], stem: str, description: str) -> 
     with zipfile.ZipFile(buffer, "w", compression=zipfile.ZIP_DEFLATED) as archive:
         for name, data in parts:
             archive.writestr(name, data)
-    note = " (one file per drone and upload, in a zip)"
+    note = " (several files, in a zip)"
     return StudioFile(f"{stem}.zip", buffer.getvalue(), "application/zip", description + note)

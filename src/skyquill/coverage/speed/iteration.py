@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import replace
 
 import numpy as np
@@ -9,17 +10,20 @@ import numpy as np
 from skyquill.coverage.speed.curve import _derivs3
 from skyquill.coverage.speed.norms import limit_ratio
 from skyquill.coverage.speed.profile import SpeedPlan, _interval_times, _profile_spline
-from skyquill.coverage.speed.rows import _Bounds, _end_caps, _GridLP
+from skyquill.coverage.speed.rows import GridSolver, _Bounds, _end_caps
 from skyquill.validation import FloatArray
 
 #: Fewest / most points per grid interval at which the refinement checks the plan (the
 #: dense check samples >= 20 per interval: jerk peaks at the curve's knots last < 1 ms).
 _SAMPLES = 24
 _MAX_SAMPLES = 256
+#: Grid size up to which every interval gets _SAMPLES, and the fewest on finer grids.
+_SAMPLE_GRID = 2000
+_MIN_SAMPLES = 3
 
 
 def _initial_solve(
-    lp: _GridLP,
+    lp: GridSolver,
     bounds: _Bounds,
     *,
     c1: FloatArray,
@@ -39,7 +43,7 @@ def _initial_solve(
 
 
 def _pseudo_jerk(
-    lp: _GridLP,
+    lp: GridSolver,
     bounds: _Bounds,
     start: FloatArray,
     *,
@@ -96,7 +100,7 @@ def _pseudo_jerk(
 
 def _refine(
     plan: SpeedPlan,
-    lp: _GridLP,
+    lp: GridSolver,
     bounds: _Bounds,
     *,
     target: float | None,
@@ -149,7 +153,10 @@ def _interval_excess(plan: SpeedPlan) -> tuple[FloatArray, FloatArray, FloatArra
     sig = plan._sigma
     h = sig[1] - sig[0]
     dt = _interval_times(plan._bsig, h, jerk=plan.jmax is not None)
-    m = np.clip(np.ceil(dt / (0.1 * plan.control_period)), _SAMPLES, _MAX_SAMPLES).astype(int)
+    # At least _SAMPLES per interval, fewer on a grid finer than _SAMPLE_GRID (the samples
+    # stay as dense along the path), and at least every control_period / 10.
+    least = max(_MIN_SAMPLES, min(_SAMPLES, math.ceil(_SAMPLES * _SAMPLE_GRID / sig.size)))
+    m = np.clip(np.ceil(dt / (0.1 * plan.control_period)), least, _MAX_SAMPLES).astype(int)
     start = np.concatenate([[0], np.cumsum(m)[:-1]])
     frac = (np.arange(int(m.sum())) - np.repeat(start, m)) / np.repeat(m, m)
     us = np.minimum(np.repeat(sig[:-1], m) + h * frac, 1.0)

@@ -16,7 +16,9 @@ from skyquill.coverage.speed.grid import _grid_map
 from skyquill.coverage.speed.iteration import _initial_solve, _refine
 from skyquill.coverage.speed.norms import component_limits, components
 from skyquill.coverage.speed.profile import SpeedPlan, _duration, _profile_spline
+from skyquill.coverage.speed.reach import ReachGrid, acceleration_rows
 from skyquill.coverage.speed.rows import (
+    GridSolver,
     _acc_matrix,
     _Bounds,
     _GridLP,
@@ -27,6 +29,7 @@ from skyquill.coverage.speed.rows import (
 from skyquill.coverage.speed.validate import (
     _validate,
     _validate_limits,
+    _validate_method,
     _validate_norm_sides,
     _validate_refine,
 )
@@ -51,6 +54,7 @@ def plan_speed(
     grid: str = "uniform",
     norm_sides: int | None = None,
     deadline: Deadline | None = None,
+    method: str = "auto",
 ) -> SpeedPlan:
     """Plan the time-optimal rest-to-rest speed profile along ``curve``.
 
@@ -120,6 +124,12 @@ def plan_speed(
     deadline : Deadline, optional
         A wall-time budget: checked before every LP solve, whose HiGHS time
         limit is what is left of it (see :class:`~skyquill.coverage.deadline.Deadline`).
+    method : {"auto", "reach", "lp"}, default "auto"
+        How the jerk-free problem is solved: ``"reach"``, by the backward and
+        forward reachability passes (:mod:`.reach`; the LP's optimum, in
+        linear time), ``"lp"`` by the grid LP (the reference). ``"auto"``:
+        the passes without a jerk limit, the LP with one (``"reach"`` with a
+        jerk limit is refused: its rows couple three nodes).
 
     Returns
     -------
@@ -146,6 +156,7 @@ def plan_speed(
         safety=safety,
     )
     backend = _validate_refine(max_excess, refine_rounds, lp_backend, grid)
+    solver = _validate_method(method, jerk=jmax is not None)
     n = args.n
     d = _eval(curve, np.array([0.0, 1.0]), 1).shape[1]
     norm = _validate_norm_sides(norm_sides, d)
@@ -173,7 +184,12 @@ def plan_speed(
     jlim = None if jmax_a is None else component_limits(jmax_a, norm)
     if jlim is not None:
         a = sparse.vstack([a, _jerk_matrix((p1, p2, p3), jlim * args.safety, vb)], format="csr")
-    lp = _GridLP(a, backend=backend, deadline=deadline)
+    lp: GridSolver
+    if solver == "reach":
+        rows = acceleration_rows(p1, p2, float(sig[1] - sig[0]), component_limits(amax_a, norm))
+        lp = ReachGrid(rows, lambda: _GridLP(a, backend=backend, deadline=deadline), deadline)
+    else:
+        lp = _GridLP(a, backend=backend, deadline=deadline)
     bounds = _Bounds(ub, None if jlim is None else vb, p1.shape[1], *_ones(n))
     log: tuple[list[float], list[float]] = ([], [])
     stop = (args.jerk_iterations, args.jerk_tol)
@@ -198,6 +214,7 @@ def plan_speed(
         _umap=umap,
         grid=grid,
         norm_sides=norm,
+        method=solver,
     )
     plan, rounds, est, extra = _refine(
         plan, lp, bounds, target=max_excess, rounds=refine_rounds, stop=stop, log=log
@@ -212,6 +229,7 @@ def plan_speed(
         refinements=rounds,
         excess_estimate=est,
         lp_solves=lp.solves,
+        method="lp" if isinstance(lp, ReachGrid) and lp.used_lp else solver,
     )
 
 

@@ -86,6 +86,8 @@ class SpeedPlan:
         Number of LPs solved.
     grid : str
         ``"uniform"`` or ``"adaptive"`` (see :func:`plan_speed`).
+    method : str
+        ``"reach"`` (the reachability passes solved every problem) or ``"lp"``.
     norm_sides : int or None
         None: ``amax``/``jmax`` hold per axis.  Else they are Euclidean norm
         limits, held in the LP by the inscribed polygon of this many sides
@@ -115,6 +117,7 @@ class SpeedPlan:
     lp_solves: int = 0
     grid: str = "uniform"
     norm_sides: int | None = None
+    method: str = "lp"
 
     def _b_eval(self, u: FloatArray, nu: int) -> FloatArray:
         return np.asarray(self._bspline(u, nu), dtype=np.float64)

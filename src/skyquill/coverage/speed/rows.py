@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
 from scipy import sparse
@@ -137,6 +137,24 @@ def _end_caps(ub: FloatArray, c1: FloatArray, jmax: FloatArray) -> None:
         with np.errstate(divide="ignore"):
             cap = (4.0 * jmax * h * h / np.abs(c1[node])) ** (2.0 / 3.0)
         ub[node] = min(ub[node], float(np.min(cap)))
+
+
+class GridSolver(Protocol):
+    """What solves the grid problem for given bounds: the LP, or the reachability passes."""
+
+    @property
+    def time(self) -> float:
+        """Wall time spent solving, s."""
+        ...
+
+    @property
+    def solves(self) -> int:
+        """Problems solved."""
+        ...
+
+    def solve(self, r: FloatArray, ub: FloatArray) -> FloatArray:
+        """``b`` for row bounds ``|A b| <= r`` and column bounds ``0 <= b <= ub``."""
+        ...
 
 
 class _GridLP:

@@ -16,6 +16,8 @@ from skyquill.validation import FloatArray, as_float, as_int, per_axis
 
 #: Grid kinds of :func:`~skyquill.coverage.speed.plan_speed`.
 GRIDS = ("uniform", "adaptive")
+#: Methods of :func:`~skyquill.coverage.speed.plan_speed`.
+METHODS = ("auto", "reach", "lp")
 #: Fewest sides of the polygon that holds a norm limit.
 MIN_NORM_SIDES = 4
 
@@ -106,3 +108,17 @@ def _validate_limits(
     acc = np.full(d, as_float("amax", amax, positive=True))
     jerk = None if jmax is None else np.full(d, as_float("jmax", jmax, positive=True))
     return acc, jerk
+
+
+def _validate_method(method: object, *, jerk: bool) -> str:
+    """``"reach"`` or ``"lp"``: the solver ``method`` names for a problem with or without jerk."""
+    if method not in METHODS:
+        raise InputError(f"method: got {method!r}, expected one of {METHODS}")
+    if method == "reach" and jerk:
+        raise InputError(
+            "method: got 'reach' with a jerk limit, expected 'lp' or 'auto' (the passes hold "
+            "speed and acceleration; jerk rows couple three nodes)"
+        )
+    if method == "auto":
+        return "lp" if jerk else "reach"
+    return str(method)

@@ -4,14 +4,19 @@
 const W = 560; // logical canvas size (CSS pixels of the drawing area)
 const PLOT_H = 420; // logical height of the plots
 const POLL_MS = 200;
-// One colour per drone, on the canvas (its pen-down path) and in the plots; drone 1's is --path.
-const COLORS = ["#e8590c", "#2b8a3e", "#5f3dc4", "#0b7285", "#d6336c", "#795548", "#364fc7", "#e67700"];
-// The page's names of the API's fields (the labels), for messages a person reads.
+// Where the page keeps the drawing and the settings across a reload.
+const STORE_KEY = "skyquill-studio-v1";
+// One colour per drone (its pen-down path, its marker, its plots). None is the legend's
+// blue (flown in simulation), grey (pen up), black (your drawing) or ink: they never clash.
+const COLORS = ["#c2410c", "#2b8a3e", "#7048e8", "#c2255c", "#8d5524", "#5c7f0d", "#d9480f", "#9c6f00"];
+// The page's names of the API's fields, for messages made in the page.
 const LABELS = {
   strokes: "Drawing", t: "Drawing", text: "Text", board: "Surface", size_m: "Size of the writing",
   drones: "Drones", vmax: "Speed", amax: "Acceleration", jmax: "Jerk", fly: "Fly it in simulation",
-  limits: "Limits",
+  limits: "Limits", target: "Vehicle",
 };
+// What the page checks before sending; replaced by the server's own (/api/limits).
+const LIMITS = { max_strokes: 200, max_points: 20000, max_stroke_points: 5000, max_text: 40, max_drones: 8, targets: [] };
 const css = getComputedStyle(document.documentElement);
 const color = (name) => css.getPropertyValue(name).trim();
 
@@ -19,15 +24,18 @@ const $ = (id) => document.getElementById(id);
 const ui = {
   studio: $("studio"), ink: $("ink"), overlay: $("overlay"), plots: $("plots"),
   undo: $("undo"), clear: $("clear"), count: $("stroke-count"), text: $("text"),
+  textCount: $("text-count"), target: $("target"), targetHint: $("target-hint"),
   board: $("board"), size: $("size_m"), drones: $("drones"), vmax: $("vmax"), amax: $("amax"),
   jmax: $("jmax"), fly: $("fly"), plan: $("plan"), progressBox: $("progress-box"),
-  progress: $("progress"), stage: $("stage"), error: $("error"), play: $("play"),
-  time: $("time"), clock: $("clock"), speed: $("speed"), summary: $("summary"),
-  files: $("files"), notes: $("notes"), form: $("form"), cancel: $("cancel"),
-  estimate: $("estimate"), warning: $("warning"), warningText: $("warning-text"),
-  planAnyway: $("plan-anyway"), dismiss: $("dismiss"), stale: $("stale"),
-  droneLegend: $("drone-legend"), plotLegend: $("plot-legend"), stagePanel: document.querySelector(".stage"),
+  progress: $("progress"), stage: $("stage"), status: $("status"), error: $("error"),
+  play: $("play"), time: $("time"), clock: $("clock"), speed: $("speed"), phase: $("phase"),
+  summary: $("summary"), files: $("files"), notes: $("notes"), form: $("form"),
+  cancel: $("cancel"), estimate: $("estimate"), warning: $("warning"),
+  warningText: $("warning-text"), planAnyway: $("plan-anyway"), dismiss: $("dismiss"),
+  stale: $("stale"), legend: $("legend"), pathKey: $("path-key"), plotLegend: $("plot-legend"),
+  notFlown: $("not-flown"), actions: $("actions"), stagePanel: document.querySelector(".stage"),
 };
+const SETTINGS = ["text", "target", "board", "size_m", "drones", "vmax", "amax", "jmax"];
 
 // ---------------------------------------------------------------- state
 
@@ -39,8 +47,12 @@ const state = {
   planned: null, // the request body the result was planned from (drawing.json is made of it)
   job: null, // URL of the running job (for Cancel)
   busy: false, // a plan is being estimated or run: the canvas is locked
+  cancelled: false, // Cancel was pressed for the running job
   version: 0, // bumped by every change of the inputs; a result of an older one is out of date
   views: [], // per drone: (u, v) on its board -> canvas px
+  cells: [], // per drone (typed text): its cell of the canvas, [x, y, w, h]
+  overview: null, // the whole-flight inset: {box, map}
+  lastStage: "",
   playing: false,
   t: 0, // animation time, s
   lastFrame: null,
@@ -130,10 +142,32 @@ function onPointerUp(event) {
   addPoint(stroke, event);
   state.current = null;
   if (stroke.points.length >= 2) {
-    state.strokes.push({ points: stroke.points, times: stroke.times });
-    inputsChanged();
+    const refused = strokeRefusal(stroke);
+    if (refused) showError(refused, "strokes");
+    else {
+      state.strokes.push({ points: stroke.points, times: stroke.times });
+      inputsChanged();
+    }
   }
   drawInk();
+}
+
+function strokeRefusal(stroke) {
+  // The studio's bounds, said before anything is sent (never a silent cut).
+  const points = state.strokes.reduce((n, s) => n + s.points.length, 0) + stroke.points.length;
+  if (state.strokes.length >= LIMITS.max_strokes) {
+    return `Drawing: at most ${LIMITS.max_strokes} strokes can be planned, and this drawing has them; `
+      + "that stroke was not added. Undo some strokes or press Clear";
+  }
+  if (stroke.points.length > LIMITS.max_stroke_points) {
+    return `Drawing: that stroke has ${stroke.points.length.toLocaleString("en")} points, at most `
+      + `${LIMITS.max_stroke_points.toLocaleString("en")} per stroke; it was not added. Draw it as several shorter strokes`;
+  }
+  if (points > LIMITS.max_points) {
+    return `Drawing: at most ${LIMITS.max_points.toLocaleString("en")} points in all can be planned; `
+      + "that stroke was not added. Undo some strokes or press Clear";
+  }
+  return "";
 }
 
 function drawInk() {
@@ -145,7 +179,8 @@ function drawInk() {
   for (const s of state.strokes) polyline(inkCtx, s.points);
   if (state.current) polyline(inkCtx, state.current.points);
   const n = state.strokes.length;
-  ui.count.textContent = `${n} stroke${n === 1 ? "" : "s"}`;
+  ui.count.textContent = `${n} of ${LIMITS.max_strokes} strokes`;
+  ui.ink.setAttribute("aria-label", `Drawing area, ${n} stroke${n === 1 ? "" : "s"}: draw strokes here with a mouse, finger or pen`);
 }
 
 function undo() {
@@ -163,6 +198,77 @@ function clearAll() {
   drawInk();
 }
 
+// ------------------------------------------------------ text and limits up front
+
+function textLength() {
+  return [...ui.text.value].length; // characters, as the server counts them (not UTF-16 units)
+}
+
+function showTextCount() {
+  const n = textLength();
+  ui.textCount.textContent = `${n} of ${LIMITS.max_text} characters`;
+  ui.textCount.classList.toggle("over", n > LIMITS.max_text);
+  const typed = ui.text.value.trim() !== "";
+  ui.studio.dataset.input = typed ? "text" : "drawing";
+  ui.notFlown.hidden = !(typed && state.strokes.length);
+}
+
+function textRefusal() {
+  const n = textLength();
+  if (n <= LIMITS.max_text) return "";
+  return `Text: ${n} characters, at most ${LIMITS.max_text}; shorten it (nothing is cut for you)`;
+}
+
+function showTargetHint() {
+  const choice = LIMITS.targets.find((t) => t.name === ui.target.value);
+  ui.targetHint.textContent = choice ? choice.help : "";
+}
+
+async function loadLimits() {
+  try {
+    const answer = await fetch("/api/limits");
+    if (answer.ok) Object.assign(LIMITS, await answer.json());
+  } catch {
+    // Offline from the server: the page's own numbers above stay.
+  }
+  ui.drones.max = String(LIMITS.max_drones);
+}
+
+// ------------------------------------------------------------ keeping the work
+
+function save() {
+  // The drawing and every setting, so that a reload (even mid-plan) loses nothing.
+  const settings = Object.fromEntries(SETTINGS.map((id) => [id, $(id).value]));
+  settings.fly = ui.fly.checked;
+  const strokes = state.strokes.map((s) => ({ points: s.points, times: s.times }));
+  try {
+    localStorage.setItem(STORE_KEY, JSON.stringify({ strokes, settings }));
+  } catch {
+    // Storage full or refused (private mode): the page works on without it.
+  }
+}
+
+function restore() {
+  let saved = null;
+  try {
+    saved = JSON.parse(localStorage.getItem(STORE_KEY) || "null");
+  } catch {
+    saved = null;
+  }
+  if (!saved || typeof saved !== "object") return;
+  const okStroke = (s) => s && Array.isArray(s.points) && Array.isArray(s.times)
+    && s.points.length === s.times.length && s.points.length >= 2;
+  if (Array.isArray(saved.strokes) && saved.strokes.every(okStroke)) {
+    state.strokes = saved.strokes.slice(0, LIMITS.max_strokes);
+    const last = state.strokes[state.strokes.length - 1];
+    // New strokes continue the recording's clock after the last one.
+    if (last) state.t0 = performance.now() - 1000 * (last.times[last.times.length - 1] + 1);
+  }
+  const settings = saved.settings || {};
+  for (const id of SETTINGS) if (typeof settings[id] === "string") $(id).value = settings[id];
+  if (typeof settings.fly === "boolean") ui.fly.checked = settings.fly;
+}
+
 // ------------------------------------------------------------- planning
 
 function number(input) {
@@ -174,6 +280,7 @@ function requestBody() {
   const body = {
     board: ui.board.value, size_m: number(ui.size), drones: number(ui.drones),
     vmax: number(ui.vmax), amax: number(ui.amax), jmax: number(ui.jmax), fly: ui.fly.checked,
+    target: ui.target.value,
   };
   const text = ui.text.value.trim();
   if (text) return { ...body, text };
@@ -195,7 +302,8 @@ async function postJSON(url, body) {
 }
 
 function apiError(data, status) {
-  const error = new Error(data.detail || `the server answered ${status}`);
+  // The server's message in the page's words (user_message); its API line as a fallback.
+  const error = new Error(data.user_message || data.detail || `The studio answered ${status}; try again`);
   error.field = data.field || null;
   return error;
 }
@@ -205,12 +313,19 @@ async function plan(confirmed = false) {
   hideWarning();
   const body = requestBody();
   if (!body.text && body.strokes.length === 0) {
-    showError("Draw something first (or type text).", "strokes");
+    showError("Drawing: draw something on the canvas first, or type text", "strokes");
+    return;
+  }
+  const tooLong = textRefusal();
+  if (tooLong) {
+    showError(tooLong, "text");
     return;
   }
   const version = state.version;
   const clicked = performance.now(); // "planned in" is the wait the person had, click to result
-  setBusy(true, 0, "estimating");
+  state.cancelled = false;
+  setBusy(true);
+  showProgress(0, "estimating the flight", true);
   let guess;
   try {
     guess = await postJSON("/api/estimate", body);
@@ -229,14 +344,15 @@ async function plan(confirmed = false) {
     const accepted = await postJSON("/api/plan", body);
     state.job = accepted.url;
     const job = await poll(accepted.url);
-    if (job.state === "cancelled") {
+    if (job.state === "cancelled" || state.cancelled) {
       forgetPlan();
-      ui.stage.textContent = "";
-      showError("");
-      ui.studio.dataset.state = state.strokes.length ? "drawn" : "empty";
+      announce("Cancelled: nothing was planned.");
       return;
     }
-    if (job.state !== "done") throw apiError({ detail: job.message || "the plan failed", field: job.field }, 422);
+    if (job.state !== "done") {
+      const message = job.user_message || job.message || "The plan failed; try again";
+      throw apiError({ user_message: message, field: job.field }, 422);
+    }
     state.planned = body;
     showResult(job.result, (performance.now() - clicked) / 1000);
     if (state.version !== version) markStale(); // the inputs changed while it was planned
@@ -259,7 +375,9 @@ async function poll(url) {
     const answer = await fetch(url);
     const job = await answer.json();
     if (!answer.ok) throw apiError(job, answer.status);
-    setBusy(true, job.progress, `${job.stage} · ${job.elapsed_s.toFixed(1)} s`);
+    if (job.state === "queued" || job.state === "running") {
+      showProgress(job.progress, job.stage, job.progress_known, job.elapsed_s);
+    }
     if (job.state !== "queued" && job.state !== "running") return job;
     await new Promise((resolve) => setTimeout(resolve, POLL_MS));
   }
@@ -267,29 +385,63 @@ async function poll(url) {
 
 async function cancel() {
   if (!state.job) return;
+  state.cancelled = true;
   ui.cancel.disabled = true;
   await fetch(state.job, { method: "DELETE" }).catch(() => null); // the poll sees the end
 }
 
-function setBusy(busy, progress = 0, stage = "") {
+function setBusy(busy) {
   state.busy = busy;
   ui.plan.disabled = busy;
+  ui.plan.textContent = busy ? "Planning…" : "Plan";
   ui.undo.disabled = ui.clear.disabled = busy;
   ui.ink.dataset.locked = String(busy);
   ui.cancel.hidden = !busy;
-  ui.cancel.disabled = !busy || stage === "estimating";
+  ui.cancel.disabled = !busy;
   ui.progressBox.hidden = !busy;
-  ui.progress.value = progress;
-  ui.stage.textContent = stage;
-  if (busy) ui.studio.dataset.state = "planning";
+  if (busy) {
+    ui.studio.dataset.state = "planning";
+    announce("");
+  } else {
+    state.lastStage = "";
+    ui.stage.textContent = "";
+    ui.progress.value = 0;
+  }
 }
+
+function showProgress(fraction, stage, known, elapsed = null) {
+  // Known: the bar shows the share done. Not known (a drone's solves, whose number shows only
+  // as they happen): the bar has no value, which browsers draw as "working, length unknown".
+  if (known) ui.progress.value = fraction;
+  else ui.progress.removeAttribute("value");
+  ui.progress.setAttribute("aria-valuetext", known ? `${Math.round(100 * fraction)} %` : "length not known in advance");
+  const clock = elapsed === null ? "" : ` · ${elapsed.toFixed(1)} s`;
+  ui.stage.textContent = `${capital(stage)}${clock}`;
+  $("unknown").hidden = known;
+  if (stage !== state.lastStage) {
+    state.lastStage = stage;
+    $("announce").textContent = `Planning: ${stage}.`; // stage changes, not the clock's ticks
+  }
+}
+
+function announce(text, done = false) {
+  ui.status.textContent = text;
+  ui.status.classList.toggle("done", done);
+}
+
+const capital = (s) => (s ? s[0].toUpperCase() + s.slice(1) : s);
 
 function showEstimate(guess) {
   const kb = (bytes) => (bytes >= 1e6 ? `${(bytes / 1e6).toFixed(1)} MB` : `${Math.ceil(bytes / 1024)} KB`);
+  const parts = [`about ${formatDuration(guess.flight_time_s)} of flight (${guess.path_length_m.toFixed(1)} m of route)`];
+  if (guess.crazyflie_uploads !== null) {
+    const n = guess.crazyflie_uploads;
+    parts.push(n === 1 ? "one Crazyflie upload" : `1 to ${n} Crazyflie uploads`);
+  }
+  parts.push(`setpoint file ≈ ${kb(guess.setpoint_bytes)}`);
   ui.estimate.hidden = false;
-  ui.estimate.textContent = `Estimate: at least ${formatDuration(guess.flight_time_s)} of flight `
-    + `(${guess.path_length_m.toFixed(1)} m of route), about ${guess.crazyflie_uploads} Crazyflie `
-    + `upload${guess.crazyflie_uploads === 1 ? "" : "s"}, setpoints ≈ ${kb(guess.setpoint_bytes)}.`;
+  ui.estimate.dataset.seconds = String(guess.flight_time_s);
+  ui.estimate.textContent = `Estimate: ${parts.join(", ")}.`;
 }
 
 function formatDuration(s) {
@@ -306,42 +458,72 @@ function hideWarning() {
   ui.warning.hidden = true;
 }
 
+function fieldBox(field) {
+  const name = field === "t" ? "strokes" : field;
+  return name ? document.querySelector(`[data-field="${name}"]`) : null;
+}
+
 function showError(message, field = null) {
+  // The message sits at the field it is about (marked); the Plan panel says where to look.
   for (const el of document.querySelectorAll(".invalid")) el.classList.remove("invalid");
   for (const el of document.querySelectorAll("[aria-invalid]")) el.removeAttribute("aria-invalid");
-  ui.error.hidden = !message;
-  ui.error.textContent = field ? labelled(message, field) : message;
-  const where = field && document.querySelector(`[data-field="${field === "t" ? "strokes" : field}"]`);
-  if (!where) return;
-  where.classList.add("invalid");
-  const input = where.querySelector("input, select");
-  if (input) {
-    input.setAttribute("aria-invalid", "true");
-    input.focus({ preventScroll: true });
+  for (const el of document.querySelectorAll(".field-error")) {
+    el.hidden = true;
+    el.textContent = "";
   }
+  const where = fieldBox(field);
+  const text = message && field ? labelled(message, field) : capital(message);
+  const slot = where && $(`${field === "t" ? "strokes" : field}-error`);
+  if (!message) {
+    ui.error.hidden = true;
+    ui.error.textContent = "";
+    return;
+  }
+  if (!where || !slot) {
+    ui.error.hidden = false;
+    ui.error.textContent = text;
+    return;
+  }
+  slot.textContent = text;
+  slot.hidden = false;
+  where.classList.add("invalid");
+  ui.error.hidden = false;
+  ui.error.textContent = `Not planned: see ${LABELS[field] || field}, marked in red.`;
+  const input = where.matches("input, select, canvas") ? where : where.querySelector("input, select, canvas");
+  if (input) input.setAttribute("aria-invalid", "true");
+  (field === "strokes" || field === "t" ? where : slot).scrollIntoView({ block: "nearest" });
+  if (input && input.tagName !== "CANVAS") input.focus({ preventScroll: true });
 }
 
 function labelled(message, field) {
-  // "vmax: got -1, ..." -> "Speed: got -1, ..." (the page's words, not the API's).
+  // A message that starts with an API name ("vmax: ...") gets the page's label instead.
+  if (Object.values(LABELS).some((label) => message.startsWith(`${label}:`))) return message;
   const label = LABELS[field];
-  const name = message.match(/^(strokes from studio drawing|[a-z_]+)(?=[:[.])/);
-  return label && name ? label + message.slice(name[0].length) : message;
+  const name = message.match(/^[a-z_]+(?=[:[.])/);
+  return label && name ? label + message.slice(name[0].length) : capital(message);
 }
 
 function forgetPlan() {
   state.result = null;
   state.planned = null;
   state.playing = false;
+  state.t = 0;
   overCtx.clearRect(0, 0, W, W);
   plotCtx.clearRect(0, 0, PW, PLOT_H);
   ui.play.disabled = ui.time.disabled = true;
   ui.play.textContent = "Play";
+  ui.time.value = "0";
+  ui.clock.textContent = "0.0 s";
+  ui.phase.textContent = "";
   ui.summary.textContent = "";
   ui.stale.hidden = true;
-  ui.droneLegend.hidden = ui.plotLegend.hidden = true;
+  ui.plotLegend.hidden = true;
+  showPathKeys(null);
   ui.files.replaceChildren(item("Plan first.", "muted"));
   ui.notes.replaceChildren();
+  ui.status.textContent = "";
   ui.studio.dataset.state = state.strokes.length ? "drawn" : "empty";
+  delete ui.studio.dataset.planId;
 }
 
 function inputsChanged() {
@@ -350,14 +532,20 @@ function inputsChanged() {
   hideWarning();
   ui.estimate.hidden = true; // it was of the inputs before the change
   if (!state.busy) showError("");
+  showTextCount();
+  showTargetHint();
+  const tooLong = textRefusal();
+  if (tooLong && !state.busy) showError(tooLong, "text");
   markStale();
   if (!state.result && !state.busy) ui.studio.dataset.state = state.strokes.length ? "drawn" : "empty";
+  save();
 }
 
 function markStale() {
   if (!state.result) return;
   ui.stale.hidden = false;
   ui.studio.dataset.state = "stale";
+  announce("Out of date: plan again.");
   for (const a of ui.files.querySelectorAll("a")) {
     a.removeAttribute("href");
     a.setAttribute("aria-disabled", "true");
@@ -366,9 +554,15 @@ function markStale() {
 
 // -------------------------------------------------------------- results
 
+function verdict(result) {
+  // The one place the page words its verdict on the limits.
+  const excess = Math.max(...result.drones.flatMap((d) => d.checks.map((c) => c.relative_excess)));
+  return excess > 0 ? `limits exceeded by ${(100 * excess).toFixed(2)} %` : "every limit met";
+}
+
 function showResult(result, waitedS) {
   state.result = result;
-  state.views = result.drones.map((d) => viewOf(result, d));
+  layoutViews(result);
   state.t = 0;
   ui.time.max = String(result.duration_s);
   ui.time.step = String(Math.max(result.duration_s / 1000, 0.01));
@@ -377,53 +571,128 @@ function showResult(result, waitedS) {
   showSummary(result, waitedS);
   showFiles(result);
   showDroneLegends(result);
-  drawFrame();
   ui.overlay.dataset.pathPoints = String(result.drones.reduce((n, d) => n + d.path.length, 0));
   ui.studio.dataset.state = "planned";
   ui.studio.dataset.planId = result.plan_id;
+  ui.studio.dataset.duration = String(result.duration_s);
+  announce(`Planned: ${result.duration_s.toFixed(1)} s of flight, ${verdict(result)}.`, true);
+  drawFrame();
   setPlaying(true);
-  // On a phone the canvas may be scrolled away while the person looked at the Plan button.
+  // On a phone the canvas may be scrolled away while the person looked at the form.
   const box = ui.stagePanel.getBoundingClientRect();
   if (box.top < 0 || box.top > window.innerHeight * 0.5) ui.stagePanel.scrollIntoView({ block: "start" });
 }
 
-function showDroneLegends(result) {
-  const n = result.drones.length;
-  for (const legend of [ui.droneLegend, ui.plotLegend]) {
-    legend.replaceChildren(...result.drones.map((_, i) => {
-      const key = document.createElement("span");
-      key.className = "key";
-      key.style.setProperty("--key-color", COLORS[i % COLORS.length]);
-      key.textContent = n > 1 ? `drone ${i + 1}` : "drone 1";
-      return key;
-    }));
-    legend.hidden = n < 2 && legend === ui.droneLegend;
-  }
+function showPathKeys(result) {
+  // One drone: its path is "planned path"; several: one key per drone, in its colour.
+  for (const key of ui.legend.querySelectorAll(".key.drone")) key.remove();
+  const n = result ? result.drones.length : 1;
+  ui.pathKey.hidden = n > 1;
+  if (n < 2) return;
+  const keys = result.drones.map((_, i) => {
+    const key = document.createElement("span");
+    key.className = "key drone";
+    key.style.setProperty("--key-color", COLORS[i % COLORS.length]);
+    key.textContent = `drone ${i + 1}'s path, pen down`;
+    return key;
+  });
+  ui.pathKey.after(...keys);
 }
 
-function viewOf(result, drone) {
-  // Drawn input: map each board back onto the ink it came from (source units are canvas px).
+function showDroneLegends(result) {
+  showPathKeys(result);
+  ui.plotLegend.replaceChildren(...result.drones.map((_, i) => {
+    const key = document.createElement("span");
+    key.className = "key";
+    key.style.setProperty("--key-color", COLORS[i % COLORS.length]);
+    key.textContent = `drone ${i + 1}`;
+    return key;
+  }));
+  ui.plotLegend.hidden = false;
+}
+
+function layoutViews(result) {
+  // Drawn input: each board mapped back onto the ink it came from (source units are canvas px).
+  // Typed text: each drone's writing in a cell of its own, as large as the cells allow.
+  state.cells = [];
   if (result.source === "strokes") {
-    const [lx, ly] = drone.source_lo;
-    const k = 1 / drone.source_scale;
-    return ([u, v]) => [lx + u * k, W - (ly + v * k)];
+    state.views = result.drones.map((d) => {
+      const [lx, ly] = d.source_lo;
+      const k = 1 / d.source_scale;
+      return ([u, v]) => [lx + u * k, W - (ly + v * k)];
+    });
+  } else {
+    state.views = textViews(result);
   }
-  // Typed text: fit every board's writing, side by side, into the canvas.
+  state.overview = overview(result);
+}
+
+function extent(drone) {
+  // What a drone writes: its input and its pen-down path (the legs from home are not).
+  let lo = [Infinity, Infinity];
+  let hi = [-Infinity, -Infinity];
+  const grow = ([u, v]) => {
+    lo = [Math.min(lo[0], u), Math.min(lo[1], v)];
+    hi = [Math.max(hi[0], u), Math.max(hi[1], v)];
+  };
+  for (const stroke of drone.input) stroke.forEach(grow);
+  drone.path.forEach((p, i) => { if (drone.pen[i]) grow(p); });
+  return [lo, hi];
+}
+
+function textViews(result) {
+  const n = result.drones.length;
+  const boxes = result.drones.map(extent);
+  const wu = Math.max(...boxes.map(([lo, hi]) => hi[0] - lo[0]), 1e-9);
+  const hv = Math.max(...boxes.map(([lo, hi]) => hi[1] - lo[1]), 1e-9);
+  const margin = n > 1 ? 22 : 40;
+  let best = null;
+  for (let cols = 1; cols <= n; cols += 1) {
+    const rows = Math.ceil(n / cols);
+    const k = Math.min((W / cols - 2 * margin) / wu, (W / rows - 2 * margin) / hv);
+    if (!best || k > best.k) best = { cols, rows, k };
+  }
+  const { cols, rows, k } = best;
+  const cw = W / cols;
+  const ch = W / rows;
+  const top = (W - rows * ch) / 2;
+  return result.drones.map((d, i) => {
+    const [lo] = boxes[i];
+    const x0 = (i % cols) * cw;
+    const y0 = top + Math.floor(i / cols) * ch;
+    state.cells[i] = n > 1 ? [x0, y0, cw, ch] : null;
+    const ox = x0 + (cw - k * wu) / 2;
+    const oy = y0 + (ch - k * hv) / 2;
+    return ([u, v]) => [ox + (u - lo[0]) * k, oy + (hv - (v - lo[1])) * k];
+  });
+}
+
+function overview(result) {
+  // The whole flight, take-off and landing included, in a corner inset: boards side by side.
   let lo = [Infinity, Infinity];
   let hi = [-Infinity, -Infinity];
   for (const d of result.drones) {
-    for (const stroke of d.input) {
-      for (const [u, v] of stroke) {
-        lo = [Math.min(lo[0], u + d.board_u0), Math.min(lo[1], v)];
-        hi = [Math.max(hi[0], u + d.board_u0), Math.max(hi[1], v)];
-      }
+    for (const [u, v] of d.path) {
+      lo = [Math.min(lo[0], u + d.board_u0), Math.min(lo[1], v)];
+      hi = [Math.max(hi[0], u + d.board_u0), Math.max(hi[1], v)];
     }
   }
-  const margin = 40;
-  const k = (W - 2 * margin) / Math.max(hi[0] - lo[0], hi[1] - lo[1], 1e-9);
-  const ox = margin + ((W - 2 * margin) - k * (hi[0] - lo[0])) / 2;
-  const oy = margin + ((W - 2 * margin) - k * (hi[1] - lo[1])) / 2;
-  return ([u, v]) => [ox + (u + drone.board_u0 - lo[0]) * k, W - (oy + (v - lo[1]) * k)];
+  const size = Math.round(W * 0.3);
+  const pad = 10;
+  const k = (size - 2 * pad) / Math.max(hi[0] - lo[0], hi[1] - lo[1], 1e-9);
+  const corners = [[W - size - 6, 6], [6, 6], [W - size - 6, W - size - 6], [6, W - size - 6]];
+  // The corner that hides the least of the path drawn in the main view.
+  const covered = ([x, y]) => result.drones.reduce((n, d, i) => n + d.path.filter((p) => {
+    const [px, py] = state.views[i](p);
+    return px >= x && px <= x + size && py >= y && py <= y + size;
+  }).length, 0);
+  const [x, y] = corners.reduce((a, b) => (covered(b) < covered(a) ? b : a));
+  const ox = x + (size - k * (hi[0] - lo[0])) / 2;
+  const oy = y + (size - k * (hi[1] - lo[1])) / 2;
+  return {
+    box: [x, y, size, size],
+    map: (d) => ([u, v]) => [ox + (u + d.board_u0 - lo[0]) * k, oy + (hi[1] - v) * k],
+  };
 }
 
 function sampleIndex(drone, t) {
@@ -439,39 +708,52 @@ function drawFrame() {
   if (!result) return;
   overCtx.lineCap = "round";
   overCtx.lineJoin = "round";
-  result.drones.forEach((drone, i) => drawDrone(drone, state.views[i], result.source === "text", i));
+  result.drones.forEach((drone, i) => {
+    overCtx.save();
+    const cell = state.cells[i];
+    overCtx.beginPath();
+    if (cell) overCtx.rect(...cell);
+    else overCtx.rect(0, 0, W, W);
+    overCtx.clip();
+    drawDrone(drone, state.views[i], result.source === "text", i, cell);
+    overCtx.restore();
+  });
+  drawOverview(result);
   ui.clock.textContent = `${state.t.toFixed(1)} / ${result.duration_s.toFixed(1)} s`;
   ui.time.value = String(state.t);
+  ui.phase.textContent = phases(result);
   drawPlots(result);
 }
 
-function drawDrone(drone, view, showInput, i) {
+function drawDrone(drone, view, showInput, i, cell) {
   const k = sampleIndex(drone, state.t);
+  const own = COLORS[i % COLORS.length];
+  if (cell) {
+    overCtx.fillStyle = own;
+    overCtx.font = "600 13px system-ui, sans-serif";
+    overCtx.fillText(`drone ${i + 1}`, cell[0] + 6, cell[1] + 16);
+  }
   if (showInput) {
     overCtx.strokeStyle = "rgba(29, 29, 31, 0.35)";
     overCtx.lineWidth = 3;
     for (const stroke of drone.input) polyline(overCtx, stroke.map(view));
   }
-  // What the simulated brush left on the board, as ink: as wide as the brush's footprint
-  // (ink_width_m, the tip pressed to its planned depth) at the canvas's scale.
-  const [x0, y0] = view([0, 0]);
-  const [x1, y1] = view([1, 0]);
-  overCtx.strokeStyle = color("--sim-ink");
-  overCtx.lineWidth = Math.max(1, drone.ink_width_m * Math.hypot(x1 - x0, y1 - y0));
-  for (const line of drone.ink) polyline(overCtx, line.map(view));
-  drawPath(drone, view, COLORS[i % COLORS.length]);
-  drawTrace(drone, view, k);
+  drawPath(drone, view, own);
+  drawLaidInk(drone, view, k);
   if (drone.flight.length) {
     // The simulated flight so far (the tip below the flown vehicle), thin and solid.
     overCtx.strokeStyle = color("--flight");
-    overCtx.lineWidth = 1.2;
+    overCtx.lineWidth = 1.5;
     polyline(overCtx, drone.flight.slice(0, k + 1).map(view));
   }
-  drawMarker(view(drone.path[k]), drone.path[k][2] < 0.003);
+  const last = drone.path.length - 1;
+  drawHome(view(drone.path[0]), cell);
+  drawHome(view(drone.path[last]), cell);
+  drawMarker(view(drone.path[k]), drone.pen[k] === 1, own, cell);
 }
 
 function drawPath(drone, view, penDown) {
-  // Pen-down runs solid, pen-up runs dashed: split the samples where the pen changes.
+  // Pen-down runs solid in the drone's colour, pen-up runs dashed grey.
   let run = [view(drone.path[0])];
   for (let i = 1; i < drone.path.length; i += 1) {
     run.push(view(drone.path[i]));
@@ -487,10 +769,22 @@ function drawPath(drone, view, penDown) {
   overCtx.setLineDash([]);
 }
 
-function drawTrace(drone, view, k) {
-  // The drone's ink so far: the pen-down samples up to now.
-  overCtx.strokeStyle = color("--drone");
-  overCtx.lineWidth = 4;
+function drawLaidInk(drone, view, k) {
+  // The ink laid up to now: the simulated brush's (as wide as its footprint) when flown,
+  // else the planned pen-down path's.
+  const [x0, y0] = view([0, 0]);
+  const [x1, y1] = view([1, 0]);
+  overCtx.strokeStyle = color("--sim-ink");
+  overCtx.lineWidth = Math.max(2, drone.ink_width_m * Math.hypot(x1 - x0, y1 - y0));
+  if (drone.ink.length) {
+    drone.ink.forEach((line, r) => {
+      const times = drone.ink_t[r] || [];
+      let n = 0;
+      while (n < times.length && times[n] <= state.t) n += 1;
+      polyline(overCtx, line.slice(0, n).map(view));
+    });
+    return;
+  }
   let run = [];
   for (let i = 0; i <= k; i += 1) {
     if (drone.pen[i]) run.push(view(drone.path[i]));
@@ -502,14 +796,45 @@ function drawTrace(drone, view, k) {
   polyline(overCtx, run);
 }
 
-function drawMarker([x, y], down) {
-  // A quadrotor seen from above: four rotors around the brush.
-  overCtx.strokeStyle = color("--drone");
-  overCtx.fillStyle = down ? color("--drone") : "white";
+function inside([x, y], cell) {
+  const [cx, cy, cw, ch] = cell || [0, 0, W, W];
+  return x >= cx && x <= cx + cw && y >= cy && y <= cy + ch;
+}
+
+function clampTo([x, y], cell, pad = 12) {
+  const [cx, cy, cw, ch] = cell || [0, 0, W, W];
+  return [Math.min(Math.max(x, cx + pad), cx + cw - pad), Math.min(Math.max(y, cy + pad), cy + ch - pad)];
+}
+
+function drawHome(p, cell) {
+  // Where the drone takes off and lands: a diamond, at the edge (pointing out) when off view.
+  const away = !inside(p, cell);
+  const [x, y] = away ? clampTo(p, cell, 9) : p;
+  overCtx.save();
+  overCtx.strokeStyle = color("--home");
+  overCtx.fillStyle = "rgba(255, 255, 255, 0.85)";
   overCtx.lineWidth = 2;
-  for (const [dx, dy] of [[-9, -9], [9, -9], [-9, 9], [9, 9]]) {
+  overCtx.setLineDash(away ? [2, 2] : []);
+  overCtx.beginPath();
+  overCtx.moveTo(x, y - 7);
+  overCtx.lineTo(x + 7, y);
+  overCtx.lineTo(x, y + 7);
+  overCtx.lineTo(x - 7, y);
+  overCtx.closePath();
+  overCtx.fill();
+  overCtx.stroke();
+  overCtx.restore();
+}
+
+function drawMarker(p, down, own, cell) {
+  // A quadrotor seen from above: four rotors around the brush; at the edge when off view.
+  const [x, y] = inside(p, cell) ? p : clampTo(p, cell);
+  overCtx.strokeStyle = own;
+  overCtx.fillStyle = down ? own : "white";
+  overCtx.lineWidth = 2;
+  for (const [dx, dy] of [[-8, -8], [8, -8], [-8, 8], [8, 8]]) {
     overCtx.beginPath();
-    overCtx.arc(x + dx, y + dy, 5, 0, 2 * Math.PI);
+    overCtx.arc(x + dx, y + dy, 4.5, 0, 2 * Math.PI);
     overCtx.stroke();
   }
   overCtx.beginPath();
@@ -518,12 +843,73 @@ function drawMarker([x, y], down) {
   overCtx.stroke();
 }
 
+function drawOverview(result) {
+  const { box, map } = state.overview;
+  const [x, y, w, h] = box;
+  overCtx.save();
+  overCtx.fillStyle = "rgba(255, 255, 255, 0.92)";
+  overCtx.strokeStyle = "#8a8a8a";
+  overCtx.lineWidth = 1;
+  overCtx.fillRect(x, y, w, h);
+  overCtx.strokeRect(x + 0.5, y + 0.5, w - 1, h - 1);
+  overCtx.fillStyle = "#3d3d3d";
+  overCtx.font = "11px system-ui, sans-serif";
+  overCtx.fillText("whole flight", x + 5, y + 12);
+  overCtx.beginPath();
+  overCtx.rect(x, y, w, h);
+  overCtx.clip();
+  result.drones.forEach((d, i) => {
+    const view = map(d);
+    overCtx.lineWidth = 1;
+    let run = [view(d.path[0])];
+    for (let s = 1; s < d.path.length; s += 1) {
+      run.push(view(d.path[s]));
+      if (d.pen[s] !== d.pen[s - 1] || s === d.path.length - 1) {
+        overCtx.strokeStyle = d.pen[s - 1] ? COLORS[i % COLORS.length] : color("--transit");
+        overCtx.setLineDash(d.pen[s - 1] ? [] : [3, 3]);
+        polyline(overCtx, run);
+        run = [run[run.length - 1]];
+      }
+    }
+    overCtx.setLineDash([]);
+    const [hx, hy] = view(d.path[0]);
+    overCtx.strokeStyle = color("--home");
+    overCtx.strokeRect(hx - 3, hy - 3, 6, 6);
+    const [px, py] = view(d.path[sampleIndex(d, state.t)]);
+    overCtx.fillStyle = COLORS[i % COLORS.length];
+    overCtx.beginPath();
+    overCtx.arc(px, py, 3.5, 0, 2 * Math.PI);
+    overCtx.fill();
+  });
+  overCtx.restore();
+}
+
+function phases(result) {
+  // What each drone does now, in words: taking off, writing stroke k, moving, landing.
+  const words = result.drones.map((d, i) => {
+    const k = sampleIndex(d, state.t);
+    const starts = [];
+    for (let s = 0; s < d.pen.length; s += 1) if (d.pen[s] && (s === 0 || !d.pen[s - 1])) starts.push(s);
+    const lastDown = d.pen.lastIndexOf(1);
+    let what;
+    if (state.t >= d.t[d.t.length - 1] - 1e-9 && k === d.t.length - 1) what = "landed";
+    else if (!starts.length || k < starts[0]) what = "taking off and flying to the first stroke";
+    else if (k > lastDown) what = "flying back and landing";
+    else {
+      const stroke = starts.filter((s) => s <= k).length;
+      what = d.pen[k] ? `writing stroke ${stroke} of ${starts.length}` : `moving to stroke ${stroke + 1}`;
+    }
+    return result.drones.length > 1 ? `drone ${i + 1}: ${what}` : capital(what);
+  });
+  return words.join(" · ");
+}
+
 // ---------------------------------------------------------------- plots
 
 const PANELS = [
-  { key: "speed", limit: "vmax", label: "speed: largest |v_i|", unit: "m/s" },
-  { key: "acc", limit: "amax", label: "acceleration: largest |a_i|", unit: "m/s²" },
-  { key: "jerk", limit: "jmax", label: "jerk: largest |j_i|", unit: "m/s³" },
+  { key: "speed", limit: "vmax", label: "speed", unit: "m/s" },
+  { key: "acc", limit: "amax", label: "acceleration", unit: "m/s²" },
+  { key: "jerk", limit: "jmax", label: "jerk", unit: "m/s³" },
 ];
 
 function drawPlots(result) {
@@ -546,18 +932,18 @@ function drawPanel(result, panel, top, height) {
   const yOf = (v) => y0 - (v / ymax) * (y0 - y1);
 
   plotCtx.font = "12px system-ui, sans-serif";
-  plotCtx.fillStyle = "#333";
-  plotCtx.fillText(`${panel.label}, ${panel.unit}`, left, top + 12);
+  plotCtx.fillStyle = "#1d1d1f";
+  plotCtx.fillText(`${panel.label}, ${panel.unit} (dashed: the limit)`, left, top + 12);
   // Axes and ticks.
-  plotCtx.strokeStyle = "#999";
+  plotCtx.strokeStyle = "#767676";
   plotCtx.lineWidth = 1;
   polyline(plotCtx, [[left, y1], [left, y0], [right, y0]]);
-  plotCtx.fillStyle = "#666";
+  plotCtx.fillStyle = "#4a4a4a";
   plotCtx.font = "10px system-ui, sans-serif";
   for (const v of [0, limit]) plotCtx.fillText(formatTick(v), 4, yOf(v) + 3);
   for (const t of timeTicks(result.duration_s)) plotCtx.fillText(`${t} s`, xOf(t) - 8, y0 + 13);
   // The limit, dashed red.
-  plotCtx.strokeStyle = "#c92a2a";
+  plotCtx.strokeStyle = "#b02525";
   plotCtx.setLineDash([6, 4]);
   polyline(plotCtx, [[left, yOf(limit)], [right, yOf(limit)]]);
   plotCtx.setLineDash([]);
@@ -568,7 +954,7 @@ function drawPanel(result, panel, top, height) {
     polyline(plotCtx, d.t.map((t, k) => [xOf(t), yOf(d[panel.key][k])]));
   });
   // Where the animation is.
-  plotCtx.strokeStyle = color("--drone");
+  plotCtx.strokeStyle = "#3d3d3d";
   polyline(plotCtx, [[xOf(state.t), y1], [xOf(state.t), y0]]);
 }
 
@@ -589,20 +975,19 @@ function timeTicks(duration) {
 function showSummary(result, waitedS) {
   const mm = (m) => `${(1000 * m).toFixed(1)} mm`;
   const worst = Math.max(...result.drones.map((d) => d.deviation_max_m));
-  const excess = Math.max(...result.drones.flatMap((d) => d.checks.map((c) => c.relative_excess)));
   const parts = [
     `${result.duration_s.toFixed(1)} s of flight`,
     `planned in ${waitedS.toFixed(1)} s`,
-    `pen-down deviation ${mm(worst)}`,
-    excess > 0 ? `limits exceeded by ${(100 * excess).toFixed(2)} %` : "every limit met",
+    `the pen stays within ${mm(worst)} of your strokes`,
+    verdict(result),
   ];
   const flown = result.drones.filter((d) => d.flight_rmse_m !== null);
-  if (flown.length) parts.push(`simulated path RMSE ${mm(Math.max(...flown.map((d) => d.flight_rmse_m)))}`);
+  if (flown.length) parts.push(`in simulation it flew on average ${mm(Math.max(...flown.map((d) => d.flight_rmse_m)))} from the plan`);
   const inked = result.drones.filter((d) => d.ink_max_deviation_m !== null);
-  if (inked.length) parts.push(`ink deviation ${mm(Math.max(...inked.map((d) => d.ink_max_deviation_m)))}`);
+  if (inked.length) parts.push(`its ink within ${mm(Math.max(...inked.map((d) => d.ink_max_deviation_m)))} of your strokes`);
   const overlaps = result.drones.filter((d) => d.ink_iou !== null);
-  if (overlaps.length) parts.push(`ink IoU ${Math.min(...overlaps.map((d) => d.ink_iou)).toFixed(2)}`);
-  if (result.min_separation_m !== null) parts.push(`closest drones ${result.min_separation_m.toFixed(2)} m`);
+  if (overlaps.length) parts.push(`${Math.round(100 * Math.min(...overlaps.map((d) => d.ink_iou)))} % of its ink overlaps yours`);
+  if (result.min_separation_m !== null) parts.push(`drones at least ${result.min_separation_m.toFixed(2)} m apart`);
   ui.summary.textContent = parts.join(" · ");
 }
 
@@ -621,7 +1006,7 @@ function showFiles(result) {
     a.download = file.name;
     a.textContent = file.name;
     a.dataset.file = file.kind;
-    li.append(a, ` — ${file.description} (${(file.size_bytes / 1024).toFixed(0)} KB)`);
+    li.append(a, ` — ${file.description} (${Math.max(1, Math.round(file.size_bytes / 1024))} KB)`);
     return li;
   });
   if (result.source === "strokes") links.push(drawingLink(result.plan_id));
@@ -630,7 +1015,7 @@ function showFiles(result) {
 }
 
 function drawingLink(planId) {
-  // The recording the plan was made of (not the canvas now), as `skyquill write --strokes` reads it.
+  // The recording the plan was made of (not the canvas now), in skyquill's stroke format.
   const body = state.planned;
   const json = JSON.stringify({ strokes: body.strokes, t: body.t }); // the id is in its name
   const li = document.createElement("li");
@@ -639,7 +1024,7 @@ function drawingLink(planId) {
   a.download = `skyquill-${planId}-drawing.json`;
   a.textContent = a.download;
   a.dataset.file = "drawing.json";
-  li.append(a, " — your strokes with their timestamps (skyquill write --strokes)");
+  li.append(a, " — your strokes with their timestamps, to plan again later");
   return li;
 }
 
@@ -668,6 +1053,15 @@ function tick(now) {
   requestAnimationFrame(tick);
 }
 
+// ------------------------------------------------------- the phone's Plan bar
+
+function fitBar() {
+  // On a phone the Plan bar is fixed at the bottom: the page keeps room for it.
+  const fixed = getComputedStyle(ui.actions).position === "fixed";
+  const h = fixed ? Math.ceil(ui.actions.getBoundingClientRect().height) : 0;
+  document.documentElement.style.setProperty("--bar-h", `${h}px`);
+}
+
 // ---------------------------------------------------------------- wiring
 
 ui.ink.addEventListener("pointerdown", onPointerDown);
@@ -677,7 +1071,7 @@ ui.ink.addEventListener("pointercancel", onPointerUp);
 ui.undo.addEventListener("click", undo);
 ui.clear.addEventListener("click", clearAll);
 ui.form.addEventListener("submit", (event) => {
-  // Plan (or Enter in a field): the browser has checked the fields' ranges first.
+  // Plan (or Enter in a field).
   event.preventDefault();
   if (!state.busy) plan();
 });
@@ -689,7 +1083,16 @@ ui.dismiss.addEventListener("click", () => {
   ui.studio.dataset.state = state.strokes.length ? "drawn" : "empty";
 });
 ui.cancel.addEventListener("click", cancel);
-window.addEventListener("resize", fitPlots);
+window.addEventListener("resize", () => {
+  fitPlots();
+  fitBar();
+});
+window.addEventListener("beforeunload", (event) => {
+  // Leaving mid-plan loses the plan (the drawing and settings are kept): ask first.
+  if (!state.busy) return;
+  event.preventDefault();
+  event.returnValue = "";
+});
 ui.play.addEventListener("click", () => {
   if (state.result && state.t >= state.result.duration_s) state.t = 0;
   setPlaying(!state.playing);
@@ -705,6 +1108,15 @@ document.addEventListener("keydown", (event) => {
     undo();
   }
 });
+if (window.ResizeObserver) new ResizeObserver(fitBar).observe(ui.actions);
+
+await loadLimits();
+restore();
 drawInk();
+showTextCount();
+showTargetHint();
+if (textRefusal()) showError(textRefusal(), "text");
+ui.studio.dataset.state = state.strokes.length ? "drawn" : "empty";
 fitPlots();
+fitBar();
 ui.studio.dataset.ready = "true";

@@ -1,0 +1,119 @@
+"""A region with holes or of several fields: a mission of hole-free pieces, each planned on its
+own.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from collections.abc import Callable
+
+import numpy as np
+from numpy.typing import NDArray
+from shapely.geometry import Polygon
+
+from skyquill.coverage.deadline import Deadline
+from skyquill.coverage.missed import missed_area
+from skyquill.coverage.mission import PiecePlanner, fly_mission
+from skyquill.coverage.plan.covering import is_convex
+from skyquill.coverage.plan.options import CoverageOptions
+from skyquill.coverage.plan.result import CoveragePlan, limits_report
+from skyquill.coverage.plan.timing import within_limits
+from skyquill.coverage.regions import (
+    Region,
+    has_keepouts,
+)
+from skyquill.errors import InfeasibleError
+from skyquill.optimize.legs import LegLimits
+from skyquill.trajectory import Trajectory
+
+FloatArray = NDArray[np.float64]
+_log = logging.getLogger(__name__)
+#: Plans one hole-free piece of a mission within a deadline.
+PlanPiece = Callable[[Polygon, Deadline], CoveragePlan]
+
+
+def in_pieces(region: Region, options: CoverageOptions) -> bool:
+    """Whether ``region`` is flown as a mission of pieces: holes, several fields, or a
+    concave field for the jerk-zigzag (whose lanes need a convex region)."""
+    if has_keepouts(region) or not isinstance(region, Polygon):
+        return True
+    return options.pattern == "zigzag-jerk" and not is_convex(region)
+
+
+def plan_mission(
+    region: Region,
+    opts: CoverageOptions,
+    deadline: Deadline,
+    plan_piece: PlanPiece,
+    *,
+    zigzag: PlanPiece,
+) -> CoveragePlan:
+    """The mission over ``region``'s hole-free pieces, each planned by ``plan_piece``.
+
+    A spiral piece that cannot be timed within its share of the budget is
+    planned by ``zigzag`` instead (see :func:`_spiral_or_zigzag`).
+    """
+    start = time.perf_counter()
+    legs = LegLimits(opts.vmax, opts.amax, opts.jmax, per_axis=opts.per_axis)
+    flight = _flight_of(
+        plan_piece if opts.pattern != "spiral" else _spiral_or_zigzag(plan_piece, zigzag)
+    )
+    mission = fly_mission(
+        region,
+        opts.width,
+        legs=legs,
+        altitude=opts.altitude,
+        deadline=deadline,
+        plan_piece=flight,
+        convex=opts.pattern in {"spiral", "zigzag-jerk"},
+    )
+    check = within_limits(mission.trajectory, opts, "mission", deadline)
+    return CoveragePlan(
+        region=region,
+        options=opts,
+        waypoints=mission.waypoints,
+        path=mission.path,
+        trajectory=mission.trajectory,
+        coverage=mission.coverage,
+        limits=limits_report(check) | {"joins": "stop"},
+        planning_time=time.perf_counter() - start,
+        speed_plan=None,
+        missed=missed_area(region, mission.swept),
+        mission=mission,
+    )
+
+
+#: Share of the remaining budget a spiral piece of a mission may spend before it is zigzagged.
+SPIRAL_SHARE = 0.25
+
+
+def _spiral_or_zigzag(plan_piece: PlanPiece, zigzag: PlanPiece) -> PlanPiece:
+    """``plan_piece``, but a piece whose spiral takes over :data:`SPIRAL_SHARE` of the
+    remaining budget (or cannot be timed) is zigzagged instead.
+
+    The speed LP of some convex parts stalls (a pentagon of 114 m² next to a
+    round hole: no plan in 60 s, its mirror image in 3 s); one such part must
+    not spend the whole mission's budget.
+    """
+
+    def plan(piece: Polygon, deadline: Deadline) -> CoveragePlan:
+        share = Deadline(SPIRAL_SHARE * deadline.remaining())
+        try:
+            return plan_piece(piece, share)
+        except InfeasibleError as exc:
+            deadline.check("a zigzag for a piece whose spiral failed")
+            _log.warning("piece of %.3g m²: spiral failed (%s), zigzag instead", piece.area, exc)
+            return zigzag(piece, deadline)
+
+    return plan
+
+
+def _flight_of(plan_piece: PlanPiece) -> PiecePlanner:
+    """A piece planner for :func:`fly_mission`: the plan's trajectory and waypoints."""
+
+    def flight(piece: Polygon, deadline: Deadline) -> tuple[Trajectory, FloatArray]:
+        plan = plan_piece(piece, deadline)
+        return plan.trajectory, plan.waypoints
+
+    return flight
