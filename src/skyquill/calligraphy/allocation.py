@@ -89,11 +89,22 @@ class _Ladder:
     #: Why a position has no plan (the solve's own error, naming the limits).
     errors: dict[float, InfeasibleError] = field(default_factory=dict)
 
-    def pace_options(self, u: float) -> WritingOptions:
+    def pace_options(self, u: float, solve: bool = False) -> WritingOptions:
         """The options with the limits of the pace at ``u`` alone (the vehicle's own at the
-        full pace when they are of the pace's shape: the CLI's defaults are)."""
+        full pace when they are of the pace's shape: the CLI's defaults are).
+
+        With ``solve``, the limits the probe is *solved* within: those of the pace,
+        but never below :data:`PROBE_SOLVE_PACE`'s. A probe timed slower than that
+        is solved within fixed limits, so slowing it gives the spline room to
+        follow the route: solved within its own pace's limits, a slower probe is
+        the faster one played slower where the limits bind, and strays as far
+        (the path-fitting writing of 中 stayed at 8.1 mm from 1.56x to 5.96x).
+        """
         u = min(u, self.top)
-        bounds = PACE_SHAPE_BOUNDS.at_pace(self.opts.stretch_factor**u)
+        pace = self.opts.stretch_factor**u
+        if solve:
+            pace = max(pace, PROBE_SOLVE_PACE)
+        bounds = PACE_SHAPE_BOUNDS.at_pace(pace)
         limits = VehicleLimits(bounds.vmax, bounds.amax, bounds.jmax)
         if u >= self.top and _same_limits(limits, self.opts.limits):
             return self.opts
@@ -123,11 +134,10 @@ class _Ladder:
         """The probe at ``u`` (solved once), ``None`` where its limits cannot be met."""
         u = min(u, self.top)
         if u not in self.probes:
-            opts = self.pace_options(u)
-            if opts is self.opts:  # the plan itself
+            if self.pace_options(u) is self.opts:  # the plan itself
                 self.probes[u] = self.plan(u)
             else:
-                self.probes[u] = self._solved(u, opts, probe=True)
+                self.probes[u] = self._solved(u, self.pace_options(u, solve=True), probe=True)
         return self.probes[u]
 
     def plan(self, u: float) -> RoutePlan | None:
@@ -181,6 +191,10 @@ class _Ladder:
         return float(self.opts.stretch_factor**self.opts.max_stretches)
 
 
+#: The slowest pace whose limits a probe is solved within (:meth:`_Ladder.pace_options`):
+#: :data:`~skyquill.calligraphy.timing.PACE_SHAPE` itself, the CLI's default limits. The
+#: same for every vehicle, so a probe's verdict still is.
+PROBE_SOLVE_PACE = 1.0
 #: The pace shape as timing bounds (:meth:`TimingBounds.at_pace` of it is the shape played
 #: at a pace, uncapped below any practical pace).
 PACE_SHAPE_BOUNDS = TimingBounds(*(1e9 * c for c in PACE_SHAPE))
