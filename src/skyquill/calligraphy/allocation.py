@@ -9,8 +9,10 @@ them. The writing is then slowed by capping the limits it is timed with at a
 played ``p`` times faster (:data:`~skyquill.calligraphy.timing.PACE_SHAPE`) --
 while the legs from and to home keep the speed limit.
 
-Which pace is decided by *probes*: the route timed and solved with the limits
-of the pace alone, whatever the vehicle's (:class:`_Ladder`). A probe's
+Which pace is decided by *probes*: the route timed with the limits of the pace
+alone and solved within them, or within the pace shape's at pace
+:data:`PROBE_SOLVE_PACE` where those are looser -- whatever the vehicle's
+(:class:`_Ladder`). A probe's
 verdict -- faithful or not -- is the same for every vehicle, so the search
 below finds the same pace for every vehicle whose limits it does not reach:
 
@@ -70,10 +72,11 @@ class _Ladder:
 
     Position ``u`` is the pace ``stretch_factor ** u``. Two plans per position:
 
-    * the *probe* (:meth:`probe`): the route timed and solved with the limits
-      of the pace alone, :data:`~skyquill.calligraphy.timing.PACE_SHAPE` played
-      at it -- the same problem for every vehicle, whose verdict (faithful or
-      not) decides the search;
+    * the *probe* (:meth:`probe`): the route timed with the limits of the pace
+      alone, :data:`~skyquill.calligraphy.timing.PACE_SHAPE` played at it, and
+      solved within them or the pace shape's at :data:`PROBE_SOLVE_PACE`,
+      whichever are looser -- the same problem for every vehicle, whose verdict
+      (faithful or not) decides the search;
     * the *plan* (:meth:`plan`): the route timed with the vehicle's limits capped
       at the pace and solved within the vehicle's limits -- what is flown. At or
       above :attr:`top` (the full pace) it is timed with the limits themselves.
