@@ -8,7 +8,7 @@ import tracemalloc
 import numpy as np
 
 from skyquill.calligraphy.board import Board
-from skyquill.calligraphy.mission import _turning_samples
+from skyquill.calligraphy.route import _turning_samples
 
 
 def _zigzag(n: int) -> np.ndarray:

@@ -14,11 +14,11 @@ from skyquill.calligraphy.brush import Brush
 from skyquill.calligraphy.mission import (
     MAX_STROKES,
     WritingOptions,
-    _route,
     check_reach,
     plan_writing,
     route_length,
 )
+from skyquill.calligraphy.route import route_points
 from skyquill.calligraphy.show import layout
 from skyquill.errors import InputError
 from skyquill.strokes import Strokes, hanzi_strokes
@@ -111,7 +111,7 @@ def test_the_route_estimate_bounds_the_route() -> None:
     board = Board()
     world = tuple(board.to_world(p) for p in H.scaled(0.5).paths)
     home = HOME - 0.3 * board.normal
-    points, _ = _route(world, board, home)
+    points, _ = route_points(world, board, home)
     built = float(np.linalg.norm(np.diff(points, axis=0), axis=1).sum())
     assert built <= route_length(world, board, home) + 1e-9
     assert built >= 0.7 * route_length(world, board, home)

@@ -118,8 +118,7 @@ def paint(
     from skyquill.io.trajectory_json import PlannedTrajectory
     from skyquill.painting.dots import MAX_DOTS, drawing_span
     from skyquill.painting.flight import painting_flight
-    from skyquill.painting.mission import ESTIMATORS, MissionConfig, check_on_wall, run_mission
-    from skyquill.painting.order import ORDERS
+    from skyquill.painting.mission import MissionConfig, check_on_wall, run_mission
     from skyquill.painting.wall import Placement, Wall, parse_angles
     from skyquill.painting.wall_file import read_wall
     from skyquill.validation import as_int, as_seed
@@ -131,12 +130,7 @@ def paint(
         positive_rate(rate)  # a long painting needs a lower one: trajectory.csv has a ceiling
         as_int("--dots", dots, low=1, high=MAX_DOTS)  # checked with a CSV too: never ignored
         in_range("--width", width, 0.0, MAX_WIDTH_M, "m", open_low=True)
-        if estimator not in ESTIMATORS:
-            raise InputError(
-                f"--estimator: got {estimator!r}, expected one of {', '.join(ESTIMATORS)}"
-            )
-        if order not in ORDERS:
-            raise InputError(f"--order: got {order!r}, expected one of {', '.join(ORDERS)}")
+        _check_choices(estimator, order, false_contacts, missed_contacts)
         update_mode = _update(update)
         if not -MAX_GAMMA_DEG <= gamma <= MAX_GAMMA_DEG:
             raise InputError(
@@ -160,12 +154,6 @@ def paint(
                 f"{MAX_PROBE_SPACING_M:g} m"
             )
         surface = None if wall is None else read_wall(wall)
-        for option, chance in (
-            ("--false-contacts", false_contacts),
-            ("--missed-contacts", missed_contacts),
-        ):
-            if not 0.0 <= chance < 1.0:
-                raise InputError(f"{option}: got {chance:g}, expected a probability in [0, 1)")
         with _progress() as bar:
             points = _dots(dots_csv, image, dots, width, seed, bar)
             if surface is None:
@@ -245,6 +233,25 @@ def _progress() -> Progress:
     from rich.progress import BarColumn, MofNCompleteColumn, TextColumn
 
     return progress_bar(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn())
+
+
+def _check_choices(
+    estimator: str, order: str, false_contacts: float, missed_contacts: float
+) -> None:
+    """Refuse an unknown ``--estimator`` or ``--order``, or a contact chance outside [0, 1)."""
+    from skyquill.painting.mission import ESTIMATORS
+    from skyquill.painting.order import ORDERS
+
+    if estimator not in ESTIMATORS:
+        raise InputError(f"--estimator: got {estimator!r}, expected one of {', '.join(ESTIMATORS)}")
+    if order not in ORDERS:
+        raise InputError(f"--order: got {order!r}, expected one of {', '.join(ORDERS)}")
+    for option, chance in (
+        ("--false-contacts", false_contacts),
+        ("--missed-contacts", missed_contacts),
+    ):
+        if not 0.0 <= chance < 1.0:
+            raise InputError(f"{option}: got {chance:g}, expected a probability in [0, 1)")
 
 
 def _update(name: str) -> UpdateMode:
