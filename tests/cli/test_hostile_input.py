@@ -495,7 +495,7 @@ ONE_HANZI = json.dumps({"strokes": ["M 0 0"], "medians": [[[100, 500], [900, 500
 NO_OVERLAP = json.loads((EXAMPLES / "s_corridor.json").read_text())
 NO_OVERLAP["boxes"][3]["center"] = [100.0, 100.0, 1.3]
 OPEN_RING = {"type": "Polygon", "coordinates": [[[0, 0], [10, 0], [10, 10], [0, 10]]]}
-BOM_SHOW = b"\xef\xbb\xbf" + SMALL_SHOW.replace("drones = 10", "drones = 500", 1).encode()
+BOM_SHOW = b"\xef\xbb\xbf" + SMALL_SHOW.replace("drones = 10", "drones = 5000", 1).encode()
 LONG_NAME = "a" * 300
 ISSUE25 = [
     # Hangs: a reader meets a named pipe (the JSON stroke reader blocked forever).
@@ -630,7 +630,7 @@ ISSUE25 = [
          ["fit", SPIRAL, "--out", f"{{tmp}}/{LONG_NAME}"],
          "got 'file name too long' from the operating system, expected a shorter name"),
     Case("a TOML byte-order mark is read like any other file's", SHOW,
-         "expected an integer from 1 to 200", setup=_write("s.toml", BOM_SHOW)),
+         "expected an integer from 1 to 1000", setup=_write("s.toml", BOM_SHOW)),
     Case("paint --dots 0 after the progress bar started",
          ["paint", "--image", str(EXAMPLES / "painting" / "quill.png"), "--dots", "0", "--out",
           "{out}"], "--dots"),

@@ -53,7 +53,7 @@ from skyquill.calligraphy.planning import RoutePlan, logger, plan_at
 from skyquill.calligraphy.route import RouteSamples
 from skyquill.calligraphy.timing import PACE_SHAPE, TimingBounds, route_times
 from skyquill.errors import InfeasibleError
-from skyquill.limits import VehicleLimits
+from skyquill.limits import LIMIT_CEILINGS, VehicleLimits
 from skyquill.validation import FloatArray
 
 #: Halvings of the last rung (:func:`plan_route`): the pace found is within
@@ -108,7 +108,12 @@ class _Ladder:
         if solve:
             pace = max(pace, PROBE_SOLVE_PACE)
         bounds = PACE_SHAPE_BOUNDS.at_pace(pace)
-        limits = VehicleLimits(bounds.vmax, bounds.amax, bounds.jmax)
+        # Never above the ceilings a vehicle's limits are held to: at limits near them the
+        # full pace's (a hair faster, TimingBounds.full_pace) would be refused as a unit mistake.
+        jmax = None if bounds.jmax is None else min(bounds.jmax, LIMIT_CEILINGS[3])
+        limits = VehicleLimits(
+            min(bounds.vmax, LIMIT_CEILINGS[1]), min(bounds.amax, LIMIT_CEILINGS[2]), jmax
+        )
         if u >= self.top and _same_limits(limits, self.opts.limits):
             return self.opts
         return replace(self.opts, limits=limits)
