@@ -567,12 +567,6 @@ def _flown_at(page: Any, limits: tuple[str, str, str]) -> tuple[float, float]:
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(
-    strict=True,
-    reason="the flights no longer lengthen (issue 27: 永 22.5/14.8/14.8 s, the cross "
-    "14.6/9.5/9.5 s at 1x/5x/20x), but the estimate (the first timing, a lower bound) "
-    "does not see the pace the fidelity caps the writing at: 2.8x / 2.6x below at 20x",
-)
 @pytest.mark.parametrize("what", ["永", "cross"])
 def test_looser_limits_never_lengthen_the_flight(page: Any, what: str) -> None:
     """Limits raised 1x, 5x, 20x: each flight no longer than the last, each estimate within 2x."""
