@@ -294,16 +294,3 @@ def test_a_character_beyond_the_tolerance_is_refused_with_the_measured_distance(
     assert "best_effort" in message
     best = plan_writing(hanzi_strokes("人"), Board(), dataclasses.replace(tight, best_effort=True))
     assert not best.faithful and best.deviation.max_m > 0.0002
-
-
-def test_the_initial_flight_time_is_the_unstretched_plans_duration() -> None:
-    """The studio's estimate (no solve) is what plan_writing starts from: equal when unstretched."""
-    from skyquill.calligraphy.mission import WritingOptions, initial_flight_time, plan_writing
-
-    strokes = text_strokes("L")
-    board, home = layout(1, 0.5, 1.0)[0]
-    opts = WritingOptions(resegment="off")
-    mission = plan_writing(strokes, board, opts, home=home)
-    assert mission.time_scale == 1.0
-    estimate = initial_flight_time(strokes, board, opts, home)
-    assert estimate == pytest.approx(mission.trajectory.duration, rel=1e-9)

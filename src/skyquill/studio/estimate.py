@@ -2,11 +2,11 @@
 
 Milliseconds of arithmetic on the route (no solve), so the page can ask on every
 Plan press and warn before a person waits minutes for a 27-minute flight. The
-flight time is the timing the planner itself starts from
+flight time is a first timing of the route
 (:func:`~skyquill.calligraphy.mission.initial_flight_time`: the route at the
-speed limit, slowing to a stop at corners, the lifts within the jerk limit):
-the plan's duration when it needs no stretch, and what ``bench/studio_estimate.py``
-measures against the planned flights. Warnings are about the chosen vehicle only.
+speed limit, slowing to a stop at corners, the lifts within the jerk limit);
+``bench/studio_estimate.py`` measures it against the planned flights. Warnings
+are about the chosen vehicle only.
 
 At loose limits the writing is not slowed by the vehicle but by fidelity: the
 planner writes at the fastest pace that stays within the tolerance
