@@ -336,7 +336,9 @@ _VEHICLE_FIELDS: dict[str, tuple[int, str, str]] = {
 #: Largest limit accepted per derivative order, SI: far beyond any multirotor (1000 m/s,
 #: ~1000 g, and a jerk to match), so a larger number is a unit mistake; and a bound that
 #: large would leave the solvers a badly scaled problem to fail on.
-_CEILINGS = {1: 1e3, 2: 1e4, 3: 1e6}
+#: Speed, acceleration and jerk beyond any vehicle (m/s, m/s^2, m/s^3): a unit mistake.
+LIMIT_CEILINGS = {1: 1e3, 2: 1e4, 3: 1e6}
+_CEILINGS = LIMIT_CEILINGS
 
 
 @dataclass(frozen=True)

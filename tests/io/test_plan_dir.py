@@ -75,7 +75,7 @@ def test_bad_plans_are_named(tmp_path: Path) -> None:
     with pytest.raises(InputError, match=r"without trajectory\.json"):
         read_plan(tmp_path)
     (tmp_path / "summary.json").write_text("{not json")
-    with pytest.raises(InputError, match=r"damaged summary"):
+    with pytest.raises(InputError, match=r"summary.json: got malformed JSON"):
         read_plan(tmp_path)
     with pytest.raises(InputError, match="expected 3 \\(x, y, z\\)"):
         write_plan(

@@ -574,11 +574,6 @@ def _flown_at(page: Any, limits: tuple[str, str, str]) -> tuple[float, float]:
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(
-    strict=True,
-    reason="the calligraphy time allocation stretches the timing more at looser limits "
-    "(永 22.5/16.5/20.3 s, the cross 15.2/22.0/22.6 s): issue 27 rewrites it",
-)
 @pytest.mark.parametrize("what", ["永", "cross"])
 def test_looser_limits_never_lengthen_the_flight(page: Any, what: str) -> None:
     """Limits raised 1x, 5x, 20x: each flight no longer than the last, each estimate within 2x."""

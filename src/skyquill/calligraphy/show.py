@@ -46,10 +46,10 @@ if TYPE_CHECKING:
 #: Extra room between boards beyond the required separation, m (lifts, transits).
 BOARD_MARGIN_M = 0.25
 
-#: Most drones in one show: the separation check compares every pair over the
-#: whole flight (n (n - 1) / 2 = 4950 pairs at 100, a few seconds of bounds),
-#: and 100 is the drone show of issue 18.
-MAX_DRONES = 100
+#: Most drones in one show: the separation check looks only at neighbours (sweep and
+#: prune over space-time boxes, :mod:`skyquill.show.separation`), so it grows about
+#: linearly with the drones; the planning work is bounded by the strokes below.
+MAX_DRONES = 1000
 #: Most strokes over all drones of one show: the planning work (each stroke
 #: costs ~0.1-0.3 s of solving on one core, measured on Latin letters and
 #: hanzi), so about 5-15 minutes on two cores at the ceiling.
@@ -395,9 +395,9 @@ def _plan_with_client(
         client = distributed.Client(address, timeout=SCHEDULER_TIMEOUT_S, set_as_default=False)
     except (OSError, TimeoutError, ValueError) as exc:
         raise InputError(
-            f"scheduler: cannot reach the dask scheduler at {address!r} "
-            f"within {SCHEDULER_TIMEOUT_S:g} s ({exc})"
-        ) from exc
+            f"scheduler: got {address!r}, which did not answer within {SCHEDULER_TIMEOUT_S:g} s "
+            f"({exc}), expected the address of a running dask scheduler"
+        ) from None
     with client:
         futures: list[Any] = client.map(_plan, jobs, pure=False)
         arrivals = distributed.as_completed(futures, loop=client.loop)

@@ -31,6 +31,12 @@ from skyquill.show import (
 from skyquill.show.limits import MAX_TOLERANCE
 from skyquill.show.report import UNITS
 
+#: Most drones one ``check`` takes: their half a million pairs are bounded in memory (the
+#: separation's intervals, :data:`~skyquill.show.separation.MAX_INTERVALS`) and in time
+#: (bench/ceilings.py measures a .skyc of this many, neighbours close; 2,000 took over
+#: 20 minutes, most of it playing the .skyc back as the drones would).
+MAX_DRONES = 1_000
+
 
 def _limit(flag: str, value: float | None, *, nonneg: bool = True) -> float | None:
     """A limit from the command line: finite (and >= 0 for speeds and distances)."""
@@ -117,7 +123,7 @@ def check(
             geofence=read_geofence(geofence) if geofence is not None else None,
             tolerance=_tolerance(tolerance),
         )
-        drones = load_show(paths)
+        drones = load_show(paths, max_drones=MAX_DRONES)
         with console.status(f"checking {len(drones)} drone(s)"):
             report = check_show(drones, minimum, limits)
         summary = report.as_dict() | {"paths": [str(p) for p in paths]}

@@ -25,12 +25,14 @@ from skyquill.cli.main import (
     app,
     check_out,
     console,
+    in_range,
     min_altitude,
     positive_rate,
     say_done,
     upload_target,
     user_errors,
 )
+from skyquill.cli.pictures import NoPictures, Pictures
 from skyquill.errors import InputError
 from skyquill.io.outputs import staged_output
 from skyquill.io.plan_dir import write_plan
@@ -41,6 +43,12 @@ from skyquill.optimize.budget import lifted
 from skyquill.optimize.fit import FitOptions, PointFit, fit_points
 from skyquill.phases import DEFAULT_ALTITUDE_M, MIN_ALTITUDE_M, check_altitude
 from skyquill.validation import FloatArray
+
+#: ``--weight`` of the point deviation: beyond 1e9 the solver's conditioning, not the fit,
+#: decides (1e300 did not end).
+WEIGHT_RANGE = (0.0, 1e9)
+#: ``--tolerance``, m: more than a kilometre from the points is no fit of them.
+TOLERANCE_RANGE_M = (0.0, 1000.0)
 
 
 def fit_summary(fit: PointFit, options: FitOptions, rate: float) -> dict[str, Any]:
@@ -97,11 +105,13 @@ def run_fit(
     source: Path,
     force: bool = False,
     flight: Flight | None = None,
+    pictures: bool = True,
 ) -> dict[str, Any]:
     """Fit the points of ``source``, then write the plan directory ``out``.
 
     2-D points are fitted in the plane and flown at ``flight.altitude_m``; 3-D ones as
     they are. Either way the mission keeps ``flight.min_altitude_m`` (else refused).
+    ``pictures``: draw ``plot.png`` (``--no-pictures`` skips it).
     """
     from skyquill.viz.fit_plot import plot_fit
 
@@ -116,6 +126,7 @@ def run_fit(
         limits=lifted_limits(fit.limits) if flat else fit.limits,
     )
     fields = fit_summary(fit, options, rate) | {"altitude_m": altitude if flat else None}
+    drawn = Pictures(pictures)
     with (
         console.status("writing and checking the plan"),
         staged_output(out, "fit", force=force, inputs=[source]) as stage,
@@ -125,8 +136,8 @@ def run_fit(
             [planned],
             rate=rate,
             guaranteed=True,
-            summary=fields,
-            plot=lambda path: plot_fit(fit, path, title),
+            summary=fields | {"pictures": drawn.entry},
+            plot=drawn.plot(lambda path: plot_fit(fit, path, title)),
             min_altitude_m=flight.min_altitude_m,
         )
     uploads = "" if fit.budget is None else f", {len(fit.budget.uploads)} upload(s)"
@@ -178,6 +189,7 @@ def fit(
     altitude: Altitude = None,
     min_altitude_m: MinAltitude = MIN_ALTITUDE_M,
     force: Force = False,
+    no_pictures: NoPictures = False,
 ) -> None:
     """Fit a smooth trajectory to POINTS_CSV that starts and ends at rest.
 
@@ -187,6 +199,9 @@ def fit(
     """
     with user_errors():
         check_out(out)
+        in_range("--weight", weight, *WEIGHT_RANGE, "(no unit)")
+        if tolerance is not None:
+            in_range("--tolerance", tolerance, *TOLERANCE_RANGE_M, "m", open_low=True)
         options = FitOptions(
             limits=VehicleLimits(vmax, amax, jmax, vmax_axis, amax_axis, jmax_axis),
             norm_sides=norm_sides,
@@ -208,7 +223,17 @@ def fit(
         if timing in ("path", "segments"):
             times = None
         flight = _flight(points, altitude, min_altitude(min_altitude_m))
-        run_fit(points, times, options, out, positive_rate(rate), points_csv, force, flight)
+        run_fit(
+            points,
+            times,
+            options,
+            out,
+            positive_rate(rate),
+            points_csv,
+            force,
+            flight,
+            not no_pictures,
+        )
 
 
 def _flight(points: FloatArray, altitude: float | None, floor: float) -> Flight:

@@ -18,13 +18,16 @@ from skyquill.cli.main import (
     console,
     min_altitude,
     say_done,
+    scheduler_address,
     stage_progress,
     user_errors,
 )
+from skyquill.cli.pictures import NoPictures, Pictures
 from skyquill.errors import InfeasibleError, InputError
 from skyquill.io.atomic import write_json
 from skyquill.io.outputs import staged_output
 from skyquill.io.plan_dir import trajectory_names, write_plan
+from skyquill.io.points import check_rows_written
 from skyquill.io.trajectory_json import PlannedTrajectory
 from skyquill.phases import MIN_ALTITUDE_M
 from skyquill.show import ShowDrone, ShowLimits, ShowReport, check_show, load_show
@@ -34,6 +37,8 @@ from skyquill.show.script import ShowScript, load_script
 #: Relative round-off allowed over the planned limits in the independent check
 #: (Ruckig's profiles touch the limits exactly; the writing QP holds them to its tolerance).
 CHECK_ROUND_OFF = 1e-6
+#: Most ``--workers`` (processes planning the writing): more than any machine's cores is a typo.
+MAX_WORKERS = 256
 
 
 @app.command()
@@ -49,6 +54,7 @@ def show(
     ] = None,
     min_altitude_m: MinAltitude = MIN_ALTITUDE_M,
     force: Force = False,
+    no_pictures: NoPictures = False,
 ) -> None:
     """Plan a show script: formations, transitions, writing, take-off and landing.
 
@@ -59,8 +65,9 @@ def show(
     with user_errors():
         check_out(out)
         floor = min_altitude(min_altitude_m)
-        if workers is not None and workers < 1:
-            raise InputError(f"--workers: got {workers}, expected at least 1")
+        if workers is not None and not 1 <= workers <= MAX_WORKERS:
+            raise InputError(f"--workers: got {workers}, expected 1 to {MAX_WORKERS}")
+        scheduler = scheduler_address(scheduler)
         show_script = load_script(script)
         stages: dict[str, float] = {}
         plan = _plan(show_script, workers, scheduler)
@@ -69,7 +76,8 @@ def show(
             report = _check(plan, show_script)
         stages["check"] = time.perf_counter() - clock
         with staged_output(out, "show", force=force, inputs=[script]) as stage:
-            summary = _write(stage, plan, show_script, report, stages, floor)
+            drawn = Pictures(not no_pictures)
+            summary = _write(stage, plan, show_script, report, stages, drawn, floor)
     say_done(
         f"{out}: {summary['drones']} drones, {summary['duration_s']:.1f} s, no two closer than "
         f"{summary['min_separation_m']['guaranteed']:.3f} m (guaranteed; "
@@ -126,6 +134,7 @@ def _write(
     script: ShowScript,
     report: ShowReport,
     stages: dict[str, float],
+    drawn: Pictures,
     min_altitude_m: float,
 ) -> dict[str, Any]:
     from skyquill.viz.light_painting import write_pictures
@@ -138,9 +147,10 @@ def _write(
     clock = time.perf_counter()
     studio = _studio_csv(stage, plans, script)
     stages["skybrush_csv"] = time.perf_counter() - clock
-    clock = time.perf_counter()
-    pictures = write_pictures(plan.drones, stage)
-    stages["pictures"] = time.perf_counter() - clock
+    if drawn.drawn:
+        with drawn.timing("long_exposure.png", "preview.gif"):
+            drawn.entry |= write_pictures(plan.drones, stage)
+    stages["pictures"] = drawn.entry["time_s"]
     sep = report.separation
     summary = {
         "command": "show",
@@ -168,9 +178,11 @@ def _write(
         ],
         "skyc": skyc,
         "skybrush_csv": studio,
-        "pictures": pictures,
+        "pictures": drawn.entry,
     }
     clock = time.perf_counter()
+    for drone in plan.drones:  # the script's rate, named as written there (show has no --rate)
+        check_rows_written(drone.trajectory.duration, script.rate_hz, "[show].rate")
     full = write_plan(
         stage,
         plan.drones,

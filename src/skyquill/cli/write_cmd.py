@@ -5,6 +5,7 @@ from __future__ import annotations
 import dataclasses
 import inspect
 import math
+import re
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any
@@ -27,14 +28,17 @@ from skyquill.cli.main import (
     app,
     check_out,
     console,
+    in_range,
     min_altitude,
     parse_color,
     positive_rate,
     say_done,
+    scheduler_address,
     stage_progress,
     upload_target,
     user_errors,
 )
+from skyquill.cli.pictures import NoPictures, Pictures
 from skyquill.colors import RGB
 from skyquill.errors import InputError
 from skyquill.io.atomic import atomic_path, write_json
@@ -44,6 +48,9 @@ from skyquill.io.trajectory_json import PlannedTrajectory
 from skyquill.limits import VehicleLimits
 from skyquill.phases import MIN_ALTITUDE_M
 from skyquill.show.lights import COLOR_BY, window_palette
+
+#: ``--separation`` between drones, m: more than 100 m apart is no show of one drawing.
+SEPARATION_RANGE_M = (0.0, 100.0)
 
 if TYPE_CHECKING:
     from skyquill.calligraphy.board import BoardKind
@@ -224,6 +231,7 @@ def write(
     target: Target = None,
     min_altitude_m: MinAltitude = MIN_ALTITUDE_M,
     force: Force = False,
+    no_pictures: NoPictures = False,
 ) -> None:
     """Plan pen-up / pen-down writing flights; write CSVs, input_strokes.json, plot, summary.
 
@@ -233,12 +241,16 @@ def write(
     On a sky board (light painting) also long_exposure.png, the photograph of the lights
     from in front, and preview.gif (``skyquill render`` shows them from any view).
     """
+    from skyquill.calligraphy.mission import MAX_ALTITUDE_M
     from skyquill.calligraphy.show import MAX_DRONES, plan_show
 
     with user_errors():
         check_out(out)
         rate = positive_rate(rate)
         floor = min_altitude(min_altitude_m)
+        scheduler = scheduler_address(scheduler)
+        in_range("--board-height", board_height, 0.0, MAX_ALTITUDE_M, "m", open_low=True)
+        in_range("--separation", separation, *SEPARATION_RANGE_M, "m", open_low=True)
         palette = _palette(light_color, color_by)
         kind = _board_kind(board, fly)
         pose = _sky_pose(kind, board_yaw, board_tilt, plane_weight, grid, lift)
@@ -292,6 +304,7 @@ def write(
             extra=extra(show),
             palette=palette,
             min_altitude_m=floor,
+            pictures=not no_pictures,
         )
     say_done(
         f"{out}: {summary['duration_s']:.1f} s of flight, planned in "
@@ -375,14 +388,24 @@ def _sky_pose(
     return _Pose(yaw, tilt, None if grid is None else _grid(grid))
 
 
+_DIGITS = re.compile(r"[0-9]{1,6}", re.ASCII)
+
+
 def _grid(text: str) -> tuple[int, int]:
     """``"4x5"`` to ``(4, 5)``."""
     rows, sep, columns = text.lower().partition("x")
-    if not (sep and rows.strip().isdigit() and columns.strip().isdigit()):
+    if not (sep and _DIGITS.fullmatch(rows.strip()) and _DIGITS.fullmatch(columns.strip())):
         raise InputError(f"--grid: got {text!r}, expected ROWSxCOLUMNS, e.g. 4x5")
+    from skyquill.calligraphy.show import MAX_DRONES
+
     shape = int(rows), int(columns)
     if min(shape) < 1:
         raise InputError(f"--grid: got {text!r}, expected at least one row and one column")
+    if shape[0] * shape[1] > MAX_DRONES:
+        raise InputError(
+            f"--grid: got {text!r} ({shape[0] * shape[1]:,} boards), expected at most "
+            f"{MAX_DRONES} boards, one per drone (rows x columns <= {MAX_DRONES})"
+        )
     return shape
 
 
@@ -482,8 +505,12 @@ def write_outputs(
     extra: dict[str, Any] | None = None,
     palette: tuple[Sequence[RGB], str] | None = None,
     min_altitude_m: float = MIN_ALTITUDE_M,
+    pictures: bool = True,
 ) -> dict[str, Any]:
     """The plan directory: trajectories, ``input_strokes.json``, ``plot.png``, ``summary.json``.
+
+    ``pictures``: draw them (``--no-pictures`` skips every picture; ``summary.json``'s
+    ``pictures`` says which were drawn and how long they took).
 
     ``extra``: more top-level sections of ``summary.json`` (``--split``'s balance).
     ``palette``: the light colours and how they are given out (``"drone"`` or
@@ -523,10 +550,13 @@ def write_outputs(
         "first_stroke_of_drone": firsts,
     }
     closest = show.min_separation_m if len(missions) > 1 else None
+    drawn = Pictures(pictures)
     with staged_output(out, "write", force=force, inputs=inputs) as stage:
         write_json(stage / "input_strokes.json", payload, indent=None)
-        _write_ink_pictures(stage, inks)
-        pictures = _light_pictures(stage, missions, planned)
+        if drawn.drawn:
+            with drawn.timing(*inks):
+                _write_ink_pictures(stage, inks)
+            _light_pictures(stage, missions, planned, drawn)
         return write_plan(
             stage,
             planned,
@@ -537,10 +567,10 @@ def write_outputs(
                 "vehicle_limits": missions[0].options.limits.as_dict(),
                 "min_separation_m": closest,
                 "drones": per_drone,
+                "pictures": drawn.entry,
             }
-            | pictures
             | (extra or {}),
-            plot=lambda path: plot_missions(missions, path, "skyquill write"),
+            plot=drawn.plot(lambda path: plot_missions(missions, path, "skyquill write")),
             min_altitude_m=min_altitude_m,
         )
 
@@ -564,15 +594,16 @@ def _window_colors(
 
 
 def _light_pictures(
-    stage: Path, missions: Sequence[Any], planned: Sequence[PlannedTrajectory]
-) -> dict[str, Any]:
+    stage: Path, missions: Sequence[Any], planned: Sequence[PlannedTrajectory], drawn: Pictures
+) -> None:
     """Light painting (sky boards): the long exposure and the preview; else nothing."""
     if missions[0].board.kind != "sky":
-        return {}
+        return
     from skyquill.viz.light_painting import write_pictures
 
     # The preview keeps every light on screen: it builds up the photograph.
-    return {"pictures": write_pictures(planned, stage, trail_s=math.inf)}
+    with drawn.timing("long_exposure.png", "preview.gif"):
+        drawn.entry |= write_pictures(planned, stage, trail_s=math.inf)
 
 
 def _ink_fidelity(mission: Any, flight: Any) -> InkFidelity | None:

@@ -19,7 +19,6 @@ Every file is written atomically (:mod:`skyquill.io.atomic`).
 
 from __future__ import annotations
 
-import json
 from collections.abc import Callable, Sequence
 from dataclasses import replace
 from pathlib import Path
@@ -29,7 +28,9 @@ import numpy as np
 
 from skyquill.errors import InputError
 from skyquill.io.atomic import atomic_path, write_json
-from skyquill.io.points import write_table_csv
+from skyquill.io.json_read import parse_json
+from skyquill.io.points import check_rows_written, write_table_csv
+from skyquill.io.source import read_bytes, special_kind
 from skyquill.io.trajectory_csv import read_trajectory_csv
 from skyquill.io.trajectory_json import (
     PlannedTrajectory,
@@ -39,6 +40,9 @@ from skyquill.io.trajectory_json import (
 from skyquill.phases import MIN_ALTITUDE_M, flight_phases
 from skyquill.trajectory import SampledTrajectory, Trajectory, sample
 from skyquill.verify import verify
+
+#: Largest summary.json read when looking for a plan's files, bytes.
+SUMMARY_BYTES = 64 * 2**20
 
 PLAN_FORMAT = "skyquill-plan"
 
@@ -134,6 +138,7 @@ def _write_drone(
     guaranteed: bool,
 ) -> dict[str, Any]:
     csv_name, json_name = names
+    check_rows_written(planned.trajectory.duration, rate)  # its read-back would refuse more
     write_trajectory_json(out / json_name, planned)
     s = sample(planned.trajectory, rate)
     table = np.column_stack([s.t, s.p, s.v, s.a, s.j])
@@ -186,7 +191,9 @@ def plan_files(path: Path) -> list[Path]:
     if path.is_file():
         return [path]
     if not path.is_dir():
-        raise InputError(f"plan: got {str(path)!r}, expected a plan directory or a trajectory file")
+        kind = special_kind(path)
+        got = repr(str(path)) if kind is None else f"{kind} {str(path)!r}"
+        raise InputError(f"plan: got {got}, expected a plan directory or a trajectory file")
     files = _listed(path) or _found(path)
     if not files:
         raise InputError(
@@ -211,10 +218,9 @@ def _listed(directory: Path) -> list[Path]:
     summary = directory / "summary.json"
     if not summary.is_file():
         return []
-    try:
-        plan = json.loads(summary.read_text(encoding="utf-8")).get("plan")
-    except (json.JSONDecodeError, UnicodeDecodeError, AttributeError, RecursionError):
-        raise InputError(f"{summary}: got a damaged summary, expected skyquill's JSON") from None
+    what = "skyquill's summary.json"
+    data = parse_json(read_bytes(summary, what, max_bytes=SUMMARY_BYTES), str(summary), what)
+    plan = data.get("plan") if isinstance(data, dict) else None
     if not isinstance(plan, dict) or plan.get("format") != PLAN_FORMAT:
         return []
     names = [d.get("json") for d in plan.get("drones", []) if isinstance(d, dict)]

@@ -34,6 +34,7 @@ from skyquill.colors import RGB, window_colors
 from skyquill.errors import InputError
 from skyquill.io.atomic import write_text
 from skyquill.io.json_read import parse_json
+from skyquill.io.source import read_bytes
 from skyquill.limits import BoxLimit, CylinderLimit, DerivativeLimit, NormLimit
 from skyquill.phases import MIN_ALTITUDE_M, FlightPhases, flight_phases
 from skyquill.trajectory import Trajectory
@@ -142,12 +143,10 @@ def read_trajectory_json(path: str | Path) -> PlannedTrajectory:
         nested too deep, another format, or a malformed trajectory.
     """
     file = Path(path)
-    if not file.is_file():
+    if not file.exists():
         raise InputError(f"trajectory file: got {str(file)!r}, expected an existing JSON file")
-    size = file.stat().st_size
-    if size > MAX_BYTES:
-        raise InputError(f"{file.name}: got {size:,} bytes, expected at most {MAX_BYTES:,}")
-    data = parse_json(file.read_bytes(), file.name, f"a {FORMAT} JSON file")
+    what = f"a {FORMAT} JSON file"
+    data = parse_json(read_bytes(file, what, max_bytes=MAX_BYTES, name=file.name), file.name, what)
     try:
         return _planned(data)
     except InputError as exc:

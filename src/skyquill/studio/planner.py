@@ -114,7 +114,7 @@ class Progress(Protocol):
 PLAN_WEIGHT, FLY_WEIGHT = 3.0, 1.0
 #: The bar's span for :func:`plan_show` (the rest: reading the input, writing files).
 SHOW_START, SHOW_END = 0.05, 0.9
-#: Each solve of a drone's route (mission.py logs one per stretch or re-segmentation)
+#: Each solve of a drone's route (the planning logs one per timing tried or re-segmentation)
 #: moves the bar this fraction of the way to the end of the drone's share: how many
 #: solves a drone takes is not known in advance, so the bar slows, never stops or jumps back.
 SOLVE_STEP = 0.35
@@ -380,10 +380,14 @@ def _unplannable(request: PlanRequest, drone: int, exc: Exception) -> StudioInpu
 
 
 def _solve_stage(step: str, solves: int) -> str:
-    """One of mission.py's per-solve records in plain words, with the try's number."""
+    """One of the planning's per-solve records in plain words, with the try's number.
+
+    The time allocation tries its fastest timing first, then slower ones
+    (:mod:`~skyquill.calligraphy.allocation`); re-segmentation comes last.
+    """
     if step.startswith("re-segmenting"):
         what = "giving each part of the route the time it needs"
-    elif "(stretch 0)" in step:
+    elif solves == 1:
         what = "fitting the flight to the limits"
     else:
         what = "fitting again, slower"
@@ -391,7 +395,7 @@ def _solve_stage(step: str, solves: int) -> str:
 
 
 class _SolveHandler(logging.Handler):
-    """Passes each of mission.py's per-solve DEBUG records to a callback, as its message."""
+    """Passes each of the planning's per-solve DEBUG records to a callback, as its message."""
 
     def __init__(self, callback: Callable[[str], None]) -> None:
         super().__init__(logging.DEBUG)

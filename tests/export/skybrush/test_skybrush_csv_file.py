@@ -64,7 +64,7 @@ GOOD = b"Time_msec,x_m,y_m,z_m,Red,Green,Blue\n0,0,0,1,0,0,0\n10,0.1,0,1,255,0,0
         ({"a.csv": GOOD + b"20,0.2,0,1,255\n"}, r"a.csv: line 4: got 5 values, expected 7"),
         (
             {"a.csv": GOOD + b"20,nan,0,1,0,0,0\n"},
-            r"line 4: got x, y, z = \['nan', '0', '1'\], expected finite",
+            r"line 4: got \['20', 'nan', '0', '1', '0', '0', '0'\], expected numbers",
         ),
         ({"a.csv": GOOD + b"20,1e9,0,1,0,0,0\n"}, r"expected finite numbers within 100000 m"),
         (

@@ -55,6 +55,7 @@ from skyquill.export.crazyflie.memory import (
     pack_pieces,
 )
 from skyquill.export.crazyflie.whole_flight import whole_flight
+from skyquill.io.json_read import read_json_file
 from skyquill.io.trajectory_json import PlannedTrajectory
 from skyquill.phases import FlightPhases
 from skyquill.targets import CRAZYFLIE, Upload, plan_uploads
@@ -393,7 +394,7 @@ _Schedule = list[tuple[str, float, int, list[tuple[str, int, int, float]]]]
 def _schedule(summary: Path) -> _Schedule:
     """The drones' uploads as ``summary`` lists them (:data:`_Schedule`)."""
     try:
-        data = json.loads(Path(summary).read_text(encoding="utf-8"))
+        data = read_json_file(summary, "a Crazyswarm export summary")  # a regular file, strictly
         return [
             (
                 str(d["drone"]),

@@ -31,6 +31,8 @@ from numpy.typing import NDArray
 
 from skyquill.errors import InputError
 from skyquill.io.atomic import atomic_path
+from skyquill.io.numbers import parse_number
+from skyquill.io.source import open_binary
 from skyquill.trajectory import PiecewisePolynomial
 from skyquill.validation import FloatArray
 
@@ -126,10 +128,15 @@ def read_csv_zip(path: str | Path) -> list[CsvDrone]:
         integer in 0..255 (colours), times not strictly increasing, fewer than two rows.
     """
     file = Path(path)
-    if not file.is_file():
+    if not file.exists():
         raise InputError(f"csv zip: got {str(file)!r}, expected an existing .zip file")
     try:
-        with zipfile.ZipFile(file) as archive:
+        with (
+            open_binary(
+                file, "a zipped CSV show", max_bytes=MAX_TOTAL_BYTES, name=file.name
+            ) as raw,
+            zipfile.ZipFile(raw) as archive,
+        ):
             members = [m for m in archive.infolist() if not m.is_dir()]
             _check_members(file.name, members)
             return [_drone(file.name, m.filename, archive.read(m)) for m in members]
@@ -214,9 +221,9 @@ def _row(where: str, row: list[str]) -> tuple[int, list[float], list[int]]:
             f"{where}: got {len(row)} values, expected {len(HEADER)} ({','.join(HEADER)})"
         )
     try:
-        t = float(row[0])
-        xyz = [float(v) for v in row[1:4]]
-        rgb = [int(v) for v in row[4:7]]
+        t = parse_number(row[0])
+        xyz = [parse_number(v) for v in row[1:4]]
+        rgb = [int(v) if v.isascii() and v.isdigit() else int("not a colour") for v in row[4:7]]
     except ValueError:
         raise InputError(
             f"{where}: got {row!r:.80}, expected numbers (colours as integers)"

@@ -14,6 +14,7 @@ what they will show.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -35,8 +36,8 @@ from skyquill.export.base import (
 from skyquill.export.skybrush.lights import (
     colored_frames,
     encode_light_program,
-    light_colors,
     light_slices,
+    longest_mismatch_ms,
     program_bytes,
 )
 from skyquill.export.skybrush.pads import on_pads, takeoff_report
@@ -155,16 +156,16 @@ def _light_mismatch(
     """
     where = f"show.json: swarm.drones[{index}].settings.lights"
     data = program_bytes(where, show["swarm"]["drones"][index]["settings"]["lights"])
-    t_ms = np.arange(0.0, np.ceil(duration_s * 1000) + 1)
-    shown = light_colors(light_slices(where, data, t_ms[-1]), t_ms)
-    wrong = np.any(shown != plan.light(t_ms / 1000, rgb), axis=1)
+    end_ms = math.ceil(duration_s * 1000)
     # the longest run of wrong milliseconds: how far a switch is from the pen's
-    runs = np.diff(np.flatnonzero(np.diff(np.concatenate([[0], wrong.astype(int), [0]]))))[::2]
+    offset = longest_mismatch_ms(
+        light_slices(where, data, end_ms), plan.pen_windows_s, plan.colors(rgb), end_ms
+    )
     return {
         "windows": len(plan.pen_windows_s),
         "lit_windows": len(colored_frames(plan.pen_windows_s, plan.colors(rgb))),
         "colors": len(set(plan.colors(rgb))),
-        "max_offset_ms": int(runs.max()) if runs.size else 0,
+        "max_offset_ms": offset,
     }
 
 
