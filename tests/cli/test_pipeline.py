@@ -11,7 +11,7 @@ own rows) by plain numpy: finite, and the speed at or below the limit.
 from __future__ import annotations
 
 import json
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 import numpy as np
@@ -30,6 +30,7 @@ from skyquill.export.skybrush.skyc_file import read_show_json, show_trajectories
 from skyquill.io.setpoints_json import read_setpoints_json
 from skyquill.io.trajectory_csv import read_trajectory_csv
 from skyquill.io.trajectory_json import PlannedTrajectory, read_trajectory_json
+from skyquill.limits import BoxLimit, CylinderLimit, DerivativeLimit, NormLimit
 from skyquill.trajectory import Trajectory
 
 runner = CliRunner()
@@ -130,33 +131,7 @@ def _distance(reference: Trajectory, back: Trajectory) -> float:
     return float(np.linalg.norm(reference.evaluate(t) - back.evaluate(here), axis=1).max())
 
 
-#: Plans whose .skyc is refused (issue 26, not met): no C2 cubic keyframes on Skybrush's grid
-#: keep these coverage and painting plans inside their limits within 2 cm of them.
-SKYC_REFUSED = {
-    "cover-zigzag-l_field",
-    "cover-zigzag-stop-square_10m",
-    "cover-zigzag-stop-l_field",
-    "paint-quill",
-}
-
-
-@pytest.mark.parametrize(
-    ("label", "args", "vmax"),
-    [
-        pytest.param(
-            *p,
-            id=p[0],
-            marks=pytest.mark.xfail(
-                strict=True,
-                reason="issue 26: the .skyc export refuses this plan (keyframes inside the "
-                "limits are 6-16 cm from it, more than the 2 cm allowed)",
-            )
-            if p[0] in SKYC_REFUSED
-            else (),
-        )
-        for p in PLANS
-    ],
-)
+@pytest.mark.parametrize(("label", "args", "vmax"), [pytest.param(*p, id=p[0]) for p in PLANS])
 @pytest.mark.slow
 def test_plan_flies_exports_and_reads_back(
     tmp_path: Path, label: str, args: Callable[[Path], list[str]], vmax: float
@@ -205,6 +180,40 @@ def test_plan_flies_exports_and_reads_back(
         assert report["max_error_m"] <= TOLERANCE_M[name]
         if name in ("skyc", "skybrush-csv", "crazyswarm"):  # as played (issue 26)
             assert report["as_played"]["within_allowed"], (name, report["as_played"])
+        if name == "skyc":  # skyquill check of the file, at the plan's own limits
+            limits = _check_options(planned[0].limits)
+            checked = runner.invoke(
+                app, ["check", str(out), "--min-distance", "0", "--tolerance", "0.01", *limits]
+            )
+            assert checked.exit_code == 0, checked.output
+
+
+def _check_options(limits: Sequence[DerivativeLimit]) -> list[str]:
+    """``skyquill check`` options that hold a plan's speed and acceleration limits (the
+    tightest its horizontal, climb, descent and norm options can say)."""
+    speed = {"xy": 0.0, "up": 0.0, "down": 0.0}
+    acceleration = 0.0
+    for lim in limits:
+        if isinstance(lim, NormLimit):
+            xy = up = down = norm = lim.radius
+        elif isinstance(lim, CylinderLimit):
+            xy = lim.radius
+            up = lim.z_upper if lim.z_upper is not None else xy
+            down = -lim.z_lower if lim.z_lower is not None else xy
+            norm = float(np.hypot(xy, max(up, down)))
+        else:  # BoxLimit
+            assert isinstance(lim, BoxLimit)
+            xy = float(np.hypot(*np.maximum(np.abs(lim.lower), np.abs(lim.upper))[:2]))
+            up, down = float(lim.upper[2]), float(-lim.lower[2])
+            norm = float(np.linalg.norm(np.maximum(np.abs(lim.lower), np.abs(lim.upper))))
+        if lim.order == 1:
+            speed = {"xy": xy, "up": up, "down": down}
+        elif lim.order == 2:
+            acceleration = norm
+    return [
+        *(f"--max-speed-{k}={v:.9g}" for k, v in speed.items()),
+        f"--max-acceleration={acceleration:.9g}",
+    ]
 
 
 def _as_delivered(name: str, planned: PlannedTrajectory) -> Trajectory:

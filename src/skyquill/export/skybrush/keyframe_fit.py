@@ -28,6 +28,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from skyquill.errors import InfeasibleError, SolverError
+from skyquill.export.base import ALLOWED_EXCESS
 from skyquill.limits import BoxLimit, CylinderLimit, DerivativeLimit, NormLimit
 from skyquill.solvers import QuadraticProgram, SecondOrderCones, solve_qp
 from skyquill.trajectory import Trajectory
@@ -39,6 +40,12 @@ SAMPLES = 8
 WINDOW_SEGMENTS = 300
 #: Relative slack with which the unconstrained solution counts as meeting a limit.
 INSIDE_TOLERANCE = 1e-9
+#: Share of each limit the fit may exceed on its hull, per order: a quarter of what the
+#: delivery allows (:data:`~skyquill.export.base.ALLOWED_EXCESS`), the rest left to the grid's
+#: rounding. Without it a plan on its jerk limit everywhere (a time-optimal move, whose jerk
+#: switches between its bounds) leaves no room to make up a switch that falls inside a
+#: segment, and the fit either leaves the plan by centimetres or is infeasible.
+FIT_SLACK = {order: 0.25 * excess for order, excess in ALLOWED_EXCESS.items()}
 #: Forward-difference stencils of a cubic's hull points per derivative order, and the factor
 #: (times ``1 / h^order``) that makes them the derivative's Bézier points.
 HULL = {
@@ -254,8 +261,14 @@ def hull_excess(limits: Sequence[DerivativeLimit], hull: dict[int, FloatArray]) 
 def _inside(
     points: FloatArray, h: FloatArray, limits: Sequence[DerivativeLimit], margin: float
 ) -> bool:
-    excess = hull_excess(limits, hull_points(_segments(points), h))
-    return bool(np.all((1.0 + excess) <= (1.0 - margin) * (1.0 + INSIDE_TOLERANCE)))
+    excess = hull_excess(limits, hull_points(_segments(points), h))[..., 1:]
+    room = np.array([_room(order, margin) for order in (1, 2, 3)])
+    return bool(np.all((1.0 + excess) <= room * (1.0 + INSIDE_TOLERANCE)))
+
+
+def _room(order: int, margin: float) -> float:
+    """The share of a limit of ``order`` the fit may use: the slack less the margin."""
+    return (1.0 + FIT_SLACK.get(order, 0.0)) * (1.0 - margin)
 
 
 def _limit_constraints(
@@ -266,7 +279,6 @@ def _limit_constraints(
     Each hull point is written as a difference of Bézier points (``d^n Q``), its bound
     scaled by ``h^n / factor``: the same constraint, better conditioned.
     """
-    shrink = 1.0 - margin
     lin_rows: list[sp.csr_array] = []
     lin_rhs: list[FloatArray] = []
     cone_blocks: list[sp.csr_array] = []
@@ -276,6 +288,7 @@ def _limit_constraints(
         if lim.order not in HULL:
             continue
         stencils, factor = HULL[lim.order]
+        shrink = _room(lim.order, margin)
         diff, scale = _difference_rows(h, stencils, n_pts, lim.order, factor)
         if isinstance(lim, NormLimit | CylinderLimit):
             axes = lim.dim if isinstance(lim, NormLimit) else 2

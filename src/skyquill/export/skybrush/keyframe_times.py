@@ -29,6 +29,7 @@ so a short one grows into the exact pieces beside it.
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -99,7 +100,10 @@ def cubic_spans(traj: Trajectory, total_ms: int) -> list[tuple[int, int, bool]]:
     """``(start, end, cubic)`` spans covering ``[0, total_ms]`` ms, from the plan's pieces.
 
     ``cubic``: the plan is one polynomial of degree <= 3 there. Piece ends are rounded to the
-    millisecond; the end held past the duration (rounded up) is not cubic.
+    millisecond; the last span reaches ``total_ms`` (the duration rounded up): a plan ends at
+    rest, so its last piece held to the next millisecond is a cubic stretched by less than a
+    millisecond (a non-cubic sliver there would need a fit region where the plan brakes at
+    its jerk limit, which short fit segments on the millimetre grid cannot follow).
     """
     breaks, cubic = _cubic_breaks(traj)
     ms = np.round(np.asarray(breaks) * 1000).astype(np.int64)
@@ -108,9 +112,10 @@ def cubic_spans(traj: Trajectory, total_ms: int) -> list[tuple[int, int, bool]]:
         start, end = int(ms[k]), int(min(ms[k + 1], total_ms))
         if end > start:
             spans.append((start, end, flag))
-    last = spans[-1][1] if spans else 0
-    if last < total_ms:
-        spans.append((last, total_ms, False))
+    if not spans:
+        return [(0, total_ms, False)]
+    start, last, flag = spans[-1]
+    spans[-1] = (start, total_ms, flag and total_ms - last <= 1)
     return spans
 
 
@@ -173,11 +178,12 @@ def segmentation(
     times: list[int] = [0]
     exact_flags: list[bool] = []
     fit_ranges: list[tuple[int, int]] = []
+    breaks = np.array([a for a, _, flag in spans if flag] + [b for _, b, flag in spans if flag])
     for start_ms, end_ms, fitted in _pieces(spans, regions):
         if fitted:
-            n = max(MIN_REGION_SEGMENTS, round((end_ms - start_ms) / h_fit))
             start = len(exact_flags)
-            cuts = np.round(np.linspace(start_ms, end_ms, n + 1)).astype(np.int64)[1:]
+            cuts = region_cuts(start_ms, end_ms, breaks, h_fit)
+            n = cuts.size
             times.extend(int(c) for c in cuts)
             exact_flags.extend([False] * n)
             fit_ranges.append((start, len(exact_flags)))
@@ -191,6 +197,32 @@ def segmentation(
     return Segmentation(
         np.array(times, dtype=np.int64), np.array(exact_flags, dtype=bool), tuple(fit_ranges)
     )
+
+
+def region_cuts(start_ms: int, end_ms: int, breaks: NDArray[np.int64], h_fit: int) -> NDArray[np.int64]:
+    """A fit region's segment ends after ``start_ms``, ms: at the plan's own cubic breaks.
+
+    Where the plan is made of cubic pieces (a time-optimal move whose jerk switches between
+    its bounds), a knot at each switch lets the C2 spline follow it exactly; uniform knots
+    would average the jerk across a switch, and a plan on its jerk limit cannot then be
+    followed within the limits. Breaks closer than ``h_fit / 2`` to a kept one are dropped (the
+    grid's rounding of shorter segments is coarser than the limits), and what remains is
+    cut into segments of about ``h_fit``, at least :data:`MIN_REGION_SEGMENTS` in all.
+    """
+    inside = np.unique(breaks[(breaks > start_ms) & (breaks < end_ms)])
+    knots = [start_ms]
+    for b in inside:
+        if b - knots[-1] >= h_fit // 2 and end_ms - b >= h_fit // 2:
+            knots.append(int(b))
+    knots.append(end_ms)
+    cuts: list[NDArray[np.int64]] = []
+    for a, b in itertools.pairwise(knots):
+        n = max(1, round((b - a) / h_fit))
+        cuts.append(np.round(np.linspace(a, b, n + 1)).astype(np.int64)[1:])
+    out = np.concatenate(cuts)
+    if out.size < MIN_REGION_SEGMENTS:
+        out = np.round(np.linspace(start_ms, end_ms, MIN_REGION_SEGMENTS + 1)).astype(np.int64)[1:]
+    return out
 
 
 def _runs(spans: list[tuple[int, int, bool]]) -> list[tuple[int, int]]:
