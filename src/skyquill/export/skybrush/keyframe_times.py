@@ -199,7 +199,9 @@ def segmentation(
     )
 
 
-def region_cuts(start_ms: int, end_ms: int, breaks: NDArray[np.int64], h_fit: int) -> NDArray[np.int64]:
+def region_cuts(
+    start_ms: int, end_ms: int, breaks: NDArray[np.int64], h_fit: int
+) -> NDArray[np.int64]:
     """A fit region's segment ends after ``start_ms``, ms: at the plan's own cubic breaks.
 
     Where the plan is made of cubic pieces (a time-optimal move whose jerk switches between
