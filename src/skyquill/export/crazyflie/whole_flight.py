@@ -19,7 +19,6 @@ checked.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -27,58 +26,13 @@ import numpy as np
 from skyquill.export.crazyflie.commander import Goal, rest_to_rest
 from skyquill.export.crazyflie.manoeuvres import APPROACH_OFFSET_M
 from skyquill.export.crazyflie.memory import FlownUploads
-from skyquill.trajectory import Samples, Trajectory, evaluation_times, sample
+from skyquill.trajectory import RestToRestSequence
 from skyquill.validation import FloatArray
 
-
-@dataclass(frozen=True)
-class Chained:
-    """Trajectories flown back to back on one clock (a :class:`~skyquill.trajectory.Trajectory`).
-
-    Unlike :class:`~skyquill.trajectory.RestToRestSequence` it does not hold its joins to
-    1e-6 m: the firmware's float32 polynomials end within a float32 rounding of their
-    targets (about 1e-6 m at 10 m), and what is checked here is what is commanded.
-    """
-
-    pieces: tuple[Trajectory, ...]
-
-    @property
-    def starts(self) -> FloatArray:
-        """Start time of each piece and the end, shape (n + 1,), s."""
-        return np.concatenate([[0.0], np.cumsum([p.duration for p in self.pieces])])
-
-    @property
-    def duration(self) -> float:
-        """Length, s."""
-        return float(self.starts[-1])
-
-    @property
-    def dim(self) -> int:
-        """3: x, y, z."""
-        return 3
-
-    @property
-    def breakpoints(self) -> FloatArray:
-        """Every piece's breakpoints on the flight's clock, shape (L + 1,), s."""
-        starts = self.starts
-        inner = [s + p.breakpoints[:-1] for s, p in zip(starts, self.pieces, strict=False)]
-        return np.concatenate([*inner, [starts[-1]]])
-
-    def evaluate(self, t: FloatArray, order: int = 0) -> FloatArray:
-        """Derivative ``order`` at flight times ``t`` (N,); returns (N, 3)."""
-        times = evaluation_times(t, self.duration)
-        starts = self.starts
-        which = np.clip(np.searchsorted(starts, times, side="right") - 1, 0, len(self.pieces) - 1)
-        out = np.empty((times.size, 3))
-        for k in np.unique(which):
-            mask = which == k
-            local = np.clip(times[mask] - starts[k], 0.0, self.pieces[k].duration)
-            out[mask] = self.pieces[k].evaluate(local, order)
-        return out
-
-    def sample(self, rate: float) -> Samples:
-        """Samples at ``rate`` Hz (position to jerk), including both ends."""
-        return sample(self, rate)
+#: How close the firmware's float32 pieces meet at rest: 1 mm, 1 mm/s, 1 mm/s^2. They end
+#: within a float32 rounding of their targets (about 1e-6 m at 10 m; a 1 s take-off's
+#: acceleration within 1.5e-4 m/s^2), and what is checked here is what is commanded.
+FLOAT32_JOIN_M = 1e-3
 
 
 def _at_rest(point: FloatArray) -> Goal:
@@ -87,7 +41,7 @@ def _at_rest(point: FloatArray) -> Goal:
 
 def whole_flight(
     flight: dict[str, Any], mission: FlownUploads, pad: FloatArray | None = None
-) -> Chained:
+) -> RestToRestSequence:
     """The commanded trajectory from take-off to the end of the landing, on one clock.
 
     Parameters
@@ -105,7 +59,7 @@ def whole_flight(
 
     Returns
     -------
-    Chained
+    RestToRestSequence
         Take-off, approach, mission, landing (4 pieces), z-up world frame, m and s.
     """
     first = np.array(flight["approach"]["point_m"], dtype=float)
@@ -119,4 +73,4 @@ def whole_flight(
     approach = rest_to_rest(float(flight["approach"]["duration_s"]), _at_rest(up), first)
     down = np.array([last[0], last[1], flight["landing"]["height_m"]])
     landing = rest_to_rest(float(flight["landing"]["duration_s"]), _at_rest(last), down)
-    return Chained((takeoff, approach, mission, landing))
+    return RestToRestSequence((takeoff, approach, mission, landing), FLOAT32_JOIN_M)
