@@ -179,6 +179,10 @@ def run(n: int, folder: Path, where: list[str]) -> dict[str, Any]:
         "skyc": {
             "segments": summary["skyc"]["details"]["segments"],
             "limit_excess_as_played": summary["skyc"]["details"]["limit_excess"],
+            # issue 26: the worst relative excess per order of show.skyc as Skybrush plays it
+            # (speed, acceleration <= 1 %, jerk <= 5 %) and the verdict
+            "as_played_relative_excess": summary["skyc"]["as_played"]["relative_excess"],
+            "as_played_verdict": summary["skyc"]["as_played"]["verdict"],
             "max_offset_ms_lights": max(
                 d["max_offset_ms"] for d in summary["skyc"]["details"]["lights"]["per_drone"]
             ),

@@ -10,6 +10,7 @@ import typer
 
 from skyquill.cli.main import (
     Force,
+    MinAltitude,
     OutDir,
     Target,
     Vmax,
@@ -17,6 +18,7 @@ from skyquill.cli.main import (
     check_out,
     console,
     in_range,
+    min_altitude,
     positive_rate,
     progress_bar,
     say_done,
@@ -27,6 +29,7 @@ from skyquill.cli.pictures import NoPictures, Pictures
 from skyquill.coverage import DEFAULT_MIN_COVERAGE
 from skyquill.errors import InputError
 from skyquill.limits import VehicleLimits
+from skyquill.phases import MIN_ALTITUDE_M, check_altitude
 
 if TYPE_CHECKING:
     from rich.progress import Progress, TaskID
@@ -100,7 +103,9 @@ def cover(
         ),
     ] = DEFAULT_MIN_COVERAGE,
     rate: Annotated[float, typer.Option(help="Setpoint rate, Hz.")] = 50.0,
-    altitude: Annotated[float, typer.Option(help="Flight height, m.")] = 2.0,
+    altitude: Annotated[
+        float, typer.Option(help="Flight height above the ground, m (--min-altitude to 120).")
+    ] = 2.0,
     time_limit: Annotated[
         float,
         typer.Option(
@@ -124,6 +129,7 @@ def cover(
         ),
     ] = None,
     target: Target = None,
+    min_altitude_m: MinAltitude = MIN_ALTITUDE_M,
     force: Force = False,
     no_pictures: NoPictures = False,
 ) -> None:
@@ -150,7 +156,9 @@ def cover(
 
     with user_errors():
         check_out(out)
+        floor = min_altitude(min_altitude_m)
         _check_heights(altitude, origin_alt)
+        altitude = check_altitude("--altitude", altitude, floor)
         rate = positive_rate(rate)
         in_range("--delta", delta, *DELTA_RANGE_M, "m", open_low=True)
         in_range("--time-limit", time_limit, *TIME_LIMIT_RANGE_S, "s", open_low=True)
@@ -206,6 +214,7 @@ def cover(
                 guaranteed=plan.delivered is not None,
                 summary=fields,
                 plot=drawn.plot(lambda path: plot_coverage(plan, path)),
+                min_altitude_m=floor,
             )
     uploads = "" if plan.delivered is None else f", {len(plan.delivered.budget.uploads)} upload(s)"
     say_done(

@@ -23,6 +23,12 @@ from skyquill.io.atomic import write_json
 from skyquill.io.outputs import staged_output
 from skyquill.io.plan_dir import plan_files, read_plan
 
+
+def summary_name(out: Path) -> str:
+    """The export's summary beside ``out``: ``<file name>.summary.json``, extension included."""
+    return f"{out.name}.summary.json"
+
+
 FORMAT_HELP = "; ".join(f"{e.name}: {e.help}" for e in EXPORTERS.values())
 #: ``--tolerance`` by default, m: Skybrush's millimetre grid and float32 polynomials stay far
 #: below it; a sampled format at too low a rate does not.
@@ -63,7 +69,11 @@ def export(
     ] = DEFAULT_TOLERANCE_M,
     force: Force = False,
 ) -> None:
-    """Export the planned trajectories of PLAN; read them back; report to <out>.summary.json."""
+    """Export the planned trajectories of PLAN; read them back; report to <out>.summary.json.
+
+    The summary is named after the whole file name (``four.skyc.summary.json``), so exports
+    of one plan into one folder in different formats never collide.
+    """
     with user_errors():
         if format not in EXPORTERS:
             raise InputError(f"--format: got {format!r}, expected one of {', '.join(EXPORTERS)}")
@@ -97,7 +107,7 @@ def export(
                 "plan": str(plan),
                 "drones": [name for name, _ in plans],
             }
-            write_json(stage / f"{out.stem}.summary.json", summary)
+            write_json(stage / summary_name(out), summary)
     say_done(f"{summary['message']} (read back: within {1e3 * report.max_error_m:.3g} mm)")
 
 

@@ -73,6 +73,21 @@ NormSides = Annotated[
         "exactly (second-order cones)."
     ),
 ]
+MinAltitude = Annotated[
+    float,
+    typer.Option(
+        "--min-altitude",
+        help="Lowest altitude of the mission above the ground, m (0 to 100): between take-off "
+        "and landing nothing is planned below it (summary.json: phases).",
+    ),
+]
+Altitude = Annotated[
+    float | None,
+    typer.Option(
+        help="Altitude a 2-D input (x, y) is flown at, m (from --min-altitude to 120; default "
+        "1, or --min-altitude if higher); refused with 3-D input, which has its own z."
+    ),
+]
 Target = Annotated[
     str | None,
     typer.Option(
@@ -80,6 +95,13 @@ Target = Annotated[
         "pieces per upload, uploads changed while hovering)."
     ),
 ]
+
+
+def min_altitude(value: float) -> float:
+    """``--min-altitude``, m, checked (:func:`skyquill.phases.check_min_altitude`)."""
+    from skyquill.phases import check_min_altitude
+
+    return check_min_altitude("--min-altitude", value)
 
 
 def upload_target(name: str | None) -> UploadTarget | None:

@@ -16,11 +16,13 @@ import typer
 
 from skyquill.cli.main import (
     Force,
+    MinAltitude,
     OutDir,
     app,
     check_out,
     console,
     in_range,
+    min_altitude,
     parse_vector3,
     positive_rate,
     progress_bar,
@@ -29,6 +31,7 @@ from skyquill.cli.main import (
 )
 from skyquill.cli.pictures import NoPictures, Pictures
 from skyquill.errors import InputError
+from skyquill.phases import MIN_ALTITUDE_M
 
 if TYPE_CHECKING:  # the painting package is imported lazily
     from rich.progress import Progress
@@ -107,6 +110,7 @@ def paint(
     ] = 0.0,
     seed: Annotated[int, typer.Option(help="Seed of the random generator.")] = 0,
     rate: Annotated[float, typer.Option(help="Sample rate of trajectory.csv, Hz.")] = 100.0,
+    min_altitude_m: MinAltitude = MIN_ALTITUDE_M,
     force: Force = False,
     no_pictures: NoPictures = False,
 ) -> None:
@@ -126,6 +130,7 @@ def paint(
 
     with user_errors():
         check_out(out)
+        floor = min_altitude(min_altitude_m)
         seed = as_seed("--seed", seed)
         positive_rate(rate)  # a long painting needs a lower one: trajectory.csv has a ceiling
         as_int("--dots", dots, low=1, high=MAX_DOTS)  # checked with a CSV too: never ignored
@@ -207,6 +212,7 @@ def paint(
                     "pictures": drawn.entry,
                 },
                 plot=drawn.plot(lambda path: plot_mission(result, path, name)),
+                min_altitude_m=floor,
             )
     say_done(
         f"{out}: {result.painted.sum()} of {len(result.reference)} dots, RMSE "

@@ -19,6 +19,7 @@ from skyquill.cli.main import (
     Force,
     Jmax,
     JmaxAxis,
+    MinAltitude,
     NormSides,
     OutDir,
     Target,
@@ -28,6 +29,7 @@ from skyquill.cli.main import (
     check_out,
     console,
     in_range,
+    min_altitude,
     parse_color,
     positive_rate,
     say_done,
@@ -44,6 +46,7 @@ from skyquill.io.outputs import staged_output
 from skyquill.io.plan_dir import trajectory_names, write_plan
 from skyquill.io.trajectory_json import PlannedTrajectory
 from skyquill.limits import VehicleLimits
+from skyquill.phases import MIN_ALTITUDE_M
 from skyquill.show.lights import COLOR_BY, window_palette
 
 #: ``--separation`` between drones, m: more than 100 m apart is no show of one drawing.
@@ -226,10 +229,14 @@ def write(
         str, typer.Option(help="drone (each drone the next colour) or stroke (each stroke).")
     ] = "drone",
     target: Target = None,
+    min_altitude_m: MinAltitude = MIN_ALTITUDE_M,
     force: Force = False,
     no_pictures: NoPictures = False,
 ) -> None:
     """Plan pen-up / pen-down writing flights; write CSVs, input_strokes.json, plot, summary.
+
+    Each drone's mission starts and ends hovering at --min-altitude above its home (the
+    vehicle takes off to it and lands from it); nothing between is planned below it.
 
     On a sky board (light painting) also long_exposure.png, the photograph of the lights
     from in front, and preview.gif (``skyquill render`` shows them from any view).
@@ -240,6 +247,7 @@ def write(
     with user_errors():
         check_out(out)
         rate = positive_rate(rate)
+        floor = min_altitude(min_altitude_m)
         scheduler = scheduler_address(scheduler)
         in_range("--board-height", board_height, 0.0, MAX_ALTITUDE_M, "m", open_low=True)
         in_range("--separation", separation, *SEPARATION_RANGE_M, "m", open_low=True)
@@ -284,6 +292,7 @@ def write(
                 board_tilt_deg=pose.tilt_deg,
                 grid=pose.grid,
                 places=places.places if sharing.split else None,
+                home_altitude_m=floor,
             )
         inputs = [p for p in (strokes, svg, hanzi) if p is not None]
         summary = write_outputs(
@@ -294,6 +303,7 @@ def write(
             inputs=inputs,
             extra=extra(show),
             palette=palette,
+            min_altitude_m=floor,
             pictures=not no_pictures,
         )
     say_done(
@@ -494,6 +504,7 @@ def write_outputs(
     inputs: Sequence[Path] = (),
     extra: dict[str, Any] | None = None,
     palette: tuple[Sequence[RGB], str] | None = None,
+    min_altitude_m: float = MIN_ALTITUDE_M,
     pictures: bool = True,
 ) -> dict[str, Any]:
     """The plan directory: trajectories, ``input_strokes.json``, ``plot.png``, ``summary.json``.
@@ -560,6 +571,7 @@ def write_outputs(
             }
             | (extra or {}),
             plot=drawn.plot(lambda path: plot_missions(missions, path, "skyquill write")),
+            min_altitude_m=min_altitude_m,
         )
 
 

@@ -7,10 +7,11 @@ One writer for ``fit``, ``write``, ``cover`` and ``paint``:
   ``yaw`` and ``pen``;
 * ``trajectory.json`` (``trajectory_<i>.json``): the exact trajectory, naming
   its kind (:mod:`skyquill.io.trajectory_json`);
-* ``summary.json``: the command's own fields plus ``plan``: the files per drone
-  and the dense check of each trajectory *as read back from the file written*
-  (what is verified is what is delivered), and the largest difference between
-  the CSV's samples and the exact trajectory;
+* ``summary.json``: the command's own fields plus ``plan``: the files per drone,
+  their flight phases (take-off, mission, landing; :mod:`skyquill.phases`) and the
+  minimum altitude they keep, and the dense check of each trajectory *as read back
+  from the file written* (what is verified is what is delivered), and the largest
+  difference between the CSV's samples and the exact trajectory;
 * ``plot.png`` when the command draws one.
 
 Every file is written atomically (:mod:`skyquill.io.atomic`).
@@ -19,6 +20,7 @@ Every file is written atomically (:mod:`skyquill.io.atomic`).
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -35,6 +37,7 @@ from skyquill.io.trajectory_json import (
     read_trajectory_json,
     write_trajectory_json,
 )
+from skyquill.phases import MIN_ALTITUDE_M, flight_phases
 from skyquill.trajectory import SampledTrajectory, Trajectory, sample
 from skyquill.verify import verify
 
@@ -59,6 +62,7 @@ def write_plan(
     guaranteed: bool,
     summary: dict[str, Any],
     plot: Callable[[Path], None] | None = None,
+    min_altitude_m: float | None = MIN_ALTITUDE_M,
 ) -> dict[str, Any]:
     """Write the plan directory ``out`` and return the ``summary.json`` written.
 
@@ -78,12 +82,24 @@ def write_plan(
         The command's own summary fields.
     plot
         Draws ``plot.png`` to the path it is given.
+    min_altitude_m
+        The mission's minimum altitude above the ground, m: each trajectory's phases are
+        found (:func:`~skyquill.phases.flight_phases`, unless given) and recorded in its
+        ``trajectory.json`` and in ``summary.json``. ``None`` records none: trajectories
+        that are not a vehicle's flight (a test's synthetic show); exporters find them then.
+
+    Raises
+    ------
+    InfeasibleError
+        A trajectory whose mission goes below ``min_altitude_m``.
     """
     if not planned:
         raise InputError("planned: got no trajectory, expected at least one")
     for i, p in enumerate(planned):
         if p.trajectory.dim != 3:
             raise InputError(f"planned[{i}]: got {p.trajectory.dim} axes, expected 3 (x, y, z)")
+    if min_altitude_m is not None:
+        planned = [_with_phases(p, min_altitude_m) for p in planned]
     out.mkdir(parents=True, exist_ok=True)
     drones = [
         _write_drone(out, names, p, rate, guaranteed)
@@ -98,12 +114,20 @@ def write_plan(
             "version": 1,
             "rate_hz": rate,
             "limits_guaranteed": guaranteed,
+            "min_altitude_m": min_altitude_m,
             "max_excess": max(d["verification"]["max_excess"] for d in drones),
             "drones": drones,
         }
     }
     write_json(out / "summary.json", full)
     return full
+
+
+def _with_phases(planned: PlannedTrajectory, min_altitude_m: float) -> PlannedTrajectory:
+    """``planned`` with its phases (found at ``min_altitude_m`` unless it has them)."""
+    if planned.phases is not None:
+        return planned
+    return replace(planned, phases=flight_phases(planned.trajectory, min_altitude_m))
 
 
 def _write_drone(
@@ -130,6 +154,7 @@ def _write_drone(
         "json": json_name,
         "kind": _kind(exact),
         "duration_s": exact.duration,
+        "phases": back.phases.as_dict() if back.phases is not None else None,
         "rows": rows,
         "verification": {
             "n_samples": check.n_samples,

@@ -19,6 +19,8 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from skyquill.calligraphy.mission import WritingOptions, initial_flight_time, route_length
 from skyquill.calligraphy.show import layout
 from skyquill.calligraphy.timing import TimingBounds
@@ -62,7 +64,9 @@ def estimate(request: PlanRequest) -> Estimate:
     options = WritingOptions(size_m=request.size_m, limits=limits)
     places = layout(len(parts), request.size_m, SEPARATION_M, kind=request.board)
     lengths, times = [], []
-    for part, (board, home) in zip(parts, places, strict=True):
+    for part, (board, place) in zip(parts, places, strict=True):
+        home = np.array(place, dtype=float)  # raised to the minimum altitude, as planned
+        home[2] = max(home[2], request.min_altitude_m)
         tip_home = home - options.brush.length_m * board.normal  # the route is the tip's
         scaled = part.scaled(options.size_m)
         lengths.append(route_length(tuple(map(board.to_world, scaled.paths)), board, tip_home))
