@@ -22,6 +22,7 @@ from skyquill.export.base import ALLOWED_EXCESS, ORDER_NAMES, DeliveredCheck, ch
 from skyquill.export.skybrush.keyframes import Keyframes, skybrush_keyframes
 from skyquill.export.skybrush.playback import played_trajectory
 from skyquill.io.trajectory_json import PlannedTrajectory
+from skyquill.trajectory import Trajectory
 from skyquill.verify import verify
 
 #: ``(margin, exact pieces kept, fit segment scale)`` tried in order: as planned; shorter fit
@@ -35,9 +36,11 @@ MAX_DEVIATION_M = 0.02
 
 @dataclass(frozen=True)
 class PlayedKeyframes:
-    """A drone's keyframes, their check as played, and the attempt that made them."""
+    """A drone's keyframes, the trajectory Skybrush plays from them, its check, and the attempt
+    that made them."""
 
     keyframes: Keyframes
+    played: Trajectory
     delivered: DeliveredCheck
     attempt: int
 
@@ -78,7 +81,7 @@ def played_keyframes(name: str, planned: PlannedTrajectory) -> PlayedKeyframes:
             infeasible = exc
             continue
         back = played_trajectory(name, {"points": frames.points()}).trajectory()
-        here = PlayedKeyframes(frames, check_delivered(name, planned, back), i)
+        here = PlayedKeyframes(frames, back, check_delivered(name, planned, back), i)
         inside = here.delivered.within_allowed or not planned.limits
         if inside and frames.fit_error_m <= MAX_DEVIATION_M:
             return here

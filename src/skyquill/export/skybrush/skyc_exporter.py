@@ -41,7 +41,7 @@ from skyquill.export.skybrush.lights import (
     program_bytes,
 )
 from skyquill.export.skybrush.pads import on_pads, takeoff_report
-from skyquill.export.skybrush.playback import played_show, played_trajectory
+from skyquill.export.skybrush.playback import played_show
 from skyquill.export.skybrush.refit import played_keyframes
 from skyquill.export.skybrush.skyc_file import (
     SkycDrone,
@@ -82,10 +82,7 @@ class SkycExporter:
             for (name, plan), keys in zip(plans, made, strict=True)
         ]
         # The validation settings are measured on what the drones will fly.
-        flown = [
-            played_trajectory(d.name, {"points": d.keyframes.points()}).trajectory() for d in drones
-        ]
-        validation = validation_settings([p.limits for _, p in plans], flown)
+        validation = validation_settings([p.limits for _, p in plans], [m.played for m in made])
         frame = options.origin
         location = (
             None
