@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TypedDict, Unpack
 
 import numpy as np
 
@@ -94,17 +95,29 @@ class Pieces:
         return out
 
 
-def fit_pieces(
-    x: FloatArray,
-    y: FloatArray,
-    *,
-    max_pieces: int = 8,
-    min_points: int = 3,
-    min_width_m: float = 0.1,
-    noise_floor_m: float = 0.002,
-    max_slope: float = MAX_SLOPE,
-) -> Pieces:
+class SplitOptions(TypedDict, total=False):
+    """How :class:`Splits` cuts the points (each as :class:`Splits` documents it)."""
+
+    max_pieces: int
+    min_points: int
+    min_width_m: float
+    noise_floor_m: float
+    max_slope: float
+
+
+def fit_pieces(x: FloatArray, y: FloatArray, **options: Unpack[SplitOptions]) -> Pieces:
     """The BIC-best piecewise-linear fit of the points ``(x, y)`` (n,) along ``x``.
+
+    ``options`` as :class:`Splits` takes them.
+    """
+    splits = Splits(x, y, **options)
+    return splits.pieces(splits.best)
+
+
+class Splits:
+    """The least-squares best cut of the points into ``K = 1 .. max_pieces`` pieces.
+
+    Built once by the dynamic programme; :meth:`pieces` reads any ``K`` off it.
 
     Parameters
     ----------
@@ -119,24 +132,6 @@ def fit_pieces(
     max_slope
         Steepest piece of a split fit (``|a|``): a steeper run is a few points that happen
         to line up across a corner or a step, not a wall the drone could face.
-    """
-    splits = Splits(
-        x,
-        y,
-        max_pieces=max_pieces,
-        min_points=min_points,
-        min_width_m=min_width_m,
-        noise_floor_m=noise_floor_m,
-        max_slope=max_slope,
-    )
-    return splits.pieces(splits.best)
-
-
-class Splits:
-    """The least-squares best cut of the points into ``K = 1 .. max_pieces`` pieces.
-
-    Built once by the dynamic programme; :meth:`pieces` reads any ``K`` off it. Arguments as
-    :func:`fit_pieces`.
 
     Attributes
     ----------
