@@ -67,7 +67,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from skyquill.errors import InputError
-from skyquill.painting.estimate import Estimator, Plan, UpdateMode
+from skyquill.painting.estimate import MAX_GAMMA_HAT_RAD, Estimator, Plan, UpdateMode
 from skyquill.painting.robust_fit import DriftModel, LineFit, fit_lines
 from skyquill.painting.segmentation import Pieces, Splits, fit_pieces, screen
 from skyquill.painting.wall import Placement, rot2
@@ -79,8 +79,6 @@ MIN_BASELINE_M = 0.3
 #: decides the line (measured: a 48 deg estimate from the first two probes, one false), with
 #: four the robust fit out-votes it. (The paper starts at two, eq. 3 for i >= 2.)
 MIN_CONTACTS = 4
-#: An estimate of gamma beyond this is degenerate and not adopted, rad.
-MAX_GAMMA_HAT_RAD = math.radians(60.0)
 #: Residuals beyond this many robust scales (and beyond ``REJECT_FLOOR_M``) are outliers.
 REJECT_SCALES = 3.5
 REJECT_FLOOR_M = 0.03
