@@ -130,14 +130,36 @@ def _direct(lengths: np.ndarray, lim: LegLimits) -> Callable[[], None]:
     return run
 
 
+def _direct_read(lengths: np.ndarray, lim: LegLimits) -> Callable[[], None]:
+    """:func:`_direct` plus reading each leg's phase durations back (``profiles[0][0].t``).
+
+    The least any leg timing that returns the profile can cost through Ruckig's Python
+    binding; not a goal, it says how much of ours is the binding.
+    """
+    inp, traj, otg = InputParameter(1), Trajectory(1), Ruckig(1)
+    inp.max_velocity, inp.max_acceleration, inp.max_jerk = [lim.vmax], [lim.amax], [lim.jmax]
+
+    def run() -> None:
+        for length in lengths:
+            inp.target_position = [length]
+            otg.calculate(inp, traj)
+            traj.profiles[0][0].t  # noqa: B018 -- the read is what is timed
+
+    return run
+
+
 def leg_cases(quick: bool) -> list[dict[str, Any]]:
     out = []
     lim = LegLimits(2.0, 3.0, 10.0)
     for k, rounds in LEG_COUNTS.items():
         pts = np.random.default_rng(k).uniform(0.0, 20.0, size=(k + 1, 3))
         lengths = np.linalg.norm(np.diff(pts, axis=0), axis=1).tolist()
-        ours_t, direct_t = _interleaved(
-            [lambda p=pts: stop_and_go(p, lim), _direct(np.asarray(lengths), lim)],
+        ours_t, direct_t, read_t = _interleaved(
+            [
+                lambda p=pts: stop_and_go(p, lim),
+                _direct(np.asarray(lengths), lim),
+                _direct_read(np.asarray(lengths), lim),
+            ],
             max(1, rounds // (5 if quick else 1)),
         )
         out.append(
@@ -147,6 +169,7 @@ def leg_cases(quick: bool) -> list[dict[str, Any]]:
                 "ours_us_per_leg": float(np.median(ours_t)) / k * 1e6,
                 "direct_us_per_leg": float(np.median(direct_t)) / k * 1e6,
                 "ratio_ours_over_direct": float(np.median(ours_t) / np.median(direct_t)),
+                "direct_reading_phase_times_us_per_leg": float(np.median(read_t)) / k * 1e6,
             }
         )
     return out

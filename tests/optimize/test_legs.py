@@ -156,3 +156,79 @@ def test_batched_legs_are_the_legs_timed_one_by_one(k: int, seed: int, per_axis:
         c = traj.coeffs[piece]
         end = c[0] + tau * (c[1] + tau * (c[2] + tau * c[3]))
         assert np.allclose(end, ends[i], atol=1e-9 * 40)
+
+
+def _ruckig_profile(length: float, v: float, a: float, j: float) -> object:
+    """A fresh one-leg Ruckig call, rest to rest: its profile (phase times, jerks, states)."""
+    inp = InputParameter(1)
+    inp.current_position, inp.target_position = [0.0], [length]
+    inp.max_velocity, inp.max_acceleration, inp.max_jerk = [v], [a], [j]
+    out = Trajectory(1)
+    Ruckig(1).calculate(inp, out)
+    return out.profiles[0][0]
+
+
+def _assert_legs_are_ruckigs(starts: np.ndarray, ends: np.ndarray, lims: list[LegLimits]) -> None:
+    """Every phase of every leg is the fresh call's: its duration and jerk bit for bit, its
+    position, speed and acceleration to round-off (Ruckig's compiled loop may fuse the
+    multiply-adds that numpy rounds twice)."""
+    legs = legs_pieces(starts, ends, lims)
+    first = 0
+    for start, end, lim in zip(starts, ends, lims, strict=True):
+        delta = end - start
+        length = float(np.linalg.norm(delta))
+        u = delta / length
+        profile = _ruckig_profile(length, *lim.along(u))
+        t = np.array(profile.t)
+        kept = np.flatnonzero(t > 1e-12)
+        got = slice(first, first + kept.size)
+        np.testing.assert_array_equal(legs.durations[got], t[kept])
+        scalar = np.stack(
+            [
+                np.array(profile.p)[kept],
+                np.array(profile.v)[kept],
+                np.array(profile.a)[kept] / 2.0,
+                np.array(profile.j)[kept] / 6.0,
+            ],
+            axis=1,
+        )
+        want = scalar[:, :, None] * u[None, None, :]
+        want[:, 0, :] += start
+        np.testing.assert_array_equal(legs.coeffs[got][:, 3], want[:, 3])
+        scale = max(1.0, length) * np.array([1.0, lim.vmax, np.max(lim.amax)])[None, :, None]
+        assert np.all(np.abs(legs.coeffs[got][:, :3] - want[:, :3]) <= 1e-13 * scale)
+        first += kept.size
+    assert first == legs.durations.size
+
+
+_LEGS = st.tuples(
+    st.integers(1, 30), st.integers(0, 2**32 - 1), st.booleans(), st.sampled_from([1e-3, 1.0, 1e3])
+)
+
+
+@settings(max_examples=30, deadline=None)
+@given(_LEGS)
+def test_rest_to_rest_legs_are_a_fresh_ruckig_call(case: tuple) -> None:
+    k, seed, per_axis, scale = case
+    rng = np.random.default_rng(seed)
+    starts, ends = rng.uniform(-scale, scale, (k, 3)), rng.uniform(-scale, scale, (k, 3))
+    lim = LegLimits(
+        float(rng.uniform(0.1, 10)),
+        rng.uniform(0.1, 10, 3) if per_axis else float(rng.uniform(0.1, 10)),
+        rng.uniform(0.5, 100, 3) if per_axis else float(rng.uniform(0.5, 100)),
+        per_axis=per_axis,
+    )
+    _assert_legs_are_ruckigs(starts, ends, [lim] * k)
+
+
+def test_legs_whose_jerks_are_not_the_rest_to_rest_pattern_are_read_from_ruckig(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # With a wrong jerk pattern no profile ends at rest at its target: every leg is timed
+    # again with its jerks read, and the result is still Ruckig's own.
+    import skyquill.optimize.legs as legs_module
+
+    monkeypatch.setattr(legs_module, "_UDDU", -legs_module._UDDU)
+    rng = np.random.default_rng(3)
+    starts, ends = rng.uniform(-5, 5, (20, 3)), rng.uniform(-5, 5, (20, 3))
+    _assert_legs_are_ruckigs(starts, ends, [LegLimits(2.0, 3.0, 10.0)] * 20)
