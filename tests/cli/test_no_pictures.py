@@ -8,6 +8,8 @@ written. The workloads are the smallest examples (a few seconds each).
 from __future__ import annotations
 
 import json
+import subprocess
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -70,3 +72,25 @@ def test_pictures_are_listed_and_timed(name: str, tmp_path: Path, plan: Path) ->
     pictures = summary["pictures"]
     assert pictures["drawn"] is True and pictures["time_s"] > 0.0
     assert sorted(pictures["files"]) == _pictures_in(tmp_path / "out")
+
+
+@pytest.mark.timeout(300)
+def test_fit_and_fly_without_pictures_never_import_matplotlib(tmp_path: Path) -> None:
+    # The pictures' time counts matplotlib's import (a second on a busy machine): it happens
+    # only when something is drawn. A fresh interpreter, since this one has imported it.
+    script = f"""
+import sys
+from typer.testing import CliRunner
+from skyquill.cli.main import app
+for args in (
+    ["fit", {str(EXAMPLES / "spiral.csv")!r}, "--out", {str(tmp_path / "plan")!r}],
+    ["fly", {str(tmp_path / "plan")!r}, "--out", {str(tmp_path / "flight")!r}],
+):
+    result = CliRunner().invoke(app, [*args, "--no-pictures"])
+    assert result.exit_code == 0, result.output
+assert "matplotlib" not in sys.modules, "imported"
+"""
+    done = subprocess.run(
+        [sys.executable, "-c", script], check=False, capture_output=True, text=True
+    )
+    assert done.returncode == 0, done.stderr[-2000:]

@@ -113,8 +113,6 @@ def run_fit(
     they are. Either way the mission keeps ``flight.min_altitude_m`` (else refused).
     ``pictures``: draw ``plot.png`` (``--no-pictures`` skips it).
     """
-    from skyquill.viz.fit_plot import plot_fit
-
     flight = flight or Flight()
     title = source.stem
     with console.status(f"fitting {points.shape[0]} points ({escape(title)})"):
@@ -137,7 +135,7 @@ def run_fit(
             rate=rate,
             guaranteed=True,
             summary=fields | {"pictures": drawn.entry},
-            plot=drawn.plot(lambda path: plot_fit(fit, path, title)),
+            plot=drawn.plot(lambda path: _plot_fit(fit, path, title)),
             min_altitude_m=flight.min_altitude_m,
         )
     uploads = "" if fit.budget is None else f", {len(fit.budget.uploads)} upload(s)"
@@ -148,6 +146,13 @@ def run_fit(
         f"rms deviation {1e3 * summary['rms_deviation_m']:.2f} mm{uploads}{where}"
     )
     return summary
+
+
+def _plot_fit(fit: PointFit, path: Path, title: str) -> None:
+    """``plot.png``; matplotlib is imported here, only when drawn and inside the pictures' time."""
+    from skyquill.viz.fit_plot import plot_fit
+
+    plot_fit(fit, path, title)
 
 
 @app.command()

@@ -141,7 +141,6 @@ def _fly_drone(
 
     from skyquill.errors import SolverError
     from skyquill.io.trajectory_csv import write_flight_csv
-    from skyquill.viz.flight_plot import plot_flight
 
     with console.status(
         f"flying {trajectory.duration:.1f} s of {escape(name)} on {setup.sim} at {setup.rate:g} Hz"
@@ -157,6 +156,8 @@ def _fly_drone(
     rows = write_flight_csv(out / f"flight{suffix}.csv", flight)
     if drawn.drawn:
         with console.status("plotting"), drawn.timing(f"plot{suffix}.png"):
+            from skyquill.viz.flight_plot import plot_flight  # matplotlib: timed, when drawn
+
             plot_flight(flight, out / f"plot{suffix}.png", name)
     summary = flight.summary()
     return summary | {

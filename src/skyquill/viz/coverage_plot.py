@@ -15,6 +15,7 @@ from shapely.geometry import MultiPolygon, Polygon
 
 from skyquill.coverage.plan import CoveragePlan
 from skyquill.coverage.regions import swept as swept_area
+from skyquill.viz.figures import figure_style, save_png
 
 #: Most setpoints drawn as dots (a 10 ha field has 370k; the figure cannot show more).
 MAX_DOTS = 40_000
@@ -46,12 +47,14 @@ def plot_coverage(plan: CoveragePlan, path: str | Path) -> None:
     opts = plan.options
     sp = plan.samples()
     # A fixed layout: constrained layout draws the figure twice to measure it.
-    fig = plt.figure(figsize=(13, 6.5))
-    grid = fig.add_gridspec(
-        3, 2, width_ratios=(1.1, 1.0), left=0.06, right=0.98, bottom=0.08, top=0.9,
-        hspace=0.45, wspace=0.18,
-    )  # fmt: skip
-    top = fig.add_subplot(grid[:, 0])
+    with figure_style():
+        fig = plt.figure(figsize=(13, 6.5))
+        grid = fig.add_gridspec(
+            3, 2, width_ratios=(1.1, 1.0), left=0.06, right=0.98, bottom=0.08, top=0.9,
+            hspace=0.45, wspace=0.18,
+        )  # fmt: skip
+        top = fig.add_subplot(grid[:, 0])
+        panels = [fig.add_subplot(grid[k, 1]) for k in range(3)]
     sprayed = None if plan.mission is None else plan.mission.swept  # spray off on transits
     # The planner's own simplified sweep: the raw buffer of a 20 km path's 1 M
     # points took a minute.
@@ -81,7 +84,7 @@ def plot_coverage(plan: CoveragePlan, path: str | Path) -> None:
         ("|jerk| (m/s³)", np.abs(sp.j[:, :2]), opts.jmax),
     )
     for k, (label, values, limit) in enumerate(rows):
-        ax = fig.add_subplot(grid[k, 1])
+        ax = panels[k]
         for i in range(values.shape[1]):
             name = "" if values.shape[1] == 1 else "xyz"[i]
             ax.plot(sp.t, values[:, i], lw=0.9, label=name or None)
@@ -90,5 +93,5 @@ def plot_coverage(plan: CoveragePlan, path: str | Path) -> None:
         if values.shape[1] > 1:
             ax.legend(loc="upper right", fontsize=8)
     ax.set_xlabel("t (s)")
-    fig.savefig(path, dpi=110)
+    save_png(fig, path, dpi=110)
     plt.close(fig)

@@ -13,6 +13,7 @@ from matplotlib.axes import Axes
 
 from skyquill.limits import BoxLimit, DerivativeLimit, NormLimit
 from skyquill.optimize.fit import PointFit
+from skyquill.viz.figures import figure_style, save_png
 
 AXES = "xyz"
 
@@ -32,7 +33,8 @@ def plot_fit(fit: PointFit, path: str | Path, title: str = "") -> None:
     traj = fit.trajectory
     t = np.linspace(0.0, traj.duration, 2000)
     # A fixed layout: constrained layout draws the figure twice to measure it (half the time).
-    fig, ax = plt.subplots(2, 2, figsize=(11, 8))
+    with figure_style():
+        fig, ax = plt.subplots(2, 2, figsize=(11, 8))
     fig.subplots_adjust(left=0.07, right=0.98, bottom=0.07, top=0.92, hspace=0.28, wspace=0.22)
     p = traj.evaluate(t)
     ax[0, 0].plot(fit.points[:, 0], fit.points[:, 1], ".", ms=2, color="0.6", label="input")
@@ -54,7 +56,7 @@ def plot_fit(fit: PointFit, path: str | Path, title: str = "") -> None:
         f"{title}  duration {traj.duration:.2f} s, max excess {check.max_excess:.1e}, "
         f"rms deviation {1e3 * fit.rms_deviation_m:.1f} mm"
     )
-    fig.savefig(path, dpi=110)
+    save_png(fig, path, dpi=110)
     plt.close(fig)
 
 

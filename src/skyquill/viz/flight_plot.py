@@ -8,8 +8,10 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
+from matplotlib.figure import Figure
 
 from skyquill.sim.result import Flight
+from skyquill.viz.figures import figure_style, save_png
 
 AXES = "xyz"
 
@@ -32,7 +34,15 @@ def plot_flight(flight: Flight, path: str | Path, title: str = "") -> None:
         Figure title (the controller, simulator and errors are appended).
     """
     # A fixed layout: constrained layout draws the figure twice to measure it.
-    fig = plt.figure(figsize=(13, 8))
+    with figure_style():
+        fig = plt.figure(figsize=(13, 8))
+        _draw(fig, flight, title)
+    save_png(fig, path, dpi=110)
+    plt.close(fig)
+
+
+def _draw(fig: Figure, flight: Flight, title: str) -> None:
+    """The five panels of :func:`plot_flight` and its title, on ``fig``."""
     grid = fig.add_gridspec(
         2, 3, height_ratios=(1.0, 1.4), left=0.06, right=0.98, bottom=0.07, top=0.91,
         hspace=0.3, wspace=0.25,
@@ -69,5 +79,3 @@ def plot_flight(flight: Flight, path: str | Path, title: str = "") -> None:
         f"{title}  {flight.controller} on {flight.sim}: RMSE {1e3 * flight.rmse_m:.2f} mm, "
         f"max {1e3 * flight.max_error_m:.2f} mm, {saturated} saturated step(s)".strip()
     )
-    fig.savefig(path, dpi=110)
-    plt.close(fig)

@@ -26,7 +26,10 @@ def plot_mission(result: MissionResult, path: str | Path, title: str = "") -> No
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, axes = plt.subplots(2, 3, figsize=(16, 8.5))
+    from skyquill.viz.figures import figure_style, save_png
+
+    with figure_style():
+        fig, axes = plt.subplots(2, 3, figsize=(16, 8.5))
     _drawing(axes[0, 0], result)
     _estimates(axes[0, 1], result)
     _gamma(axes[0, 2], result)
@@ -40,7 +43,7 @@ def plot_mission(result: MissionResult, path: str | Path, title: str = "") -> No
     )
     # A fixed layout: tight_layout draws the figure once more to measure it.
     fig.subplots_adjust(left=0.05, right=0.98, bottom=0.07, top=0.92, hspace=0.3, wspace=0.25)
-    fig.savefig(path, dpi=90)
+    save_png(fig, path, dpi=90)
     plt.close(fig)
 
 
@@ -50,12 +53,16 @@ def _landings(ax: Any, result: MissionResult) -> None:
 
 
 def _drawing(ax: Any, result: MissionResult) -> None:
+    from matplotlib.collections import LineCollection
+
     target = result.target_w
     ax.plot(target[:, 0], target[:, 2], "o", mfc="none", color="0.4", label="desired")
     ok = result.painted
     ax.plot(result.painted_w[ok, 0], result.painted_w[ok, 2], ".", color="C3", label="painted")
-    for a, b in zip(target[ok], result.painted_w[ok], strict=True):
-        ax.plot([a[0], b[0]], [a[2], b[2]], color="C3", lw=0.4)
+    # Each dot's miss as one segment of one collection (an artist per dot was a third of
+    # the figure's time at 140 dots).
+    misses = np.stack([target[ok][:, [0, 2]], result.painted_w[ok][:, [0, 2]]], axis=1)
+    ax.add_collection(LineCollection(list(misses), colors="C3", linewidths=0.4))
     ax.set(xlabel="x_w (m)", ylabel="z_w (m)", title="drawing (Figs. 5-7)", aspect="equal")
     ax.legend(loc="lower right", fontsize=8)
 

@@ -26,6 +26,7 @@ from matplotlib.collections import LineCollection
 from skyquill.calligraphy.mission import Mission
 from skyquill.limits import BoxLimit
 from skyquill.validation import FloatArray
+from skyquill.viz.figures import figure_style, save_png
 
 #: Samples per drone of the board view and of the derivative panels.
 BOARD_SAMPLES = 4000
@@ -47,9 +48,10 @@ def plot_missions(missions: list[Mission], path: str | Path, title: str = "") ->
     title
         Figure title.
     """
-    fig = plt.figure(figsize=(16, 6), dpi=DPI)
-    boards = fig.add_axes((0.04, 0.08, 0.44, 0.8))
-    panels = [fig.add_axes((0.55, 0.08 + 0.3 * k, 0.43, 0.2)) for k in (2, 1, 0)]
+    with figure_style():
+        fig = plt.figure(figsize=(16, 6), dpi=DPI)
+        boards = fig.add_axes((0.04, 0.08, 0.44, 0.8))
+        panels = [fig.add_axes((0.55, 0.08 + 0.3 * k, 0.43, 0.2)) for k in (2, 1, 0)]
     _board_view(boards, missions)
     names = ("speed [m/s]", "acceleration [m/s²]", "jerk [m/s³]")
     for ax, order, name in zip(panels, (1, 2, 3), names, strict=True):
@@ -60,7 +62,7 @@ def plot_missions(missions: list[Mission], path: str | Path, title: str = "") ->
         f"{title}  {len(missions)} drone(s), max deviation {1e3 * worst:.2f} mm, max excess "
         f"{max(m.verification.max_excess for m in missions):.1e}"
     )
-    fig.savefig(path, dpi=DPI)
+    save_png(fig, path, dpi=DPI)
     plt.close(fig)
 
 
