@@ -75,7 +75,7 @@ def test_pictures_are_listed_and_timed(name: str, tmp_path: Path, plan: Path) ->
 
 
 @pytest.mark.timeout(300)
-def test_fit_and_fly_without_pictures_never_import_matplotlib(tmp_path: Path) -> None:
+def test_fit_fly_and_write_without_pictures_never_import_matplotlib(tmp_path: Path) -> None:
     # The pictures' time counts matplotlib's import (a second on a busy machine): it happens
     # only when something is drawn. A fresh interpreter, since this one has imported it.
     script = f"""
@@ -85,6 +85,7 @@ from skyquill.cli.main import app
 for args in (
     ["fit", {str(EXAMPLES / "spiral.csv")!r}, "--out", {str(tmp_path / "plan")!r}],
     ["fly", {str(tmp_path / "plan")!r}, "--out", {str(tmp_path / "flight")!r}],
+    ["write", "I", "--out", {str(tmp_path / "write")!r}],
 ):
     result = CliRunner().invoke(app, [*args, "--no-pictures"])
     assert result.exit_code == 0, result.output

@@ -523,8 +523,6 @@ def write_outputs(
     drones, like ``trajectory_<i>.csv``), and its fidelity in the drone's
     ``flight`` section of ``summary.json``.
     """
-    from skyquill.viz.writing_plot import plot_missions
-
     missions = list(show.missions)
     names = trajectory_names(len(missions))
     per_drone: list[dict[str, Any]] = []
@@ -570,7 +568,7 @@ def write_outputs(
                 "pictures": drawn.entry,
             }
             | (extra or {}),
-            plot=drawn.plot(lambda path: plot_missions(missions, path, "skyquill write")),
+            plot=drawn.plot(lambda path: _plot_missions(missions, path)),
             min_altitude_m=min_altitude_m,
         )
 
@@ -591,6 +589,13 @@ def _window_colors(
     if palette is None:
         return [()] * len(missions)
     return window_palette([len(m.pen_windows) for m in missions], *palette)
+
+
+def _plot_missions(missions: Sequence[Any], path: Path) -> None:
+    """``plot.png``; matplotlib is imported here, only when drawn and inside the pictures' time."""
+    from skyquill.viz.writing_plot import plot_missions
+
+    plot_missions(list(missions), path, "skyquill write")
 
 
 def _light_pictures(
