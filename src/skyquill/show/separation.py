@@ -175,6 +175,7 @@ def guaranteed_separation(
     *,
     step_s: float = STEP_S,
     tolerance_m: float = TOLERANCE_M,
+    prune: bool = True,
 ) -> Separation:
     """The guaranteed closest approach of ``motions`` (all on one clock), against ``minimum_m``.
 
@@ -188,6 +189,9 @@ def guaranteed_separation(
         Grid step of the first pass, s.
     tolerance_m
         The bound is refined until it is this close to the closest distance seen, m.
+    prune
+        Examine only the pairs whose space-time boxes come close (``False``: every pair in
+        every window, ``N^2 / 2`` pairs: the reference the pruning is tested against).
 
     Raises
     ------
@@ -208,7 +212,7 @@ def guaranteed_separation(
     # stay farther apart than it (and than the minimum) cannot hold the closest approach.
     # (Grown by round-off: the k-d tree's distances and the boxes' gaps round differently.)
     threshold = max(minimum, _sampled_closest(fleet, t[::WINDOW])) * (1.0 + 1e-9) + 1e-12
-    first, second, window = _candidates(fleet, t, threshold)
+    first, second, window = (_candidates if prune else _every_pair)(fleet, t, threshold)
     pair_of, pair_index = np.unique(first * n + second, return_inverse=True)
     pairs = (pair_of // n, pair_of % n)
     closest = _Closest(pair_of.size, minimum)
@@ -262,6 +266,18 @@ def _candidates(fleet: Fleet, t: FloatArray, threshold: float) -> tuple[IntArray
     window = boxes_first // n
     one, two = boxes_first % n, boxes_second % n
     return np.minimum(one, two), np.maximum(one, two), window
+
+
+def _every_pair(fleet: Fleet, t: FloatArray, threshold: float) -> tuple[IntArray, ...]:
+    """``(first, second, window)`` of every pair in every window (nothing pruned)."""
+    del threshold  # every pair, however far apart
+    first, second = np.triu_indices(len(fleet), 1)
+    windows = np.arange(0, t.size - 1, WINDOW).size
+    return (
+        np.tile(first, windows).astype(np.intp),
+        np.tile(second, windows).astype(np.intp),
+        np.repeat(np.arange(windows), first.size).astype(np.intp),
+    )
 
 
 def _boxes(fleet: Fleet, t: FloatArray, starts: IntArray) -> tuple[FloatArray, FloatArray]:
