@@ -338,21 +338,46 @@ def _grid_intervals(
     per_chunk = max(1, CHUNK // WINDOW)
     for begin in range(0, pair.size, per_chunk):
         part = slice(begin, begin + per_chunk)
+        # Each window whole first: a pair holding its places, or moving in parallel, is
+        # proven by one bound (a formation's hold, the drones waiting while others write);
+        # only the windows it leaves open are cut into grid intervals.
+        whole = _whole_windows(fleet, t, pairs, pair[part], window[part], lengths[part], closest)
+        count += whole.a.size
+        lower, still = _settle(whole, closest, tolerance, lower)
         items = _window_intervals(
             fleet,
             t,
             pairs,
-            pair=pair[part],
-            window=window[part],
-            lengths=lengths[part],
+            pair=pair[part][still],
+            window=window[part][still],
+            lengths=lengths[part][still],
             closest=closest,
         )
         closest.record(items.pair, items.a, items.da)
         closest.record(items.pair, items.b, items.db)
         count += items.a.size
-        lower, items = _settle(items, closest, tolerance, lower)
-        kept.append(items)
+        lower, left = _settle(items, closest, tolerance, lower)
+        kept.append(items.take(left))
     return _joined(kept), lower, count
+
+
+def _whole_windows(  # noqa: PLR0917 - private: the slices of one chunk
+    fleet: Fleet,
+    t: FloatArray,
+    pairs: tuple[IntArray, IntArray],
+    pair: IntArray,
+    window: IntArray,
+    lengths: IntArray,
+    closest: _Closest,
+) -> _Intervals:
+    """One interval per candidate window of ``pair``, bounded (ends and midpoint recorded)."""
+    i, j = pairs[0][pair], pairs[1][pair]
+    a, b = t[window * WINDOW], t[window * WINDOW + lengths]
+    da = np.linalg.norm(fleet.position(i, a) - fleet.position(j, a), axis=1)
+    db = np.linalg.norm(fleet.position(i, b) - fleet.position(j, b), axis=1)
+    closest.record(pair, a, da)
+    closest.record(pair, b, db)
+    return _bounded(fleet, pairs, pair, (a, b), (da, db), closest)
 
 
 def _window_intervals(
@@ -442,8 +467,9 @@ def _relative(
 
 def _settle(
     items: _Intervals, closest: _Closest, tolerance: float, lower: tuple[float, int, float]
-) -> tuple[tuple[float, int, float], _Intervals]:
-    """Close the intervals whose bound is high enough; the lowest closed bound so far and the rest.
+) -> tuple[tuple[float, int, float], NDArray[np.bool_]]:
+    """Close the intervals whose bound is high enough; the lowest closed bound so far and
+    which intervals stay open.
 
     An interval stays open while its bound is below what is asked for (or more than
     ``tolerance`` below the closest distance seen), it is wider than
@@ -460,7 +486,7 @@ def _settle(
         k = int(np.argmin(np.where(open_, np.inf, lb)))
         if lb[k] < lower[0]:
             lower = (float(lb[k]), int(items.pair[k]), float(items.a[k]))
-    return lower, items.take(open_)
+    return lower, open_
 
 
 def _refine(
@@ -479,7 +505,8 @@ def _refine(
     the number of intervals bounded.
     """
     while items.a.size:
-        lower, items = _settle(items, closest, tolerance, lower)
+        lower, left = _settle(items, closest, tolerance, lower)
+        items = items.take(left)
         if 2 * items.a.size > MAX_INTERVALS:
             if tolerance == math.inf:
                 raise SolverError(
