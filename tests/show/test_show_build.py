@@ -139,3 +139,25 @@ def test_an_svg_formation_is_read_relative_to_the_script(tmp_path: Path) -> None
     assert isinstance(scene, FormationScene) and scene.svg == tmp_path / "art" / "zig.svg"
     points = make_formation(scene, script).points
     assert points.shape == (6, 3) and pdist(points).min() >= 1.5
+
+
+def test_a_show_hundreds_of_metres_wide_plays_inside_its_limits_on_skybrushs_grid() -> None:
+    """430 m from the origin Skybrush stores positions in 13-14 mm units, on which 0.2 s jerk
+    ramps (jmax 10, amax 2) round 5 % over the acceleration limit and fitted keyframes lag
+    the plan by 60 cm (refused before): the moves ramp at a jerk the grid can hold, and
+    every drone's keyframes play inside the limits. Near the origin the jerk is the show's."""
+    from skyquill.export.skybrush.refit import played_keyframes
+
+    far = SCRIPT.replace("[-2.0, -8.0]", "[420.0, -8.0]")
+    far = far.replace("[-3.0, 0.0, 6.0]", "[425.0, 0.0, 6.0]")
+    far = far.replace("[0.0, 0.0, 9.0]", "[428.0, 0.0, 9.0]")
+    wide = build_show(parse_script(far))
+    jerks = {s["moves_jerk_limit"] for s in wide.scenes if "moves_jerk_limit" in s}
+    assert len(jerks) == 1 and 5.0 < jerks.pop() < 9.0
+    for i, drone in enumerate(wide.drones):
+        keys = played_keyframes(f"drone {i}", drone)
+        assert keys.keyframes.scale in (13, 14)
+        assert keys.delivered.within_allowed and keys.keyframes.fit_error_m <= 0.02
+    near = build_show(parse_script(SCRIPT))
+    near_jerks = [s["moves_jerk_limit"] for s in near.scenes if "moves_jerk_limit" in s]
+    assert near_jerks == pytest.approx([10.0] * 4)

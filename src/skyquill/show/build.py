@@ -18,7 +18,7 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -52,10 +52,12 @@ from skyquill.show.script import (
     WriteScene,
 )
 from skyquill.show.transition import PLAN_MARGIN, Transition
-from skyquill.show.writing import plan_writing_scene
+from skyquill.show.writing import plan_writing_scene, writer_count, writing_boards
 from skyquill.trajectory import PiecewisePolynomial, Trajectory, concatenate
 from skyquill.validation import FloatArray
 
+#: Scenes whose drones fly time-optimal moves at the show's limits (:func:`leg_limits`).
+MOVING = ("takeoff", "formation", "land")
 #: Holds shorter than this are left out, s.
 MIN_HOLD_S = 1e-9
 
@@ -173,6 +175,12 @@ def build_show(
         safety_m=script.safety_m,
     )
     _check_pads(homes, script)
+    formations = {
+        k: make_formation(scene, script)
+        for k, scene in enumerate(script.scenes)
+        if isinstance(scene, FormationScene)
+    }
+    script = replace(script, extent_m=show_extent(script, homes, list(formations.values())))
     line = _Timeline(homes)
     times: dict[str, float] = {}
     records: list[dict[str, Any]] = []
@@ -182,8 +190,10 @@ def build_show(
     for k, scene in enumerate(script.scenes):
         start, clock = line.now, time.perf_counter()
         where = _Where(workers, scheduler, _writing_progress(progress, k, total))
-        kind, detail = _fly(scene, script, line, homes, where)
+        kind, detail = _fly(scene, script, line, homes, where, formation=formations.get(k))
         times[kind] = times.get(kind, 0.0) + time.perf_counter() - clock
+        if kind in MOVING:  # lowered for Skybrush's grid in a wide show (leg_limits)
+            detail["moves_jerk_limit"] = leg_limits(script).jmax
         records.append({"type": kind, "start_s": start, "end_s": line.now} | detail)
         if progress is not None:
             progress(k + 1, total, f"planned scene {k + 1} of {total} ({kind})")
@@ -213,13 +223,19 @@ def _writing_progress(progress: Progress | None, scene: int, total: int) -> Prog
 
 
 def _fly(
-    scene: Scene, script: ShowScript, line: _Timeline, homes: FloatArray, where: _Where
+    scene: Scene,
+    script: ShowScript,
+    line: _Timeline,
+    homes: FloatArray,
+    where: _Where,
+    *,
+    formation: Formation | None,
 ) -> tuple[str, dict[str, Any]]:
     if isinstance(scene, Takeoff):
         _climb(line, homes, _air(homes, scene.altitude_m, script), scene.stagger_s, script)
         return "takeoff", {"altitude_m": scene.altitude_m}
     if isinstance(scene, FormationScene):
-        formation = make_formation(scene, script)
+        assert formation is not None
         route = _reform(line, formation.points, script)
         line.hold(scene.hold_s, scene.color)
         return "formation", {
@@ -243,6 +259,31 @@ def _fly(
         "via_curtain": route.via_curtain,
         "transition": _described(route),
     }
+
+
+#: Safety distances added to the places of a show to bound where its drones fly: layers step
+#: out of a formation's plane by about 1.4 safety distances each, and few shows need more
+#: than three of them (:mod:`skyquill.show.layers`).
+EXTENT_MARGIN_SAFETIES = 5.0
+
+
+def show_extent(script: ShowScript, homes: FloatArray, formations: list[Formation]) -> float:
+    """The farthest a drone of ``script`` flies from the origin along an axis, m (bounded).
+
+    Moves are straight between the pads, the air above them, the formations and the writing
+    boards, so the largest coordinate of those places bounds them, plus
+    :data:`EXTENT_MARGIN_SAFETIES` safety distances for layers. Skybrush stores each drone's
+    positions in units chosen by this extent (``ShowScript.extent_m``).
+    """
+    places = [np.abs(homes).max(), *(np.abs(f.points).max() for f in formations)]
+    for scene in script.scenes:
+        if isinstance(scene, (Takeoff, Land)):
+            places.append(scene.altitude_m)
+        elif isinstance(scene, WriteScene):
+            count = min(writer_count(scene), script.drones)
+            for board in writing_boards(count, scene, script.safety_m):
+                places.append(float(np.abs(board.origin).max()) + scene.size_m)
+    return float(max(places)) + EXTENT_MARGIN_SAFETIES * script.safety_m
 
 
 def make_formation(scene: FormationScene, script: ShowScript) -> Formation:

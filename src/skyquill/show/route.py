@@ -30,6 +30,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from skyquill.errors import InfeasibleError, InputError
+from skyquill.export.skybrush.keyframe_times import playable_jerk
 from skyquill.optimize.legs import LegLimits
 from skyquill.show.capt import lower_bound_s, matchings, straight, straight_to, through_layers
 from skyquill.show.formation import grid_formation
@@ -86,7 +87,25 @@ INSIDE = 1e-9
 
 
 def leg_limits(script: ShowScript) -> LegLimits:
-    """The moves' limits: the show's speed, acceleration and jerk norms (:data:`INSIDE` them)."""
+    """The moves' limits: the show's speed, acceleration and jerk norms (:data:`INSIDE` them).
+
+    In a show so wide that Skybrush stores its positions in units of several millimetres
+    (``script.extent_m``: beyond about 200 m from the origin), the jerk is lowered so that a
+    ramp to the acceleration limit lasts long enough for that grid
+    (:func:`~skyquill.export.skybrush.keyframe_times.playable_jerk`): the ``.skyc`` plays
+    the plan inside its limits instead of being refused.
+    """
+    limits = show_limits(script)
+    if script.extent_m is None:
+        return limits
+    jmax = float(limits.jmax)
+    jerk = playable_jerk(float(limits.amax), jmax, script.extent_m)
+    return LegLimits(limits.vmax, limits.amax, min(jmax, jerk))
+
+
+def show_limits(script: ShowScript) -> LegLimits:
+    """The show's own speed, acceleration and jerk norms (:data:`INSIDE` them): the lower
+    bound of a transition is measured at these."""
     lim = script.limits
     if lim.vmax is None or lim.amax is None or lim.jmax is None:
         raise InputError("[limits]: got a missing limit, expected vmax, amax and jmax")
@@ -125,7 +144,7 @@ def route_to(start: FloatArray, targets: FloatArray, script: ShowScript) -> Rout
     limits, d = leg_limits(script), script.safety_m
     names = [f"drone {i}" for i in range(len(targets))]
     matching = matchings(start, targets)
-    bound = lower_bound_s(matching.bottleneck_m, limits)
+    bound = lower_bound_s(matching.bottleneck_m, show_limits(script))
     options: list[_Option] = []
     direct = straight_to(start, targets, limits, d, matching)
     if direct is not None:

@@ -134,6 +134,11 @@ class ShowScript:
     geofence
         Where the drones may fly (``[show].geofence``: a GeoJSON or WKT file in the
         show's metres, :func:`~skyquill.show.geofence.read_geofence`), or ``None``.
+    extent_m
+        The farthest any drone flies from the origin along an axis, m, or ``None`` (not yet
+        known): set by :func:`~skyquill.show.build.build_show` before it plans, so that the
+        transitions' jerk ramps are long enough for the Skybrush grid of a show that wide
+        (:func:`~skyquill.show.route.leg_limits`).
     """
 
     drones: int
@@ -145,6 +150,7 @@ class ShowScript:
     scenes: tuple[Scene, ...]
     base: Path = field(default_factory=Path)
     geofence: Geofence | None = None
+    extent_m: float | None = None
 
 
 def _color(where: str, value: Any) -> RGB:

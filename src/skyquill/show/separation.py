@@ -175,6 +175,7 @@ def guaranteed_separation(
     *,
     step_s: float = STEP_S,
     tolerance_m: float = TOLERANCE_M,
+    prune: bool = True,
 ) -> Separation:
     """The guaranteed closest approach of ``motions`` (all on one clock), against ``minimum_m``.
 
@@ -188,6 +189,9 @@ def guaranteed_separation(
         Grid step of the first pass, s.
     tolerance_m
         The bound is refined until it is this close to the closest distance seen, m.
+    prune
+        Examine only the pairs whose space-time boxes come close (``False``: every pair in
+        every window, ``N^2 / 2`` pairs: the reference the pruning is tested against).
 
     Raises
     ------
@@ -208,7 +212,7 @@ def guaranteed_separation(
     # stay farther apart than it (and than the minimum) cannot hold the closest approach.
     # (Grown by round-off: the k-d tree's distances and the boxes' gaps round differently.)
     threshold = max(minimum, _sampled_closest(fleet, t[::WINDOW])) * (1.0 + 1e-9) + 1e-12
-    first, second, window = _candidates(fleet, t, threshold)
+    first, second, window = (_candidates if prune else _every_pair)(fleet, t, threshold)
     pair_of, pair_index = np.unique(first * n + second, return_inverse=True)
     pairs = (pair_of // n, pair_of % n)
     closest = _Closest(pair_of.size, minimum)
@@ -262,6 +266,18 @@ def _candidates(fleet: Fleet, t: FloatArray, threshold: float) -> tuple[IntArray
     window = boxes_first // n
     one, two = boxes_first % n, boxes_second % n
     return np.minimum(one, two), np.maximum(one, two), window
+
+
+def _every_pair(fleet: Fleet, t: FloatArray, threshold: float) -> tuple[IntArray, ...]:
+    """``(first, second, window)`` of every pair in every window (nothing pruned)."""
+    del threshold  # every pair, however far apart
+    first, second = np.triu_indices(len(fleet), 1)
+    windows = np.arange(0, t.size - 1, WINDOW).size
+    return (
+        np.tile(first, windows).astype(np.intp),
+        np.tile(second, windows).astype(np.intp),
+        np.repeat(np.arange(windows), first.size).astype(np.intp),
+    )
 
 
 def _boxes(fleet: Fleet, t: FloatArray, starts: IntArray) -> tuple[FloatArray, FloatArray]:
@@ -322,21 +338,46 @@ def _grid_intervals(
     per_chunk = max(1, CHUNK // WINDOW)
     for begin in range(0, pair.size, per_chunk):
         part = slice(begin, begin + per_chunk)
+        # Each window whole first: a pair holding its places, or moving in parallel, is
+        # proven by one bound (a formation's hold, the drones waiting while others write);
+        # only the windows it leaves open are cut into grid intervals.
+        whole = _whole_windows(fleet, t, pairs, pair[part], window[part], lengths[part], closest)
+        count += whole.a.size
+        lower, still = _settle(whole, closest, tolerance, lower)
         items = _window_intervals(
             fleet,
             t,
             pairs,
-            pair=pair[part],
-            window=window[part],
-            lengths=lengths[part],
+            pair=pair[part][still],
+            window=window[part][still],
+            lengths=lengths[part][still],
             closest=closest,
         )
         closest.record(items.pair, items.a, items.da)
         closest.record(items.pair, items.b, items.db)
         count += items.a.size
-        lower, items = _settle(items, closest, tolerance, lower)
-        kept.append(items)
+        lower, left = _settle(items, closest, tolerance, lower)
+        kept.append(items.take(left))
     return _joined(kept), lower, count
+
+
+def _whole_windows(  # noqa: PLR0917 - private: the slices of one chunk
+    fleet: Fleet,
+    t: FloatArray,
+    pairs: tuple[IntArray, IntArray],
+    pair: IntArray,
+    window: IntArray,
+    lengths: IntArray,
+    closest: _Closest,
+) -> _Intervals:
+    """One interval per candidate window of ``pair``, bounded (ends and midpoint recorded)."""
+    i, j = pairs[0][pair], pairs[1][pair]
+    a, b = t[window * WINDOW], t[window * WINDOW + lengths]
+    da = np.linalg.norm(fleet.position(i, a) - fleet.position(j, a), axis=1)
+    db = np.linalg.norm(fleet.position(i, b) - fleet.position(j, b), axis=1)
+    closest.record(pair, a, da)
+    closest.record(pair, b, db)
+    return _bounded(fleet, pairs, pair, (a, b), (da, db), closest)
 
 
 def _window_intervals(
@@ -426,8 +467,9 @@ def _relative(
 
 def _settle(
     items: _Intervals, closest: _Closest, tolerance: float, lower: tuple[float, int, float]
-) -> tuple[tuple[float, int, float], _Intervals]:
-    """Close the intervals whose bound is high enough; the lowest closed bound so far and the rest.
+) -> tuple[tuple[float, int, float], NDArray[np.bool_]]:
+    """Close the intervals whose bound is high enough; the lowest closed bound so far and
+    which intervals stay open.
 
     An interval stays open while its bound is below what is asked for (or more than
     ``tolerance`` below the closest distance seen), it is wider than
@@ -444,7 +486,7 @@ def _settle(
         k = int(np.argmin(np.where(open_, np.inf, lb)))
         if lb[k] < lower[0]:
             lower = (float(lb[k]), int(items.pair[k]), float(items.a[k]))
-    return lower, items.take(open_)
+    return lower, open_
 
 
 def _refine(
@@ -463,7 +505,8 @@ def _refine(
     the number of intervals bounded.
     """
     while items.a.size:
-        lower, items = _settle(items, closest, tolerance, lower)
+        lower, left = _settle(items, closest, tolerance, lower)
+        items = items.take(left)
         if 2 * items.a.size > MAX_INTERVALS:
             if tolerance == math.inf:
                 raise SolverError(

@@ -129,3 +129,39 @@ def test_cubic_pieces_are_exact_segments_rounded_inside_the_limits() -> None:
     assert np.linalg.norm(back.evaluate(t, 2), axis=1).max() <= 2.0 * 1.01
     assert np.linalg.norm(back.evaluate(t, 3), axis=1).max() <= 10.0 * 1.05
     assert np.linalg.norm(back.evaluate(t) - traj.evaluate(t), axis=1).max() <= 3e-3
+
+
+@pytest.mark.parametrize("jmax", [10.0, None])
+def test_jerk_ramps_long_enough_for_a_coarse_grid_play_inside_the_limits(
+    jmax: float | None,
+) -> None:
+    """447 m from the origin (14 mm units): a time-optimal landing at jmax 10 (0.2 s ramps)
+    has no keyframes inside its limits near it; at :func:`playable_jerk` it plays exactly."""
+    from skyquill.errors import InfeasibleError
+    from skyquill.export.skybrush.keyframe_times import playable_jerk
+    from skyquill.export.skybrush.refit import played_keyframes
+    from skyquill.io.trajectory_json import PlannedTrajectory
+    from skyquill.optimize.legs import LegLimits, leg_pieces
+
+    assert playable_jerk(2.0, 10.0, 100.0) == 10.0  # 4 mm units: the limit itself
+    jerk = jmax or playable_jerk(2.0, 10.0, 447.0)
+    start, goal = np.array([447.0, 30.0, 10.0]), np.array([444.0, 25.0, 4.0])
+
+    def move(a: np.ndarray, b: np.ndarray) -> PiecewisePolynomial:
+        durations, coeffs = leg_pieces(a, b, LegLimits(4.0, 2.0, jerk))
+        return PiecewisePolynomial(np.concatenate([[0.0], np.cumsum(durations)]), coeffs)
+
+    hold = PiecewisePolynomial(np.array([0.0, 2.0]), np.array([[goal]]))
+    pad = goal - np.array([0.0, 0.0, 4.0])
+    flight = RestToRestSequence((move(start, goal), hold, move(goal, pad)))
+    limits = VehicleLimits(4.0, 2.0, 10.0).derivative_limits(3)
+    planned = PlannedTrajectory(flight, (), limits)
+    if jmax is not None:
+        with pytest.raises(InfeasibleError, match=r"grid of 14 mm units.*lower jerk limit"):
+            played_keyframes("d", planned)
+        return
+    assert 5.0 < jerk < 8.0
+    keys = played_keyframes("d", planned)
+    assert keys.keyframes.scale == 14 and keys.attempt == 0
+    assert keys.keyframes.exact_segments == keys.keyframes.units.shape[0]
+    assert keys.delivered.within_allowed

@@ -38,6 +38,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from skyquill.errors import InputError
+from skyquill.export.skybrush.playback import scaling_factor
 from skyquill.limits import DerivativeLimit, limit_bounds
 from skyquill.trajectory import PiecewisePolynomial, RestToRestSequence, Trajectory
 
@@ -58,6 +59,12 @@ ROUNDING_SHARE = {1: 0.25, 2: 0.5, 3: 1.0}
 ROUNDING_FACTOR = {1: 3.0, 2: 12.0, 3: 24.0}
 #: Most segments per drone (a 40-hour show at 250 ms): bounds memory and time.
 MAX_SEGMENTS = 600_000
+#: Largest share of the acceleration limit that one grid unit may move the acceleration at
+#: the end of a jerk ramp by (``6 u / h^2`` for a ramp of ``h`` s held as one cubic segment):
+#: measured on time-optimal moves 447-458 m from the origin (14 mm units), ramps of 0.2 s
+#: (105 % of the limit per unit) leave no rounding inside the limits, ramps of 0.33 s (38 %)
+#: and longer do; ``tests/export/skybrush/test_skybrush_keyframes.py``.
+RAMP_UNIT_SHARE = 0.5
 
 
 @dataclass(frozen=True)
@@ -94,6 +101,31 @@ def fit_segment_ms(limits: Sequence[DerivativeLimit], unit_m: float, scale: floa
         worst = math.sqrt(3.0) * ROUNDING_FACTOR[order] * unit_m
         h = max(h, (worst / (ROUNDING_SHARE[order] * bound)) ** (1.0 / order))
     return int(min(MAX_FIT_MS, max(MIN_FIT_MS, round(1000.0 * h * scale))))
+
+
+def playable_jerk(amax: float, jmax: float, extent_m: float) -> float:
+    """The largest jerk, at most ``jmax``, whose ramps to ``amax`` Skybrush's grid can hold, m/s^3.
+
+    A time-optimal move ramps its acceleration to ``amax`` in ``amax / jerk`` s, one cubic
+    piece, kept as one exact segment (:func:`segmentation`). On the grid of a drone that
+    flies up to ``extent_m`` from the origin (units of ``scale`` mm, chosen by that extent:
+    :func:`~.playback.scaling_factor`) moving one point by one unit moves the ramp's end
+    acceleration by ``6 u / h^2``; a ramp shorter than ``sqrt(6 u / (share * amax))``
+    (:data:`RAMP_UNIT_SHARE`) cannot be rounded inside the limits, and fitted segments long
+    enough for the grid lag such a plan by tens of centimetres (they cannot ramp as fast).
+    Within about 200 m of the origin (units up to 6 mm) at ``amax`` 2, ``jmax`` 10 this is
+    ``jmax`` itself.
+
+    Parameters
+    ----------
+    amax, jmax
+        The acceleration (m/s^2) and jerk (m/s^3) limits, positive.
+    extent_m
+        The largest coordinate (absolute) the drone reaches, m.
+    """
+    unit_m = scaling_factor(np.array([extent_m], dtype=float)) / 1000.0
+    shortest_ramp_s = math.sqrt(6.0 * unit_m / (RAMP_UNIT_SHARE * amax))
+    return min(jmax, amax / shortest_ramp_s)
 
 
 def cubic_spans(traj: Trajectory, total_ms: int) -> list[tuple[int, int, bool]]:

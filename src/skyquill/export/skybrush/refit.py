@@ -69,6 +69,7 @@ def played_keyframes(name: str, planned: PlannedTrajectory) -> PlayedKeyframes:
     """
     last: PlayedKeyframes | None = None
     far: float | None = None  # the least distance of keyframes that kept the limits
+    unit_mm = 1  # Skybrush's unit for this drone (the keyframes' scale)
     infeasible: InfeasibleError | SolverError | None = None
     for i, (margin, exact, scale) in enumerate(ATTEMPTS):
         try:
@@ -80,6 +81,7 @@ def played_keyframes(name: str, planned: PlannedTrajectory) -> PlayedKeyframes:
             # settle (seen on long coverage plans): the next attempt's segments differ.
             infeasible = exc
             continue
+        unit_mm = frames.scale
         back = played_trajectory(name, {"points": frames.points()}).trajectory()
         here = PlayedKeyframes(frames, back, check_delivered(name, planned, back), i)
         inside = here.delivered.within_allowed or not planned.limits
@@ -97,12 +99,15 @@ def played_keyframes(name: str, planned: PlannedTrajectory) -> PlayedKeyframes:
             planned,
             f"keyframes inside them are {100 * far:.1f} cm from it at best, farther than "
             f"{100 * MAX_DEVIATION_M:g} cm",
+            unit_mm,
         )
-    raise _unfittable(name, planned, str(infeasible))
+    raise _unfittable(name, planned, str(infeasible), unit_mm)
 
 
-def _unfittable(name: str, planned: PlannedTrajectory, cause: str) -> InfeasibleError:
-    """The refusal of a drone no keyframes keep inside its limits, with the plan's own excess."""
+def _unfittable(name: str, planned: PlannedTrajectory, cause: str, unit_mm: int) -> InfeasibleError:
+    """The refusal of a drone no keyframes keep inside its limits, with the plan's own excess
+    and, for a plan inside its limits, what to change (the grid's unit grows with the
+    drone's distance from the origin: :func:`~.keyframe_times.playable_jerk`)."""
     own = verify(planned.trajectory, planned.limits, guaranteed=False)
     orders = [(n, own.excess(n)) for n in ORDER_NAMES]
     order, excess = max(orders, key=lambda item: item[1])
@@ -110,6 +115,13 @@ def _unfittable(name: str, planned: PlannedTrajectory, cause: str) -> Infeasible
         f"the plan itself is {100 * excess:.2f} % over its {ORDER_NAMES[order]} limit"
         if excess > 0
         else "the plan keeps its limits, but not on Skybrush's grid"
+        + (
+            f" of {unit_mm} mm units (its unit beyond {32.768 * (unit_mm - 1):.0f} m from the "
+            "origin): bring the drone nearer the show's origin, or plan it with a lower jerk "
+            "limit"
+            if unit_mm > 1
+            else ""
+        )
     )
     return InfeasibleError(
         f"plan: got drone {name}, which no C2 cubic keyframes on Skybrush's ms and mm grid "
