@@ -17,7 +17,7 @@ from skyquill.validation import FloatArray, as_float, as_int, per_axis
 #: Grid kinds of :func:`~skyquill.coverage.speed.plan_speed`.
 GRIDS = ("uniform", "adaptive")
 #: Methods of :func:`~skyquill.coverage.speed.plan_speed`.
-METHODS = ("auto", "reach", "lp")
+METHODS = ("auto", "reach", "banded", "lp")
 #: Fewest sides of the polygon that holds a norm limit.
 MIN_NORM_SIDES = 4
 
@@ -111,14 +111,17 @@ def _validate_limits(
 
 
 def _validate_method(method: object, *, jerk: bool) -> str:
-    """``"reach"`` or ``"lp"``: the solver ``method`` names for a problem with or without jerk."""
+    """``"reach"``, ``"banded"`` or ``"lp"``: the solver ``method`` names for a problem with or
+    without jerk (without a jerk limit ``"banded"`` is ``"reach"``: the same passes answer)."""
     if method not in METHODS:
         raise InputError(f"method: got {method!r}, expected one of {METHODS}")
     if method == "reach" and jerk:
         raise InputError(
-            "method: got 'reach' with a jerk limit, expected 'lp' or 'auto' (the passes hold "
-            "speed and acceleration; jerk rows couple three nodes)"
+            "method: got 'reach' with a jerk limit, expected 'banded', 'lp' or 'auto' (the "
+            "passes hold speed and acceleration; jerk rows couple three nodes)"
         )
     if method == "auto":
-        return "lp" if jerk else "reach"
+        return "banded" if jerk else "reach"
+    if method == "banded" and not jerk:
+        return "reach"
     return str(method)
