@@ -144,7 +144,12 @@ class _Scaled:
 
 
 def solve_banded_lp(
-    rows: BandedRows, bound: FloatArray, ub: FloatArray, weights: FloatArray
+    rows: BandedRows,
+    bound: FloatArray,
+    ub: FloatArray,
+    weights: FloatArray,
+    *,
+    tolerance: float = TOLERANCE,
 ) -> BandedSolution:
     """``max weights' b`` s.t. ``|rows(b)| <= bound`` and ``0 <= b <= ub``.
 
@@ -158,6 +163,9 @@ def solve_banded_lp(
         Column upper bounds, finite, ``>= 0``; a column at 0 stays there.
     weights : ndarray, shape (n,)
         Objective weights, ``> 0``.
+    tolerance : float, default :data:`TOLERANCE`
+        Relative gap and primal residual at which to stop (an iterate of a
+        fixed-point iteration needs less than the last solve).
 
     Returns
     -------
@@ -172,7 +180,7 @@ def solve_banded_lp(
     a = _Scaled(rows, bound, ub)
     cost = -np.asarray(weights, dtype=np.float64) * ub
     cost /= float(np.max(np.abs(cost)))
-    x, status, its, gap = _mehrotra(a, cost)
+    x, status, its, gap = _mehrotra(a, cost, tolerance)
     b = np.clip(x, 0.0, 1.0) * ub
     return BandedSolution(_feasible(rows, bound, b), status, its, gap)
 
@@ -211,7 +219,9 @@ class _State:
         return np.concatenate([flat, -flat, x, -x])
 
 
-def _mehrotra(a: _Scaled, cost: FloatArray) -> tuple[FloatArray, str, int, float]:
+def _mehrotra(
+    a: _Scaled, cost: FloatArray, tolerance: float
+) -> tuple[FloatArray, str, int, float]:
     """Mehrotra's predictor-corrector on ``min cost' x`` s.t. ``|A x| <= 1``, ``0 <= x <= 1``.
 
     Returns ``x``, the status, the iterations and the relative gap.
@@ -229,7 +239,7 @@ def _mehrotra(a: _Scaled, cost: FloatArray) -> tuple[FloatArray, str, int, float
         rp = st.stack(a.apply(x), x) + s - h
         obj = float(cost @ x)
         gap = float(s @ z) / max(1.0, abs(obj))
-        if gap <= TOLERANCE and float(np.max(np.abs(rp))) <= TOLERANCE:
+        if gap <= tolerance and float(np.max(np.abs(rp))) <= tolerance:
             status = "optimal"
             break
         mu = float(s @ z) / s.size

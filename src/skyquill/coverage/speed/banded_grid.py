@@ -23,12 +23,15 @@ from collections.abc import Callable
 import numpy as np
 
 from skyquill.coverage.deadline import Deadline
-from skyquill.coverage.speed.banded import BandedRows, solve_banded_lp
+from skyquill.coverage.speed.banded import TOLERANCE, BandedRows, solve_banded_lp
 from skyquill.coverage.speed.reach import AccelerationRows, ReachPass
 from skyquill.coverage.speed.rows import _GridLP, jerk_coefficients
 from skyquill.validation import FloatArray
 
 _log = logging.getLogger(__name__)
+#: Relative gap of the pseudo-jerk iterates (the iteration stops at a change of 1e-3 of
+#: ``sqrt(b)``; the certification LP is solved to :data:`~.banded.TOLERANCE`).
+ROUGH_TOLERANCE = 1e-6
 
 
 def banded_rows(
@@ -128,8 +131,9 @@ class BandedGrid:
         """Whether the HiGHS LP had to answer."""
         return self._lp is not None
 
-    def solve(self, r: FloatArray, ub: FloatArray) -> FloatArray:
-        """The optimum for the LP's row bounds ``r`` and ``0 <= b <= ub``."""
+    def solve(self, r: FloatArray, ub: FloatArray, *, rough: bool = False) -> FloatArray:
+        """The optimum for the LP's row bounds ``r`` and ``0 <= b <= ub`` (to
+        :data:`ROUGH_TOLERANCE` when ``rough``)."""
         if self.deadline is not None:
             self.deadline.check(f"speed solve {self.solves + 1}")
         n = ub.size
@@ -139,7 +143,8 @@ class BandedGrid:
             if b is not None:
                 return b
         start = time.perf_counter()
-        sol = solve_banded_lp(self.rows, bound, ub, np.ones(n))
+        tol = ROUGH_TOLERANCE if rough else TOLERANCE
+        sol = solve_banded_lp(self.rows, bound, ub, np.ones(n), tolerance=tol)
         self.ipm_time += time.perf_counter() - start
         self.ipm_solves += 1
         self.ipm_iterations += sol.iterations

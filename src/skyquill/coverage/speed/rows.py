@@ -174,8 +174,9 @@ class GridSolver(Protocol):
         """Problems solved."""
         ...
 
-    def solve(self, r: FloatArray, ub: FloatArray) -> FloatArray:
-        """``b`` for row bounds ``|A b| <= r`` and column bounds ``0 <= b <= ub``."""
+    def solve(self, r: FloatArray, ub: FloatArray, *, rough: bool = False) -> FloatArray:
+        """``b`` for row bounds ``|A b| <= r`` and column bounds ``0 <= b <= ub``; ``rough``:
+        an iterate of a fixed-point iteration, which a solver may answer less precisely."""
         ...
 
 
@@ -201,7 +202,7 @@ class _GridLP:
         """LPs solved."""
         return self.lp.solves
 
-    def solve(self, r: FloatArray, ub: FloatArray) -> FloatArray:
+    def solve(self, r: FloatArray, ub: FloatArray, *, rough: bool = False) -> FloatArray:
         """Solve with row bounds ``-r <= A b <= r`` (``inf`` = free row) and ``b <= ub``.
 
         With a deadline, no solve is started once it is spent, nor given more
