@@ -1,9 +1,11 @@
-"""Paper 002 reproduced: Tables 1 and 2, robust vs SVD with false contacts, painting order.
+"""Paper 002 reproduced (Tables 1 and 2, robust vs SVD, order) and the joint estimator beyond it.
 
 Run from the repository root::
 
-    .venv/bin/python bench/painting.py            # 10 seeds, ~3-4 minutes
+    .venv/bin/python bench/painting.py            # 10 seeds, ~40 minutes on an idle 2-core box
     .venv/bin/python bench/painting.py --quick    # 5 seeds -> bench/results/painting_quick.json
+    .venv/bin/python bench/painting.py --only joint early   # some sections only (merged into
+                                                            # the existing JSON)
 
 It writes ``bench/results/painting.json`` and prints the tables.
 
@@ -30,6 +32,24 @@ seed one whole mission with its own hover errors, IMU noise, drift and faults):
   squeeze) against the reduced :class:`ContactModel` (no IMU noise on either side).
 * Order -- ``shortest`` (nearest neighbour + 2-opt) against ``paper``: total flight time,
   transit length and RMSE, ``gamma = 10``, ``svd``/``onboard``; ratio shortest / paper.
+* Joint (issue 29) -- every wall (flat; three segments -10|0|+10 and +10|0|+10; a 20 m
+  cylinder; a 10 cm recess from x = 0.6 to 1.4 m) x ``gamma`` in {0, +10, -10} x truth /
+  onboard localization x estimator: ``none`` (shortest order), ``paper`` (paper 002's
+  estimator for that wall -- SVD on the flat wall, the segment lines elsewhere -- with the
+  paper's order and §4.1 point) and ``joint`` (placement and wall together, a probing pass
+  every 0.4 m, then a short tour from the middle). Per cell: RMSE (mean, sd) and the largest
+  dot error over the seeds, the worst per-seed max / RMSE, the aim error (the estimate's own
+  share: where each dot lands flying the plan exactly), flight time, landings, battery use
+  and, for ``joint``, how often the wall fitted its model.
+* Vehicle -- the three-segment wall at ``gamma = 10`` with true localization and a 1 cm hover
+  error instead of 3 cm (every other setting the same): what the estimator achieves when the
+  vehicle does not hide it.
+* Early -- information early, for ``joint`` on the three-segment wall at ``gamma = 10`` and
+  the flat wall at ``gamma = 10``: the paper's order, the shortest tour, ``spread`` (the first
+  dots 0.4 m apart) and the probing pass at 0.4 and 0.6 m before the shortest tour; RMSE,
+  worst dot, aim error and flight time.
+* Joint robustness -- 10 % false and 5 % missed contacts, flat and three-segment walls,
+  ``gamma = 10``: ``robust`` (paper's order) against ``joint``.
 
 BLAS is pinned to one thread (``threadpoolctl``); wall time per section is recorded.
 """
@@ -55,6 +75,7 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 from rich.table import Table
 from threadpoolctl import threadpool_limits
 
+from painting_joint import JOINT_SECTIONS, show_joint
 from skyquill.painting.crosscheck import simulated_touch
 from skyquill.painting.dots import paper_drawing
 from skyquill.painting.estimate import RigidEstimator
@@ -339,21 +360,38 @@ def show(console: Console, data: dict[str, Any]) -> None:
         )
 
 
+#: name -> (function, missions per seed, or None for a fixed count)
+PAPER_SECTIONS: dict[str, tuple[Callable[[list[int], Callable[[], None]], Any], int]] = {
+    "table1": (table1, len(GAMMAS) * len(TABLE1_COLUMNS)),
+    "table2": (table2, len(WALLS) * len(TABLE2_COLUMNS)),
+    "robustness": (robustness, 2 * 4 * 4),
+    "order": (ordering, 2),
+    "contact_crosscheck": (crosscheck, 0),
+}
+
+
 def main() -> None:
-    """Run every section, print, write the JSON."""
+    """Run the sections asked for (all by default), print, write the JSON."""
+    sections = PAPER_SECTIONS | JOINT_SECTIONS
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seeds", type=int, default=10, help="seeds per cell (>= 5)")
     parser.add_argument("--quick", action="store_true", help="5 seeds, painting_quick.json")
     parser.add_argument("--out", type=Path, default=None)
+    parser.add_argument(
+        "--only", nargs="+", choices=list(sections), default=None,
+        help="run these sections only; the others are kept from the existing JSON",
+    )  # fmt: skip
     args = parser.parse_args()
     n_seeds = 5 if args.quick else max(args.seeds, 5)
     out = args.out or (QUICK_RESULTS if args.quick else RESULTS)
     seeds = list(range(n_seeds))
+    chosen = args.only or list(sections)
     console = Console()
-    total = n_seeds * (
-        len(GAMMAS) * len(TABLE1_COLUMNS) + len(WALLS) * len(TABLE2_COLUMNS) + 2 * 4 * 4 + 2
-    ) + len(CROSSCHECK_SPEEDS)
-    data: dict[str, Any] = {
+    total = sum(n_seeds * sections[name][1] for name in chosen)
+    total += len(CROSSCHECK_SPEEDS) if "contact_crosscheck" in chosen else 0
+    data: dict[str, Any] = json.loads(out.read_text()) if args.only and out.exists() else {}
+    data.setdefault("wall_time_s", {})
+    data |= {
         "command": " ".join(["python", *sys.argv]),
         "date": datetime.now(UTC).isoformat(timespec="seconds"),
         "machine": {"platform": platform.platform(), "python": sys.version.split()[0]},
@@ -361,7 +399,6 @@ def main() -> None:
         "config": asdict(MissionConfig()),
         "drawing": "paper_drawing(): 140 dots, 3.5 m x 2.1 m, ellipse + star",
         "delta_m": DELTA.tolist(),
-        "wall_time_s": {},
     }
     with threadpool_limits(1), Progress(
         TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
@@ -372,18 +409,16 @@ def main() -> None:
         def tick() -> None:
             progress.advance(task)
 
-        for name, fn in (
-            ("table1", table1),
-            ("table2", table2),
-            ("robustness", robustness),
-            ("order", ordering),
-            ("contact_crosscheck", crosscheck),
-        ):
+        for name in chosen:
             progress.update(task, description=name)
             start = time.perf_counter()
-            data[name] = fn(seeds, tick)
+            data[name] = sections[name][0](seeds, tick)
             data["wall_time_s"][name] = time.perf_counter() - start
-    show(console, data)
+            out.parent.mkdir(parents=True, exist_ok=True)
+            out.write_text(json.dumps(data, indent=1) + "\n")  # each section as it ends
+    if all(name in data for name in PAPER_SECTIONS):
+        show(console, data)
+    show_joint(console, data)
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text(json.dumps(data, indent=1) + "\n")
     console.print(f"wrote {out}")

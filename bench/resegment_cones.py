@@ -43,7 +43,7 @@ from typing import Any
 import numpy as np
 from threadpoolctl import threadpool_info, threadpool_limits
 
-import skyquill.calligraphy.mission as mission_module
+import skyquill.calligraphy.planning as planning_module
 from common import jsonable, machine_info, time_calls, time_stats
 from skyquill.calligraphy.mission import WritingOptions, plan_writing
 from skyquill.io.points import read_points_csv
@@ -117,7 +117,7 @@ class ConeWriting(WritingOptions):
 
 def yong_case(kind: str, bounds: tuple[float, float, float], runs: int) -> dict[str, Any]:
     seen: list[tuple[Callable[[np.ndarray], SmoothingProblem], ResegmentResult]] = []
-    original = mission_module.resegment
+    original = planning_module.resegment
 
     def spy(*args: Any, **kwargs: Any) -> ResegmentResult:
         out = original(*args, **kwargs)
@@ -127,11 +127,11 @@ def yong_case(kind: str, bounds: tuple[float, float, float], runs: int) -> dict[
     kw = dict(zip(("vmax", "amax", "jmax"), bounds, strict=True))
     opts = ConeWriting(**kw) if kind == "cones" else WritingOptions(**kw)
     strokes = hanzi_strokes("永")
-    mission_module.resegment = spy  # type: ignore[assignment]
+    planning_module.resegment = spy  # type: ignore[assignment]
     try:
         plan_stats, mission = _timed(lambda: plan_writing(strokes, options=opts), runs)
     finally:
-        mission_module.resegment = original
+        planning_module.resegment = original
     make, rr = seen[-1]
     grad_stats, grad = _timed(lambda: time_gradient(rr.times, make, result=rr.result), 3 * runs)
     return {

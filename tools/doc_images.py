@@ -8,7 +8,8 @@ the command line that made it and the numbers it reported, so a reader can rerun
     .venv/bin/python tools/doc_images.py            # all pictures (about two minutes)
     .venv/bin/python tools/doc_images.py --only fit # one of them
 
-The studio's screenshots come from ``tools/studio_screenshots.py`` instead (``docs/guides/studio.md``).
+The studio's screenshots come from ``tools/studio_screenshots.py`` instead
+(``docs/guides/studio.md``).
 """
 
 from __future__ import annotations

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 from skyquill.errors import InputError
 from skyquill.validation import FloatArray, as_array
@@ -27,14 +28,60 @@ def polyline_distance(points: FloatArray, vertices: FloatArray) -> FloatArray:
     v = as_array("vertices", vertices, shape=(None, p.shape[1]))
     if v.shape[0] < 2:
         raise InputError(f"vertices: got {v.shape[0]} vertex, expected at least 2")
-    a = v[:-1]  # (S, d)
-    ab = v[1:] - a
+    a, b = _short_segments(v)
+    ab = b - a
     length2 = np.einsum("sd,sd->s", ab, ab)
-    best = np.full(p.shape[0], np.inf)
-    for start in range(0, p.shape[0], 4096):  # bounded (chunk, S, d) temporaries
-        q = p[start : start + 4096, None, :] - a[None, :, :]
-        s = np.einsum("nsd,sd->ns", q, ab) / np.where(length2 > 0.0, length2, 1.0)
-        s = np.clip(s, 0.0, 1.0)
-        gap = q - s[:, :, None] * ab[None, :, :]
-        best[start : start + 4096] = np.sqrt(np.einsum("nsd,nsd->ns", gap, gap).min(axis=1))
+    # A point's nearest segment has its midpoint within (distance to the nearest
+    # midpoint's segment) + (longest half-segment): only those are measured, found by a
+    # k-d tree, so memory and time grow with the points and segments, not their product
+    # (the table of every point against every segment took 6.7 GB for one drawing).
+    tree = cKDTree(0.5 * (a + b))
+    reach = 0.5 * float(np.sqrt(length2.max()))
+    best = np.empty(p.shape[0])
+    for start in range(0, p.shape[0], _CHUNK):
+        chunk = p[start : start + _CHUNK]
+        _, nearest = tree.query(chunk)
+        radius = _segment_distance(chunk, a[nearest], ab[nearest], length2[nearest]) + reach
+        near = tree.query_ball_point(chunk, radius * (1.0 + 1e-9) + 1e-12)
+        counts = np.fromiter((len(n) for n in near), dtype=np.intp, count=len(near))
+        point = np.repeat(np.arange(chunk.shape[0]), counts)
+        seg = np.fromiter((k for n in near for k in n), dtype=np.intp, count=int(counts.sum()))
+        dist = _segment_distance(chunk[point], a[seg], ab[seg], length2[seg])
+        out = np.full(chunk.shape[0], np.inf)
+        np.minimum.at(out, point, dist)
+        best[start : start + _CHUNK] = out
     return best
+
+
+#: Points measured at once.
+_CHUNK = 4096
+
+
+def _segment_distance(
+    p: FloatArray, a: FloatArray, ab: FloatArray, length2: FloatArray
+) -> FloatArray:
+    """Distance from each ``p[k]`` to the segment ``a[k] + [0, 1] ab[k]``, shape (K,)."""
+    s = np.einsum("kd,kd->k", p - a, ab) / np.where(length2 > 0.0, length2, 1.0)
+    gap = p - a - np.clip(s, 0.0, 1.0)[:, None] * ab
+    distance: FloatArray = np.sqrt(np.einsum("kd,kd->k", gap, gap))
+    return distance
+
+
+def _short_segments(v: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """The polyline's segments ``(starts, ends)``, long ones cut into pieces.
+
+    Cutting changes no distance (the same points), but bounds the longest half-segment
+    the k-d tree search must allow for: no piece is longer than twice the mean.
+    """
+    a, b = v[:-1], v[1:]
+    length = np.linalg.norm(b - a, axis=1)
+    limit = 2.0 * float(length.mean())
+    pieces = np.maximum(1, np.ceil(length / limit).astype(np.intp)) if limit > 0.0 else None
+    if pieces is None or np.all(pieces == 1):
+        return a, b
+    seg = np.repeat(np.arange(a.shape[0]), pieces)
+    first = np.repeat(np.cumsum(pieces) - pieces, pieces)
+    k = np.arange(seg.size) - first
+    u0 = (k / pieces[seg])[:, None]
+    u1 = ((k + 1) / pieces[seg])[:, None]
+    return a[seg] + u0 * (b - a)[seg], a[seg] + u1 * (b - a)[seg]

@@ -31,6 +31,7 @@ Units are SI: m/s, m/s^2, m/s^3, ...
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from functools import lru_cache
 from typing import Any
@@ -335,7 +336,9 @@ _VEHICLE_FIELDS: dict[str, tuple[int, str, str]] = {
 #: Largest limit accepted per derivative order, SI: far beyond any multirotor (1000 m/s,
 #: ~1000 g, and a jerk to match), so a larger number is a unit mistake; and a bound that
 #: large would leave the solvers a badly scaled problem to fail on.
-_CEILINGS = {1: 1e3, 2: 1e4, 3: 1e6}
+#: Speed, acceleration and jerk beyond any vehicle (m/s, m/s^2, m/s^3): a unit mistake.
+LIMIT_CEILINGS = {1: 1e3, 2: 1e4, 3: 1e6}
+_CEILINGS = LIMIT_CEILINGS
 
 
 @dataclass(frozen=True)
@@ -480,3 +483,46 @@ def vehicle_limits(
             z: dict[str, Any] = {"z_lower": -b, "z_upper": b} if dim == 3 else {}
             limits.append(CylinderLimit(order, b, sides=coupled_sides, **z))
     return tuple(limits)
+
+
+def limit_bounds(limits: Sequence[DerivativeLimit]) -> dict[int, float]:
+    """The smallest bound on each derivative order's magnitude the limits state, SI units.
+
+    A norm gives its radius, a cylinder the smaller of its radius and vertical bounds, a box
+    its smallest bound; orders without a limit are left out. Any motion keeping these in
+    every direction keeps the limits (a straight vertical take-off, for one).
+    """
+    out: dict[int, float] = {}
+    for lim in limits:
+        if isinstance(lim, NormLimit | CylinderLimit):
+            bound = float(lim.radius)
+            if isinstance(lim, CylinderLimit) and lim.z_lower is not None:
+                assert lim.z_upper is not None
+                bound = min(bound, abs(lim.z_lower), abs(lim.z_upper))
+        else:
+            bound = float(np.minimum(np.abs(lim.lower), np.abs(lim.upper)).min())
+        out[lim.order] = min(out.get(lim.order, float("inf")), bound)
+    return out
+
+
+def lifted_limits(limits: Sequence[DerivativeLimit]) -> tuple[DerivativeLimit, ...]:
+    """2-axis limits of a plan drawn in the plane, stated for its flight in 3-D.
+
+    A 2-D plan flown at an altitude keeps z still, so a 2-axis norm is the same norm over
+    three axes; it is stated so, because the flight's take-off and landing move in z. A
+    2-axis box gets the smaller of its x and y bounds on z; a cylinder without vertical
+    bounds gets its radius. 3-axis limits are kept.
+    """
+    out: list[DerivativeLimit] = []
+    for lim in limits:
+        if isinstance(lim, NormLimit) and lim.dim == 2:
+            out.append(NormLimit(lim.order, lim.radius, lim.sides, 3))
+        elif isinstance(lim, BoxLimit) and lim.dim == 2:
+            low = float(np.max(lim.lower))
+            high = float(np.min(lim.upper))
+            out.append(BoxLimit(lim.order, np.append(lim.lower, low), np.append(lim.upper, high)))
+        elif isinstance(lim, CylinderLimit) and lim.z_lower is None:
+            out.append(CylinderLimit(lim.order, lim.radius, -lim.radius, lim.radius, lim.sides))
+        else:
+            out.append(lim)
+    return tuple(out)

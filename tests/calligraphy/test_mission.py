@@ -251,12 +251,11 @@ def test_route_times_lifts_for_the_jerk_limit_and_settle_after_the_approach() ->
     """Fitting the tip, every lift lasts at least a jerk-limited rest-to-rest move of its
     length; coming from home, the legs to and from it are slower and the vehicle pauses
     above the first stroke. Fitting the path, only the home legs change."""
-    from skyquill.calligraphy.mission import (
+    from skyquill.calligraphy.route import LIFT, route_points
+    from skyquill.calligraphy.timing import (
         HOME_LEG_SPEED,
-        LIFT,
         LIFT_JERK_FACTOR,
         SETTLE_S,
-        _route,
         route_times,
     )
     from skyquill.optimize.timing import allocate_path_times
@@ -264,7 +263,7 @@ def test_route_times_lifts_for_the_jerk_limit_and_settle_after_the_approach() ->
     board, opts = Board(), WritingOptions()
     strokes = tuple(board.to_world(p) for p in hanzi_strokes("人").scaled(0.5).paths)
     home = HOME - 0.3 * board.normal
-    points, roles = _route(strokes, board, home)
+    points, roles = route_points(strokes, board, home)
     tip = np.diff(route_times(points, roles, board, opts))
     path = np.diff(route_times(points, roles, board, WritingOptions(follow="path")))
     base = np.diff(allocate_path_times(points, 1.0, 1.0))
@@ -295,16 +294,3 @@ def test_a_character_beyond_the_tolerance_is_refused_with_the_measured_distance(
     assert "best_effort" in message
     best = plan_writing(hanzi_strokes("人"), Board(), dataclasses.replace(tight, best_effort=True))
     assert not best.faithful and best.deviation.max_m > 0.0002
-
-
-def test_the_initial_flight_time_is_the_unstretched_plans_duration() -> None:
-    """The studio's estimate (no solve) is what plan_writing starts from: equal when unstretched."""
-    from skyquill.calligraphy.mission import WritingOptions, initial_flight_time, plan_writing
-
-    strokes = text_strokes("L")
-    board, home = layout(1, 0.5, 1.0)[0]
-    opts = WritingOptions(resegment="off")
-    mission = plan_writing(strokes, board, opts, home=home)
-    assert mission.time_scale == 1.0
-    estimate = initial_flight_time(strokes, board, opts, home)
-    assert estimate == pytest.approx(mission.trajectory.duration, rel=1e-9)

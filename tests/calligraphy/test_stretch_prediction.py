@@ -6,11 +6,8 @@ import math
 
 import pytest
 
-from skyquill.calligraphy.mission import (
-    DEVIATION_EXPONENT,
-    WritingOptions,
-    _stretches_needed,
-)
+from skyquill.calligraphy.allocation import DEVIATION_EXPONENT, _stretches_needed
+from skyquill.calligraphy.options import WritingOptions
 
 
 @pytest.mark.parametrize(

@@ -14,11 +14,11 @@ from skyquill.calligraphy.brush import Brush
 from skyquill.calligraphy.mission import (
     MAX_STROKES,
     WritingOptions,
-    _route,
     check_reach,
     plan_writing,
     route_length,
 )
+from skyquill.calligraphy.route import route_points
 from skyquill.calligraphy.show import layout
 from skyquill.errors import InputError
 from skyquill.strokes import Strokes, hanzi_strokes
@@ -73,8 +73,8 @@ def test_a_brush_or_board_the_vehicle_cannot_write_with_is_refused(
 
 
 def test_drones_are_bounded() -> None:
-    with pytest.raises(InputError, match=r"^drones: got 101, expected an integer from 1 to 100"):
-        layout(101, 0.5, 1.0)
+    with pytest.raises(InputError, match=r"^drones: got 1001, expected an integer from 1 to 1000"):
+        layout(1001, 0.5, 1.0)
 
 
 def test_a_far_home_is_refused_by_the_route_estimate() -> None:
@@ -111,7 +111,7 @@ def test_the_route_estimate_bounds_the_route() -> None:
     board = Board()
     world = tuple(board.to_world(p) for p in H.scaled(0.5).paths)
     home = HOME - 0.3 * board.normal
-    points, _ = _route(world, board, home)
+    points, _ = route_points(world, board, home)
     built = float(np.linalg.norm(np.diff(points, axis=0), axis=1).sum())
     assert built <= route_length(world, board, home) + 1e-9
     assert built >= 0.7 * route_length(world, board, home)

@@ -70,7 +70,7 @@ def test_cover_tunes_for_a_coverage_target(tmp_path: Path) -> None:
         (["--width", "0"], "width"),
         (["--width", "50"], "width"),
         (["--width", "0.001"], "width: got 0.001 m on a region of 100 m²"),
-        (["--time-limit", "0"], "time_limit: got 0.0"),
+        (["--time-limit", "0"], "--time-limit: got 0, expected more than 0"),
         (["--vmax", "-1"], "vmax"),
         (["--jmax", "0"], "jmax"),
         (["--pattern", "snake"], "pattern"),
@@ -144,7 +144,8 @@ def test_a_time_limit_below_the_estimate_exits_2_in_one_line(tmp_path: Path) -> 
     result = CliRunner().invoke(app, args)
     assert result.exit_code == 2
     lines = result.output.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith("error: time_limit: got 5 s, expected at least")
+    assert len(lines) == 1
+    assert lines[0].startswith("error: --time-limit: got 5 s, expected at least")
     assert not out.exists()
 
 
@@ -155,7 +156,7 @@ def test_a_spent_time_limit_exits_2_naming_the_step(tmp_path: Path) -> None:
     args = ["cover", str(region), "--out", str(out), "--time-limit", "1"]
     result = CliRunner().invoke(app, args)
     assert result.exit_code == 2
-    assert "time_limit: got 1 s, expected enough for this plan: it stopped at" in " ".join(
+    assert "--time-limit: got 1 s, expected enough for this plan: it stopped at" in " ".join(
         result.output.split()
     )
     assert not out.exists()

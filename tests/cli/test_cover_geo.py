@@ -57,7 +57,7 @@ def test_the_exports_use_the_origin(plan_dir: Path, tmp_path: Path) -> None:
         app, ["export", str(plan_dir), "--out", str(out), "--format", "px4-global"]
     )
     assert result.exit_code == 0, result.output
-    report = json.loads((tmp_path / "g.summary.json").read_text())
+    report = json.loads((tmp_path / "g.csv.summary.json").read_text())
     assert report["max_error_m"] < 0.01
     show = tmp_path / "s.skyc"
     result = runner.invoke(app, ["export", str(plan_dir), "--out", str(show), "--format", "skyc"])

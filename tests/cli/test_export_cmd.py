@@ -47,7 +47,8 @@ def targeted(tmp_path_factory: pytest.TempPathFactory) -> Path:
          move([1, 0, 1], [1, 1, 1.5], 25, 5.0))
     )  # fmt: skip
     out = tmp_path_factory.mktemp("targeted")
-    limits = VehicleLimits(1.0, 2.0, 10.0).derivative_limits(3)
+    # jerk 13.4 m/s^3 at most (the eased spline): limits it keeps, as delivered too
+    limits = VehicleLimits(1.0, 2.0, 15.0).derivative_limits(3)
     write_plan(out, [PlannedTrajectory(plan, (), limits)], rate=100.0, guaranteed=True, summary={})
     return out
 
@@ -57,7 +58,7 @@ def test_every_format_from_a_targeted_plan(targeted: Path, tmp_path: Path, fmt: 
     out = tmp_path / f"show{EXPORTERS[fmt].suffix}"
     result = runner.invoke(app, ["export", str(targeted), "--format", fmt, "--out", str(out)])
     assert result.exit_code == 0, result.output
-    summary = json.loads((tmp_path / "show.summary.json").read_text())
+    summary = json.loads((tmp_path / f"{out.name}.summary.json").read_text())
     assert summary["format"] == fmt and all(Path(f).exists() for f in summary["files"])
 
 
@@ -66,7 +67,7 @@ def test_every_format_from_a_fit(fitted: Path, tmp_path: Path, fmt: str) -> None
     out = tmp_path / f"show{EXPORTERS[fmt].suffix}"
     result = runner.invoke(app, ["export", str(fitted), "--format", fmt, "--out", str(out)])
     assert result.exit_code == 0, result.output
-    summary = json.loads((tmp_path / "show.summary.json").read_text())
+    summary = json.loads((tmp_path / f"{out.name}.summary.json").read_text())
     assert summary["format"] == fmt and summary["files"]
     for name in summary["files"]:
         assert Path(name).exists()
@@ -148,10 +149,10 @@ def test_crazyswarm_round_trip_flies_in_the_simulator(targeted: Path, tmp_path: 
         app, ["export", str(targeted), "--format", "crazyswarm", "--out", str(tmp_path / "cf.csv")]
     )
     assert result.exit_code == 0, result.output
-    summary = json.loads((tmp_path / "cf.summary.json").read_text())
+    summary = json.loads((tmp_path / "cf.csv.summary.json").read_text())
     assert [Path(f).name for f in summary["files"]] == ["cf_part1.csv", "cf_part2.csv", "cf_fly.py"]
     assert [u["pieces"] for u in summary["drone_uploads"][0]["uploads"]] == [20, 25]
-    flown = read_export(tmp_path / "cf.summary.json")["trajectory"]
+    flown = read_export(tmp_path / "cf.csv.summary.json")["trajectory"]
     original = read_trajectory_json(targeted / "trajectory.json").trajectory
     t = np.linspace(0.0, original.duration, 3000)
     for order in range(3):
@@ -167,7 +168,7 @@ def test_the_light_colour_reaches_the_skybrush_formats(fitted: Path, tmp_path: P
     args = ["export", str(fitted), "--format", "skybrush-csv", "--out", str(out)]
     result = runner.invoke(app, [*args, "--light", "#0a141e"])  # 10,20,30
     assert result.exit_code == 0, result.output
-    summary = json.loads((tmp_path / "lit.summary.json").read_text())
+    summary = json.loads((tmp_path / "lit.zip.summary.json").read_text())
     assert summary["lights_exact_to_ms"] and summary["format"] == "skybrush-csv"
 
 
@@ -181,3 +182,22 @@ def test_a_bad_light_colour_is_named(fitted: Path, tmp_path: Path, light: str) -
         result.output
     )
     assert not out.exists()
+
+
+def test_two_exports_of_one_plan_into_one_folder_both_work(fitted: Path, tmp_path: Path) -> None:
+    """The README's own sequence: a .skyc and Studio's zip of one plan, side by side; each
+    summary is named after its whole file name, so neither refuses the other's."""
+    for name, fmt in (("four.skyc", "skyc"), ("four.zip", "skybrush-csv")):
+        result = runner.invoke(
+            app, ["export", str(fitted), "--format", fmt, "--out", str(tmp_path / name)]
+        )
+        assert result.exit_code == 0, result.output
+    for name, fmt in (("four.skyc", "skyc"), ("four.zip", "skybrush-csv")):
+        summary = json.loads((tmp_path / f"{name}.summary.json").read_text())
+        assert summary["format"] == fmt and Path(summary["files"][0]).name == name
+    # and once more, each replacing only its own files
+    again = runner.invoke(
+        app, ["export", str(fitted), "--format", "skyc", "--out", str(tmp_path / "four.skyc")]
+    )
+    assert again.exit_code == 0, again.output
+    assert (tmp_path / "four.zip.summary.json").exists()

@@ -150,7 +150,7 @@ def test_every_outer_loop_flies_on_rotorpy(spiral: Path, tmp_path: Path, control
         (["--wind", "1e5,0,0"], "--wind: got '1e5,0,0', expected components of at most 100"),
         (["--gust", "-1"], "--gust: got -1, expected a number from 0 to 100"),
         (["--noise", "inf"], "--noise: got inf, expected a number from 0 to 1"),
-        (["--rate", "0"], "--rate: got 0, expected a positive number of Hz"),
+        (["--rate", "0"], "--rate: got 0, expected 50 to 10000 Hz"),
         (["--sim", "rotorpy", "--wind", "1,0,0"], "--sim rotorpy: got --wind, --gust or --noise"),
     ],
 )

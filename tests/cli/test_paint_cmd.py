@@ -7,6 +7,7 @@ import json
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pytest
 from PIL import Image
 from typer.testing import CliRunner
@@ -81,9 +82,10 @@ def test_image_segmented_wall_shortest_order(tmp_path: Path) -> None:
         (["--offset", "0,-1.1"], "--offset: got '0,-1.1', expected three comma-separated"),
         (["--offset", "0,1,0"], "--offset: got '0,1,0', expected the drone in front"),
         (["--gamma", "95"], "--gamma: got 95, expected an angle from -60 to 60 deg"),
-        (["--estimator", "ekf"], "--estimator: got 'ekf', expected one of none, svd"),
+        (["--estimator", "ekf"], "--estimator: got 'ekf', expected one of none, svd, robust"),
         (["--localization", "gps"], "--localization: got 'gps', expected 'onboard'"),
-        (["--order", "spiral"], "--order: got 'spiral', expected one of given"),
+        (["--order", "spiral"], "--order: got 'spiral', expected one of given, paper, shortest"),
+        (["--probe-spacing", "-0.1"], "--probe-spacing: got -0.1, expected 0 (no probing pass)"),
         (["--false-contacts", "2"], "--false-contacts: got 2, expected a probability"),
     ],
 )
@@ -125,3 +127,46 @@ def test_out_is_a_file(tmp_path: Path) -> None:
         app, ["paint", str(EXAMPLES / "paper_140.csv"), "--out", str(tmp_path / "f")]
     )
     assert result.exit_code == 2 and "an existing file" in " ".join(result.output.split())
+
+
+def test_joint_on_a_wall_file(tmp_path: Path) -> None:
+    """The default estimator on a cylinder described in a file: the wall fit, the aim error,
+    the probing pass and the battery use are in the summary and in the last line."""
+    wall = tmp_path / "tower.toml"
+    wall.write_text("[cylinder]\nradius = 20.0\n")
+    result = runner.invoke(
+        app,
+        ["paint", str(EXAMPLES / "paper_140.csv"), "--wall", str(wall), "--gamma", "10",
+         "--localization", "truth", "--out", str(tmp_path / "o")],
+    )  # fmt: skip
+    assert result.exit_code == 0, result.output
+    assert "batteries" in result.output
+    summary = json.loads((tmp_path / "o" / "summary.json").read_text())
+    assert summary["estimator"] == "joint" and summary["order"] == "shortest"
+    assert summary["wall"] == str(wall)
+    assert summary["probes"] == 10 and summary["wall_fit"]["fits"]
+    assert summary["aim_rmse_m"] < 0.01 and summary["rmse_m"] < 0.06
+    assert summary["estimate"]["gamma_deg"] == pytest.approx(10.0, abs=0.3)
+    assert summary["battery_use"] == pytest.approx(summary["flight_time_s"] / 480.0)
+    assert (tmp_path / "o" / "plot.png").exists()
+
+
+def test_a_wall_that_does_not_fit_says_so(tmp_path: Path) -> None:
+    """A wall of steps every 20 cm is no wall of eight plane pieces: said in the last line."""
+    steps = "".join(
+        f"[[segment]]\nfrom = {a:.1f}\nto = {a + 0.2:.1f}\nangle = {0 if k % 2 == 0 else 40}\n"
+        for k, a in enumerate(np.arange(-2.1, 2.1, 0.2))
+    )
+    wall = tmp_path / "steps.toml"
+    wall.write_text(steps)
+    dots = tmp_path / "d.csv"
+    dots.write_text("x,z\n" + "".join(f"{x:.3f},1.5\n" for x in np.linspace(-1.9, 1.9, 40)))
+    result = runner.invoke(
+        app,
+        ["paint", str(dots), "--wall", str(wall), "--localization", "truth",
+         "--out", str(tmp_path / "o")],
+    )  # fmt: skip
+    assert result.exit_code == 0, result.output
+    summary = json.loads((tmp_path / "o" / "summary.json").read_text())
+    assert not summary["wall_fit"]["fits"]
+    assert "does not fit" in " ".join(result.output.split())

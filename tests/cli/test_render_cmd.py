@@ -40,8 +40,8 @@ def test_render_writes_the_photograph_the_preview_and_a_summary(plan: Path, tmp_
     [
         (["--trail", "-1"], "--trail: got -1, expected a number of seconds >= 0 or inf"),
         (["--light", "300,0,0"], "--light: got '300,0,0'"),
-        (["--elevation", "95"], "elevation_deg: got 95, expected -89 to 89"),
-        (["--fov", "0"], "fov_deg: got 0, expected 1 to 170 degrees"),
+        (["--elevation", "95"], "--elevation: got 95, expected -89 to 89"),
+        (["--fov", "0"], "--fov: got 0, expected 1 to 170 degrees"),
     ],
 )
 def test_bad_views_exit_2_in_one_line(

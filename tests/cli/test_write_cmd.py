@@ -119,20 +119,20 @@ def test_write_yong_and_fly_draws_and_measures_the_ink(tmp_path: Path) -> None:
     [
         (["write"], "expected exactly one of TEXT, --strokes FILE or --svg FILE"),
         (["write", "一马", "--drones", "3"], "got 3 drones for 2 character(s)"),
-        (["write", "Hi", "--size", "-1"], "size_m: got -1"),
+        (["write", "Hi", "--size", "-1"], "--size: got -1"),
         (["write", "Hi", "--rate", "0"], "--rate: got 0"),
         (["write", "Hi", "--follow", "ink"], "--follow: got 'ink', expected tip or path"),
         (
             ["write", "Hi", "--brush-length", "0.01"],
-            "brush length_m: got 0.01 m, expected at least",
+            "--brush-length: got 0.01 m, expected at least",
         ),
-        (["write", "Hi", "--brush-length", "3"], "brush length_m: got 3 m, expected at most 2 m"),
+        (["write", "Hi", "--brush-length", "3"], "--brush-length: got 3 m, expected at most 2 m"),
         (
             ["write", "Hi", "--press-depth", "0.05"],
-            "brush press_depth_m: got 0.05 m, expected less",
+            "--press-depth: got 0.05 m, expected less",
         ),
-        (["write", "Hi", "--board-height", "-1"], "board: got the writing from -1 m up"),
-        (["write", "Hi", "--board-height", "200"], "expected both within the flight volume"),
+        (["write", "Hi", "--board-height", "-1"], "--board-height: got -1, expected more than 0"),
+        (["write", "Hi", "--board-height", "200"], "--board-height: got 200, expected more"),
     ],
 )
 def test_bad_input(tmp_path: Path, args: list[str], message: str) -> None:

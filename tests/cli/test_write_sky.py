@@ -114,7 +114,10 @@ def test_split_too_close_is_infeasible(tmp_path: Path) -> None:
         (["Hi", "--split", "strokes", "--drones", "20"], "got 20 drones for a drawing of"),
         (["Hi", "--split", "strokes"], "--split: got --drones 1, expected at least 2"),
         (["Hi", "--split", "words", "--drones", "2"], "--split: got 'words', expected strokes"),
-        (["E" * 101, "--board", "sky", "--drones", "101"], "--drones: got 101, expected 1 to 100"),
+        (
+            ["E" * 1001, "--board", "sky", "--drones", "1001"],
+            "--drones: got 1001, expected 1 to 1000",
+        ),
     ],
 )
 def test_bad_input(tmp_path: Path, args: list[str], message: str) -> None:

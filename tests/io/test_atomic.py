@@ -28,3 +28,17 @@ def test_the_temporary_keeps_the_suffix_and_nan_is_refused(tmp_path: Path) -> No
     assert (tmp_path / "a.txt").read_text(encoding="utf-8") == "é"
     with pytest.raises(ValueError):
         write_json(tmp_path / "n.json", {"x": float("nan")})
+
+
+def test_files_get_the_mode_the_users_umask_gives(tmp_path: Path) -> None:
+    """Not the 0600 of a temporary file: a plan is shared like any other file."""
+    import os
+    import stat
+
+    from skyquill.io import atomic
+
+    path = tmp_path / "summary.json"
+    atomic.write_json(path, {"a": 1})
+    assert stat.S_IMODE(path.stat().st_mode) == 0o666 & ~atomic._UMASK
+    assert stat.S_IMODE(path.stat().st_mode) != 0o600 or atomic._UMASK == 0o066
+    assert os.umask(atomic._UMASK) == atomic._UMASK  # read back, left as it was

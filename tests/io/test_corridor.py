@@ -160,25 +160,33 @@ BAD_CASES: list[tuple[str, Mutation, str]] = [
     ("missing yaw", _delete("boxes", 0, "yaw_deg"), r"^boxes\[0\]\.yaw_deg in "),
     ("unknown key", _set("speed", value=3.0), r"^speed in .*unknown key"),
     ("unknown box key", _set("boxes", 1, "yaw", value=3.0), r"^boxes\[1\]\.yaw in .*unknown"),
-    ("no boxes", _set("boxes", value=[]), r"^boxes in .*at least 1 box.*got \[\]"),
+    ("no boxes", _set("boxes", value=[]), r"^boxes in .*got \[\], expected .*at least 1 box"),
     ("boxes not list", _set("boxes", value={"a": 1}), r"^boxes in .*list"),
     ("box not object", _set("boxes", 2, value=[1, 2, 3]), r"^boxes\[2\] in .*object"),
-    ("start 2 values", _set("start", value=[0.0, 0.0]), r"^start in .*exactly 3.*got 2 values"),
-    ("goal 4 values", _set("goal", value=[0, 0, 0, 0]), r"^goal in .*exactly 3.*got 4 values"),
+    (
+        "start 2 values",
+        _set("start", value=[0.0, 0.0]),
+        r"^start in .*got 2 values.*expected exactly 3",
+    ),
+    (
+        "goal 4 values",
+        _set("goal", value=[0, 0, 0, 0]),
+        r"^goal in .*got 4 values.*expected exactly 3",
+    ),
     ("center length", _set("boxes", 4, "center", value=[1.0]), r"^boxes\[4\]\.center in "),
     (
         "size nan",
         _set("boxes", 2, "size", 1, value=math.nan),
-        r"^boxes\[2\]\.size\[1\] in .*got nan",
+        r"corridor.json: got NaN, expected .*not JSON",  # json_read refuses it first
     ),
-    ("start inf", _set("start", 2, value=math.inf), r"^start\[2\] in .*finite.*got inf"),
-    ("yaw nan", _set("boxes", 5, "yaw_deg", value=math.nan), r"^boxes\[5\]\.yaw_deg in .*finite"),
+    ("start inf", _set("start", 2, value=math.inf), r"corridor.json: got Infinity, expected"),
+    ("yaw nan", _set("boxes", 5, "yaw_deg", value=math.nan), r"corridor.json: got NaN"),
     ("yaw string", _set("boxes", 5, "yaw_deg", value="45"), r"^boxes\[5\]\.yaw_deg in .*'45'"),
     ("yaw bool", _set("boxes", 5, "yaw_deg", value=True), r"^boxes\[5\]\.yaw_deg in .*True"),
     ("size zero", _set("boxes", 1, "size", 2, value=0.0), r"^boxes\[1\]\.size in .*> 0"),
     ("size negative", _set("boxes", 6, "size", 0, value=-1.0), r"^boxes\[6\]\.size in .*> 0"),
     ("waypoint short", _set("waypoints", 3, value=[1.0, 2.0]), r"^waypoints\[3\] in .*exactly 3"),
-    ("waypoint nan", _set("waypoints", 2, 0, value=math.nan), r"^waypoints\[2\]\[0\] in "),
+    ("waypoint nan", _set("waypoints", 2, 0, value=math.nan), r"corridor.json: got NaN"),
     ("one waypoint", _set("waypoints", value=[[0.0, 0.0, 1.2]]), r"^waypoints in .*at least 2"),
     ("waypoints flat", _set("waypoints", value=[1.0, 2.0, 3.0]), r"^waypoints\[0\] in "),
     ("start outside", _set("start", value=[3.0, 5.0, 1.2]), r"^start in .*inside boxes\[0\]"),
@@ -206,7 +214,9 @@ def test_unmodified_copy_loads(tmp_path: Path, raw: dict[str, Any]) -> None:
 
 
 def test_missing_file(tmp_path: Path) -> None:
-    with pytest.raises(InputError, match=r"^path: expected an existing .*nope\.json"):
+    with pytest.raises(
+        InputError, match=r"nope\.json: no such file, expected a corridor JSON file"
+    ):
         load_box_corridor(tmp_path / "nope.json")
 
 
@@ -218,7 +228,7 @@ def test_invalid_json(tmp_path: Path) -> None:
 
 
 def test_top_level_not_object(tmp_path: Path) -> None:
-    with pytest.raises(InputError, match=r"top level.*JSON object.*got list"):
+    with pytest.raises(InputError, match=r"top level.*got list, expected a JSON object"):
         load_box_corridor(_write(tmp_path, [1, 2, 3]))
 
 

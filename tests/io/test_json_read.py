@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import os
 import tempfile
 from pathlib import Path
 
@@ -59,12 +60,37 @@ def test_files_missing_or_too_large(tmp_path: Path) -> None:
     big.write_text("[" + "0," * 100 + "0]", encoding="utf-8")
     with pytest.raises(InputError, match=r"big\.json: got 203 bytes, expected .* at most 100"):
         read_json_file(big, WHAT, max_bytes=100)
-    with pytest.raises(InputError, match=r"cannot be read"):
+    with pytest.raises(InputError, match=r"got a folder, expected a test document \(a regular"):
         read_json_file(tmp_path, WHAT)
+    pipe = tmp_path / "pipe.json"
+    os.mkfifo(pipe)
+    with pytest.raises(InputError, match=r"pipe.json: got a named pipe, expected a test document"):
+        read_json_file(pipe, WHAT)
+
+
+@pytest.mark.parametrize(
+    ("raw", "match"),
+    [
+        ('{"a": 1, "a": 2}', r"got the key 'a' twice in one object, expected .*each key once"),
+        ('[{"b": {"c": 1, "c": 1}}]', r"got the key 'c' twice"),
+        ("[NaN]", r"got NaN, expected .*not JSON"),
+        ('{"x": -Infinity}', r"got -Infinity, expected"),
+        ("[1e400]", r"got a number beyond the float range \(about 1.8e308\), expected"),
+    ],
+)
+def test_what_json_forbids_and_python_allows_is_refused(raw: str, match: str) -> None:
+    with pytest.raises(InputError, match=rf"doc\.json: {match}"):
+        parse_json(raw.encode(), "doc.json", WHAT)
 
 
 _json = st.recursive(
-    st.one_of(st.none(), st.booleans(), st.floats(), st.integers(), st.text(max_size=4)),
+    st.one_of(
+        st.none(),
+        st.booleans(),
+        st.floats(allow_nan=False, allow_infinity=False),
+        st.integers(),
+        st.text(max_size=4),
+    ),
     lambda inner: st.one_of(
         st.lists(inner, max_size=4), st.dictionaries(st.text(max_size=3), inner, max_size=3)
     ),

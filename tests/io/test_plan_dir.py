@@ -17,6 +17,7 @@ from skyquill.trajectory import SplineTrajectory
 
 def _spline(seed: int = 0, dim: int = 3) -> SplineTrajectory:
     ctrl = np.random.default_rng(seed).normal(scale=0.2, size=(12, dim))
+    ctrl[:, -1] += 1.0  # in the air: the mission keeps the minimum altitude (0.3 m)
     ctrl[:3] = ctrl[0]  # at rest at both ends
     ctrl[-3:] = ctrl[-1]
     return SplineTrajectory(ctrl, 5, 4.0)
@@ -74,7 +75,7 @@ def test_bad_plans_are_named(tmp_path: Path) -> None:
     with pytest.raises(InputError, match=r"without trajectory\.json"):
         read_plan(tmp_path)
     (tmp_path / "summary.json").write_text("{not json")
-    with pytest.raises(InputError, match=r"damaged summary"):
+    with pytest.raises(InputError, match=r"summary.json: got malformed JSON"):
         read_plan(tmp_path)
     with pytest.raises(InputError, match="expected 3 \\(x, y, z\\)"):
         write_plan(
@@ -86,3 +87,18 @@ def test_bad_plans_are_named(tmp_path: Path) -> None:
         )
     with pytest.raises(InputError, match="expected at least one"):
         write_plan(tmp_path / "o", [], rate=10.0, guaranteed=True, summary={})
+
+
+def test_the_phases_are_recorded_and_a_mission_below_the_minimum_altitude_refused(
+    tmp_path: Path,
+) -> None:
+    from skyquill.errors import InfeasibleError
+
+    summary = _write(tmp_path / "ok")
+    drone = summary["plan"]["drones"][0]  # type: ignore[index]
+    assert summary["plan"]["min_altitude_m"] == 0.3  # type: ignore[index]
+    assert drone["phases"]["mission_s"] == [0.0, 4.0] and drone["phases"]["lowest_m"] >= 0.3
+    [(_, planned)] = read_plan(tmp_path / "ok")
+    assert planned.phases is not None and planned.phases.as_dict() == drone["phases"]
+    with pytest.raises(InfeasibleError, match=r"min_altitude_m: got a plan that never rests"):
+        _write(tmp_path / "low", min_altitude_m=1.5)

@@ -89,3 +89,24 @@ def test_trajectory_csv_columns_and_2d_padding(tmp_path: Path) -> None:
 def test_write_json_refuses_nan(tmp_path: Path) -> None:
     with pytest.raises(ValueError, match="Out of range float"):
         write_json(tmp_path / "s.json", {"x": float("nan")})
+
+
+def test_a_trajectory_csv_is_never_longer_than_its_read_back_takes(tmp_path: Path) -> None:
+    """Issue 25: paint at its dot ceiling wrote 813 MB of trajectory.csv, then refused it."""
+    from skyquill.io.points import check_rows_written, write_trajectory_csv
+    from skyquill.io.table import MAX_ROWS
+
+    check_rows_written(MAX_ROWS / 100.0 - 1.0, 100.0)
+    long = SplineTrajectory(np.zeros((6, 3)), 5, MAX_ROWS / 100.0)
+    with pytest.raises(
+        InputError, match=r"^rate: got 100 Hz over a 10000 s flight \(1,000,002 rows\)"
+    ):
+        write_trajectory_csv(tmp_path / "t.csv", long, 100.0)
+    assert not (tmp_path / "t.csv").exists()
+
+
+def test_the_refusal_names_where_the_rate_came_from() -> None:
+    from skyquill.io.points import check_rows_written
+
+    with pytest.raises(InputError, match=r"^\[show\]\.rate: got 100 Hz over a 20000 s flight"):
+        check_rows_written(20_000.0, 100.0, "[show].rate")

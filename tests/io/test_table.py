@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import tempfile
 from pathlib import Path
 
@@ -117,8 +118,24 @@ def test_utf16_and_binary_are_named_not_unicode_errors(tmp_path: Path) -> None:
 def test_missing_file_and_directory(tmp_path: Path) -> None:
     with pytest.raises(InputError, match=r"points file: got '.*nope.csv', expected an existing"):
         read_table(tmp_path / "nope.csv", required=("x",), name="points file")
-    with pytest.raises(InputError, match=r"csv file: got '.*', expected an existing CSV file"):
+    with pytest.raises(InputError, match=r"got a folder, expected a CSV file \(a regular file\)"):
         read_table(tmp_path, required=("x",))
+
+
+def test_a_named_pipe_is_refused_without_blocking(tmp_path: Path) -> None:
+    pipe = tmp_path / "pipe.csv"
+    os.mkfifo(pipe)
+    with pytest.raises(InputError, match=r"pipe.csv: got a named pipe, expected a CSV file"):
+        read_table(pipe, required=("x",))
+
+
+@pytest.mark.parametrize(
+    "cell", ["1_0", "٠.١", "０.５", "0x10", "1,5", "½", "²", "1e", "--1", "Infinity"]
+)
+def test_numbers_are_plain_ascii_decimals(tmp_path: Path, cell: str) -> None:
+    path = write(tmp_path, f'x,y\n0,0\n"{cell}",1\n')
+    with pytest.raises(InputError, match=r"t.csv line 3, column x: got .*, expected a"):
+        read_table(path, required=("x", "y"))
 
 
 def test_row_counts_are_bounded(tmp_path: Path) -> None:
@@ -141,7 +158,7 @@ def test_huge_files_and_lines_are_refused_before_being_read(
         read_table(one_line, required=("x",))
     monkeypatch.setattr(table_module, "MAX_BYTES", 100)
     big = write(tmp_path, "x\n" + "1\n" * 60, "big.csv")
-    with pytest.raises(InputError, match=r"big.csv: got 122 bytes, expected at most 100"):
+    with pytest.raises(InputError, match=r"big.csv: got 122 bytes, expected a CSV file of at most"):
         read_table(big, required=("x",))
 
 

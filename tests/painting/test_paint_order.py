@@ -46,3 +46,14 @@ def test_orders_are_permutations_and_two_opt_never_lengthens(dots: np.ndarray) -
 def test_unknown_order() -> None:
     with pytest.raises(InputError, match=r"--order: got 'zigzag', expected one of given"):
         order_dots(np.zeros((2, 2)), "zigzag")
+
+
+def test_spread_starts_with_dots_across_the_width() -> None:
+    dots = paper_drawing()
+    route = order_dots(dots, "spread", start_xz=np.array([0.0, 1.5]), spacing_m=0.5)
+    assert sorted(route.tolist()) == list(range(len(dots)))
+    first = dots[route[:8], 0]
+    assert np.all(np.diff(first) > 0.3)  # one sweep, left to right (the start is nearer left?)
+    assert first.min() < -1.6 and first.max() > 1.6
+    for method in ("spread",):
+        assert sorted(order_dots(dots[:5], method).tolist()) == list(range(5))

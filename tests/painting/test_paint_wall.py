@@ -102,3 +102,53 @@ def test_wall_validation() -> None:
         Wall(np.zeros(3), np.array([0.5, -0.5]))
     with pytest.raises(InputError, match=r"wall angles: got 2 angle\(s\) and 0 corner"):
         Wall(np.zeros(2), np.zeros(0))
+
+
+@pytest.mark.parametrize("radius", [20.0, -20.0, 6.0])
+def test_cylinder_polygon_stays_on_the_circle(radius: float) -> None:
+    wall = Wall.cylinder(radius, step_deg=0.5)
+    x = np.linspace(-4.0, 4.0, 401)
+    circle = np.sign(radius) * (abs(radius) - np.sqrt(radius**2 - x**2))
+    # circumscribed polygon: within R (1 / cos(step / 2) - 1) of the circle along its radius,
+    # that over the cosine of the steepest slope along y
+    radial = abs(radius) * (1 / math.cos(math.radians(0.25)) - 1)
+    steepest = math.asin(4.0 / abs(radius))
+    assert np.max(np.abs(wall.depth(x) - circle)) <= radial / math.cos(steepest) + 1e-12
+    assert wall.depth(np.array([0.0]))[0] == pytest.approx(0.0, abs=1e-12)
+
+
+def test_recess_depths() -> None:
+    wall = Wall.recess(0.6, 1.4, 0.1, side_deg=45.0)
+    x = np.array([0.0, 0.6, 0.65, 1.0, 1.35, 1.4, 3.0])
+    assert wall.depth(x) == pytest.approx([0, 0, 0.05, 0.1, 0.05, 0, 0], abs=1e-12)
+
+
+def _hit_one_by_one(wall: Wall, start: np.ndarray, direction: np.ndarray) -> float:
+    """The ray's hit tried segment by segment (the definition the vectorised one keeps)."""
+    for k in range(wall.n_segments):
+        anchor, u = wall.line(k)
+        n = np.array([-u[1], u[0]])
+        along = float(direction @ n)
+        if along <= 1e-12:
+            continue
+        t = float((anchor - start) @ n) / along
+        if int(wall.segment_of(np.array([start[0] + t * direction[0]]))[0]) == k:
+            return t
+    return math.inf
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    angles=st.lists(st.floats(-60, 60), min_size=1, max_size=5),
+    x0=st.floats(-3, 3),
+    y0=st.floats(-2, 0.5),
+    heading=st.floats(-80, 80),
+)
+def test_hit_matches_the_segment_by_segment_definition(
+    angles: list[float], x0: float, y0: float, heading: float
+) -> None:
+    wall = Wall.segmented(angles, (-2.0, 2.0))
+    start = np.array([x0, y0])
+    direction = rot2(math.radians(heading)) @ np.array([0.0, 1.0])
+    expected = _hit_one_by_one(wall, start, direction)
+    assert wall.hit(start, direction) == pytest.approx(expected, rel=1e-12, abs=1e-12)

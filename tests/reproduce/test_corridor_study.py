@@ -97,3 +97,26 @@ def test_rejects_bad_arguments(tmp_path: Path) -> None:
         run_corridor_study(EXAMPLES / "s_corridor.json", tmp_path, n_ctrl_values=(3,))
     with pytest.raises(InputError, match=r"sides\[i\]: got 2"):
         run_corridor_study(EXAMPLES / "s_corridor.json", tmp_path, sides=(2,))
+
+
+def test_a_study_without_one_feasible_solve_is_refused(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Issue 25: no feasible solve exited 0 with ``coupled_lower_cost_everywhere: true``."""
+    from typer.testing import CliRunner
+
+    from skyquill.cli.main import app
+    from skyquill.errors import InfeasibleError
+    from skyquill.reproduce import corridor
+
+    def infeasible(*_: object) -> None:
+        raise InfeasibleError("limits: got an empty feasible set", ("corridor",))
+
+    monkeypatch.setattr(corridor, "solve", infeasible)
+    with pytest.raises(InfeasibleError, match="corridor: got no feasible solve for any of M"):
+        run_corridor_study(EXAMPLES / "s_corridor.json", tmp_path / "o", n_ctrl_values=(44,))
+    result = CliRunner().invoke(app, ["reproduce", "corridor", "--out", str(tmp_path / "cli")])
+    lines = [line for line in result.output.splitlines() if line.strip()]
+    assert result.exit_code == 2 and len(lines) == 1, result.output
+    assert lines[0].startswith("error: corridor: got no feasible solve")
+    assert not (tmp_path / "cli" / "summary.json").exists()

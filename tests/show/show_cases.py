@@ -44,9 +44,10 @@ def planted() -> tuple[PiecewisePolynomial, PiecewisePolynomial, float]:
 
 
 def plan(folder: Path, trajectories: Sequence[Trajectory]) -> Path:
-    """A plan directory as the planning commands write it."""
+    """A plan directory as the planning commands write it (no flight phases: some of these
+    drones are already moving at their start, which no vehicle could take off into)."""
     planned = [PlannedTrajectory(t) for t in trajectories]
-    write_plan(folder, planned, rate=50.0, guaranteed=True, summary={})
+    write_plan(folder, planned, rate=50.0, guaranteed=True, summary={}, min_altitude_m=None)
     return folder
 
 

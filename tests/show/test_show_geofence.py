@@ -61,7 +61,11 @@ def test_geojson_collection_and_wkt(tmp_path: Path) -> None:
             },
             r"ceiling_m: got 'high', expected metres",
         ),
-        ({"type": "Polygon", "coordinates": "x"}, r"shapely cannot read"),
+        ({"type": "Polygon", "coordinates": "x"}, r"coordinates: got 'x', expected a list"),
+        (
+            {"type": "Polygon", "coordinates": [[[0, 0], [9, 0], [9, 9], [0, 9]]]},
+            r"coordinates\[0\]: got a ring from \[0, 0\] to \[0, 9\], expected a closed ring",
+        ),
     ],
 )
 def test_bad_geofences_are_one_input_error(tmp_path: Path, content: object, message: str) -> None:

@@ -42,7 +42,13 @@ def test_a_skyc_written_by_skyquill(three: Path, tmp_path: Path) -> None:
     assert result.exit_code == 0, result.output
     drones = load_show([show])
     assert [d.name for d in drones] == [f"show.skyc/trajectory_{i}" for i in range(3)]
-    for drone, traj in zip(drones, row(0.0), strict=True):
+    # A Skybrush show starts and ends on its pads (issue 26): the plan with its climb from
+    # the ground and its descent to it.
+    from skyquill.export.skybrush.pads import on_pads
+    from skyquill.io.plan_dir import read_plan
+
+    delivered = [on_pads(planned).trajectory for _, planned in read_plan(three)]
+    for drone, traj in zip(drones, delivered, strict=True):
         t = np.linspace(0.0, traj.duration, 50)
         # Skybrush's mm grid: the played show is within a millimetre of the plan.
         assert np.abs(drone.trajectory.evaluate(t) - traj.evaluate(t)).max() < 1e-3

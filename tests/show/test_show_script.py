@@ -122,3 +122,12 @@ def test_random_scripts_give_a_script_or_an_input_error(
         return  # not representable in TOML (None, NaN keys...)
     with contextlib.suppress(InputError):
         parse_script(text)
+
+
+def test_a_thousand_drones_are_accepted_and_more_refused() -> None:
+    """The ceiling of issue 27: shows of 1,000 drones (was 200); above it, one plain refusal."""
+    script = "[show]\ndrones = {n}\nsafety_distance = 1.5\n" + HEAD.split("\n", 4)[4] + TAIL
+    assert parse_script(script.format(n=1000)).drones == 1000
+    refused = r"^\[show\]\.drones: got 1001, expected an integer from 1 to 1000"
+    with pytest.raises(InputError, match=refused):
+        parse_script(script.format(n=1001))

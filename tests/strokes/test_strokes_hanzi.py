@@ -90,7 +90,7 @@ def test_env_directory_then_bundle(tmp_path: Path, monkeypatch: pytest.MonkeyPat
 
 def test_env_directory_missing(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setenv("SKYQUILL_HANZI_DIR", str(tmp_path / "nowhere"))
-    with pytest.raises(InputError, match="nowhere: no such file or directory"):
+    with pytest.raises(InputError, match="nowhere: got no such file or directory, expected"):
         hanzi_strokes("永")
 
 

@@ -103,3 +103,16 @@ def test_any_json_gives_strokes_or_input_error(
         assert "expected" in str(exc)
     else:
         assert s.n_strokes == len(medians)  # type: ignore[arg-type]
+
+
+def test_one_characters_file_writes_that_character_only(tmp_path: Path) -> None:
+    """Issue 25: `write 永一 --hanzi one.json` wrote the one file's strokes for both."""
+    from skyquill.strokes import typed_strokes
+
+    named = _file(tmp_path, "一.json", YI)
+    assert hanzi_strokes("一", named).source == "hanzi 一"
+    with pytest.raises(InputError, match=r"'永' \(U\+6C38\) not found; looked in .*一\.json"):
+        hanzi_strokes("永", named)
+    anonymous = _file(tmp_path, "one.json", YI)
+    with pytest.raises(InputError, match=r"one\.json: got one character's hanzi-writer data in a"):
+        typed_strokes("永一", "futural", anonymous)

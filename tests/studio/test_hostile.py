@@ -85,3 +85,16 @@ def test_values_of_the_wrong_type_are_refused_not_converted(
     answer = client.post("/api/plan?wait=true", json=body)
     assert answer.status_code == 422
     assert field in answer.json()["detail"]
+
+
+def test_a_body_nested_too_deeply_names_the_body(client: TestClient) -> None:
+    """Issue 25: the studio's deep-nesting 400 came without a field."""
+    for raw in (
+        b"[" * 100_000 + b"]" * 100_000,
+        b'{"strokes": ' + b"[" * 5000 + b"]" * 5000 + b"}",
+    ):
+        answer = client.post("/api/plan", content=raw, headers={"content-type": "application/json"})
+        assert answer.status_code == 400
+        assert answer.json()["field"] == "body"
+        assert answer.json()["detail"].startswith("body: got JSON that cannot be read")
+    assert client.get("/no/such/page").status_code == 404  # other HTTP errors as before

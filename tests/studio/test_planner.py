@@ -12,7 +12,7 @@ from skyquill.studio.planner import run_plan
 
 
 def test_progress_follows_the_solves_the_flight_and_the_files() -> None:
-    """Each solve of the route is a stage (mission.py's DEBUG records); the bar only rises."""
+    """Each solve of the route is a stage (the planning's DEBUG records); the bar only rises."""
     seen: list[tuple[float, str]] = []
     output = run_plan(
         PlanRequest(text="L", target="skybrush"),

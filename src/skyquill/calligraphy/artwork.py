@@ -25,7 +25,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from skyquill.calligraphy.board import Board, sky_board
-from skyquill.calligraphy.mission import WritingOptions, densify, route_times
+from skyquill.calligraphy.options import WritingOptions
+from skyquill.calligraphy.route import densify
+from skyquill.calligraphy.timing import route_times
 from skyquill.errors import InputError
 from skyquill.strokes import Strokes
 from skyquill.validation import FloatArray, as_float, as_int

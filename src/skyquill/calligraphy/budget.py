@@ -30,17 +30,12 @@ from typing import Any
 
 import numpy as np
 
+from skyquill.calligraphy.allocation import plan_route
 from skyquill.calligraphy.board import Board
-from skyquill.calligraphy.mission import (
-    Mission,
-    RoutePlan,
-    RouteSamples,
-    WritingOptions,
-    fidelity,
-    plan_route,
-    resegmented,
-    route_times,
-)
+from skyquill.calligraphy.mission import Mission
+from skyquill.calligraphy.options import WritingOptions
+from skyquill.calligraphy.planning import RoutePlan, fidelity, resegmented
+from skyquill.calligraphy.route import RouteSamples
 from skyquill.errors import InfeasibleError
 from skyquill.targets import (
     Strategy,
@@ -51,7 +46,6 @@ from skyquill.targets import (
     uploads_summary,
 )
 from skyquill.trajectory import RestToRestSequence, Trajectory
-from skyquill.validation import FloatArray
 
 #: How far a pen-up point may lie from the lifted stroke end it is found by, m.
 LIFT_MATCH_M = 1e-9
@@ -92,7 +86,7 @@ class _Group:
 
 
 def plan_for_target(
-    samples: RouteSamples, times: FloatArray, board: Board, opts: WritingOptions, start: float
+    samples: RouteSamples, board: Board, opts: WritingOptions, start: float
 ) -> Mission:
     """The mission along ``samples`` that fits ``opts.target`` (see the module docstring).
 
@@ -100,8 +94,6 @@ def plan_for_target(
     ----------
     samples
         The whole route (built by :func:`~skyquill.calligraphy.mission.plan_writing`).
-    times
-        Its rest-to-rest timing, shape (N,), s.
     board
         Where it writes.
     opts
@@ -123,7 +115,7 @@ def plan_for_target(
     groups: list[_Group] | None = None
     fallback: Mission | None = None  # the last strategy's plan beyond the tolerance
     if "one-upload" in opts.target_strategies:
-        whole = _attempt(budget, times, board, inner)
+        whole = _attempt(budget, board, inner)
         if whole is not None:
             plan = _refined(budget, whole, board, inner)
             trajectory: Trajectory = plan.fit.trajectory
@@ -152,12 +144,10 @@ def _timed(mission: Mission, start: float) -> Mission:
     return replace(mission, planning_time_s=time.perf_counter() - start)
 
 
-def _attempt(
-    samples: RouteSamples, times: FloatArray, board: Board, opts: WritingOptions
-) -> RoutePlan | None:
+def _attempt(samples: RouteSamples, board: Board, opts: WritingOptions) -> RoutePlan | None:
     """:func:`plan_route` without re-segmentation; ``None`` if the limits cannot be met."""
     try:
-        return plan_route(samples, times, board, opts)
+        return plan_route(samples, board, opts)
     except InfeasibleError:
         return None
 
@@ -206,9 +196,7 @@ def _plan_legs(
     opts: WritingOptions,
 ) -> _Group:
     """Legs ``span = (first, stop)`` planned as one rest-to-rest spline."""
-    sub = _sub(samples, cuts, *span)
-    times = route_times(sub.points, sub.roles, board, opts)
-    return _Group(*span, _attempt(sub, times, board, opts))
+    return _Group(*span, _attempt(_sub(samples, cuts, *span), board, opts))
 
 
 def _groups(

@@ -219,7 +219,9 @@ def measure_deviation(
 def _two_sided(paths: list[FloatArray], strokes: list[FloatArray]) -> Deviation:
     """Distances between each path (K, d) and its stroke (J, d), both ways."""
     forward, backward, total, count = 0.0, 0.0, 0.0, 0
-    for path, stroke in zip(paths, strokes, strict=True):
+    for run, stroke in zip(paths, strokes, strict=True):
+        # A touch of one sample is a polyline of zero length.
+        path = np.vstack([run, run]) if run.shape[0] == 1 else run
         to_input = polyline_distance(path, stroke)
         to_path = polyline_distance(stroke, path)
         forward = max(forward, float(to_input.max()))

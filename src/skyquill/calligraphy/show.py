@@ -36,6 +36,7 @@ from skyquill.calligraphy.mission import (
     plan_writing,
 )
 from skyquill.errors import InputError
+from skyquill.phases import MIN_ALTITUDE_M, check_min_altitude
 from skyquill.strokes import Strokes
 from skyquill.validation import FloatArray, as_float, as_int
 
@@ -45,10 +46,10 @@ if TYPE_CHECKING:
 #: Extra room between boards beyond the required separation, m (lifts, transits).
 BOARD_MARGIN_M = 0.25
 
-#: Most drones in one show: the separation check compares every pair over the
-#: whole flight (n (n - 1) / 2 = 4950 pairs at 100, a few seconds of bounds),
-#: and 100 is the drone show of issue 18.
-MAX_DRONES = 100
+#: Most drones in one show: the separation check looks only at neighbours (sweep and
+#: prune over space-time boxes, :mod:`skyquill.show.separation`), so it grows about
+#: linearly with the drones; the planning work is bounded by the strokes below.
+MAX_DRONES = 1000
 #: Most strokes over all drones of one show: the planning work (each stroke
 #: costs ~0.1-0.3 s of solving on one core, measured on Latin letters and
 #: hanzi), so about 5-15 minutes on two cores at the ceiling.
@@ -134,6 +135,13 @@ def layout(
     return out
 
 
+def _raised(home: FloatArray, height_m: float) -> FloatArray:
+    """``home`` (3,) raised to at least ``height_m``."""
+    out = np.array(home, dtype=float)
+    out[2] = max(out[2], height_m)
+    return out
+
+
 def check_show_size(parts: Sequence[Strokes]) -> None:
     """Refuse a show above :data:`MAX_DRONES` drones or :data:`MAX_SHOW_STROKES` strokes.
 
@@ -167,6 +175,7 @@ def plan_show(
     board_tilt_deg: float = 0.0,
     grid: tuple[int, int] | None = None,
     places: Sequence[tuple[Board, FloatArray]] | None = None,
+    home_altitude_m: float = MIN_ALTITUDE_M,
 ) -> Show:
     """Plan one mission per part (one drone each) and check their separation.
 
@@ -210,6 +219,10 @@ def plan_show(
         Each drone's board and home, instead of :func:`layout`'s (e.g. drones
         sharing one board: :func:`~skyquill.calligraphy.artwork.split_strokes`);
         the board arguments above are then unused.
+    home_altitude_m
+        Each home is raised to at least this height, m: the mission starts and ends
+        hovering there, above its pad, and the vehicle takes off to it and lands from it
+        (:mod:`skyquill.phases`; the minimum flight altitude, by default).
 
     Returns
     -------
@@ -236,6 +249,8 @@ def plan_show(
         )  # fmt: skip
     elif len(places) != len(parts):
         raise InputError(f"places: got {len(places)}, expected one per part ({len(parts)})")
+    lift = check_min_altitude("home_altitude_m", home_altitude_m)
+    places = [(board, _raised(home, lift)) for board, home in places]
     jobs = [(part, board, opts, home) for part, (board, home) in zip(parts, places, strict=True)]
     steps = _Steps(len(jobs) * (2 if fly else 1), progress)
     steps.start(f"planning {len(jobs)} drone(s)")
@@ -380,9 +395,9 @@ def _plan_with_client(
         client = distributed.Client(address, timeout=SCHEDULER_TIMEOUT_S, set_as_default=False)
     except (OSError, TimeoutError, ValueError) as exc:
         raise InputError(
-            f"scheduler: cannot reach the dask scheduler at {address!r} "
-            f"within {SCHEDULER_TIMEOUT_S:g} s ({exc})"
-        ) from exc
+            f"scheduler: got {address!r}, which did not answer within {SCHEDULER_TIMEOUT_S:g} s "
+            f"({exc}), expected the address of a running dask scheduler"
+        ) from None
     with client:
         futures: list[Any] = client.map(_plan, jobs, pure=False)
         arrivals = distributed.as_completed(futures, loop=client.loop)

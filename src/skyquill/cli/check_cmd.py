@@ -28,7 +28,14 @@ from skyquill.show import (
     load_show,
     read_geofence,
 )
+from skyquill.show.limits import MAX_TOLERANCE
 from skyquill.show.report import UNITS
+
+#: Most drones one ``check`` takes: their half a million pairs are bounded in memory (the
+#: separation's intervals, :data:`~skyquill.show.separation.MAX_INTERVALS`) and in time
+#: (bench/ceilings.py measures a .skyc of this many, neighbours close; 2,000 took over
+#: 20 minutes, most of it playing the .skyc back as the drones would).
+MAX_DRONES = 1_000
 
 
 def _limit(flag: str, value: float | None, *, nonneg: bool = True) -> float | None:
@@ -38,6 +45,16 @@ def _limit(flag: str, value: float | None, *, nonneg: bool = True) -> float | No
     if not math.isfinite(value) or (nonneg and value < 0):
         expected = "a finite number >= 0" if nonneg else "a finite number"
         raise InputError(f"{flag}: got {value:g}, expected {expected}")
+    return value
+
+
+def _tolerance(value: float) -> float:
+    """``--tolerance``: a fraction from 0 to :data:`MAX_TOLERANCE`."""
+    if not (math.isfinite(value) and 0.0 <= value <= MAX_TOLERANCE):
+        raise InputError(
+            f"--tolerance: got {value:g}, expected a fraction from 0 to {MAX_TOLERANCE:g} "
+            "(0.01 allows 1 % over the speed and acceleration limits)"
+        )
     return value
 
 
@@ -64,6 +81,14 @@ def check(
         float | None, typer.Option(help="Lowest altitude (z), m; unchecked if not given.")
     ] = None,
     max_altitude: Annotated[float, typer.Option(help="Highest altitude (z), m.")] = 150.0,
+    tolerance: Annotated[
+        float,
+        typer.Option(
+            help="Relative excess allowed over the speed and acceleration limits, 0 to 0.05 "
+            "(0.01: a .skyc as Skybrush plays it, whose millimetre grid may put it up to 1 % "
+            "over its plan's limits)."
+        ),
+    ] = 0.0,
     geofence: Annotated[
         Path | None,
         typer.Option(
@@ -96,8 +121,9 @@ def check(
             min_altitude=_limit("--min-altitude", min_altitude, nonneg=False),
             max_altitude=_limit("--max-altitude", max_altitude, nonneg=False),
             geofence=read_geofence(geofence) if geofence is not None else None,
+            tolerance=_tolerance(tolerance),
         )
-        drones = load_show(paths)
+        drones = load_show(paths, max_drones=MAX_DRONES)
         with console.status(f"checking {len(drones)} drone(s)"):
             report = check_show(drones, minimum, limits)
         summary = report.as_dict() | {"paths": [str(p) for p in paths]}

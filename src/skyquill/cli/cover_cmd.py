@@ -10,19 +10,26 @@ import typer
 
 from skyquill.cli.main import (
     Force,
+    MinAltitude,
     OutDir,
     Target,
     Vmax,
     app,
     check_out,
     console,
+    in_range,
+    min_altitude,
+    positive_rate,
+    progress_bar,
     say_done,
     upload_target,
     user_errors,
 )
+from skyquill.cli.pictures import NoPictures, Pictures
 from skyquill.coverage import DEFAULT_MIN_COVERAGE
 from skyquill.errors import InputError
 from skyquill.limits import VehicleLimits
+from skyquill.phases import MIN_ALTITUDE_M, check_altitude
 
 if TYPE_CHECKING:
     from rich.progress import Progress, TaskID
@@ -33,6 +40,16 @@ if TYPE_CHECKING:
 
 #: The bar is drawn only for planning that takes longer than this, s.
 BAR_AFTER_S = 1.0
+#: ``--altitude``, m above the ground: a coverage flight stays under the 120 m ceiling of
+#: open-category drone rules (EU 2019/947, FAA part 107's 400 ft).
+ALTITUDE_RANGE_M = (0.0, 120.0)
+#: ``--origin-alt``, m above mean sea level: the shore of the Dead Sea (-430 m) to the
+#: summit of Everest (8849 m), with a margin.
+ORIGIN_ALT_RANGE_M = (-500.0, 9000.0)
+#: ``--delta``, m: a corner control point farther than 100 m is no corner of a field.
+DELTA_RANGE_M = (0.0, 100.0)
+#: ``--time-limit``, s: the planning budget, an hour at most.
+TIME_LIMIT_RANGE_S = (0.0, 3600.0)
 
 
 @app.command()
@@ -86,7 +103,9 @@ def cover(
         ),
     ] = DEFAULT_MIN_COVERAGE,
     rate: Annotated[float, typer.Option(help="Setpoint rate, Hz.")] = 50.0,
-    altitude: Annotated[float, typer.Option(help="Flight height, m.")] = 2.0,
+    altitude: Annotated[
+        float, typer.Option(help="Flight height above the ground, m (--min-altitude to 120).")
+    ] = 2.0,
     time_limit: Annotated[
         float,
         typer.Option(
@@ -110,7 +129,9 @@ def cover(
         ),
     ] = None,
     target: Target = None,
+    min_altitude_m: MinAltitude = MIN_ALTITUDE_M,
     force: Force = False,
+    no_pictures: NoPictures = False,
 ) -> None:
     """Plan a coverage flight of REGION; write summary.json, trajectory.csv and plot.png.
 
@@ -135,6 +156,12 @@ def cover(
 
     with user_errors():
         check_out(out)
+        floor = min_altitude(min_altitude_m)
+        _check_heights(altitude, origin_alt)
+        altitude = check_altitude("--altitude", altitude, floor)
+        rate = positive_rate(rate)
+        in_range("--delta", delta, *DELTA_RANGE_M, "m", open_low=True)
+        in_range("--time-limit", time_limit, *TIME_LIMIT_RANGE_S, "s", open_low=True)
         geo = load_geo_region(region, crs, origin_alt)
         shape = geo.region
         options = CoverageOptions(
@@ -170,10 +197,12 @@ def cover(
             console.status("writing and checking the plan"),
             staged_output(out, "cover", force=force, inputs=[region]) as stage,
         ):
+            drawn = Pictures(not no_pictures)
             fields = (
                 plan.summary()
                 | {"region": str(region), "min_coverage": min_coverage or None}
                 | geo.summary()
+                | {"pictures": drawn.entry}
             )
             if geo.frame is not None:
                 fields["path_geojson"] = _write_geojson(stage, geo.frame, plan, planned)
@@ -184,7 +213,8 @@ def cover(
                 # The refit for a target holds the limits through the hull; the LP does not.
                 guaranteed=plan.delivered is not None,
                 summary=fields,
-                plot=lambda path: plot_coverage(plan, path),
+                plot=drawn.plot(lambda path: plot_coverage(plan, path)),
+                min_altitude_m=floor,
             )
     uploads = "" if plan.delivered is None else f", {len(plan.delivered.budget.uploads)} upload(s)"
     say_done(
@@ -204,6 +234,21 @@ def _write_geojson(
     covered = plan.region.intersection(swept(plan.path, plan.options.width))
     check = write_path_geojson(stage / "path.geojson", frame, planned, covered, plan.region)
     return {"file": "path.geojson"} | check.as_dict()
+
+
+def _check_heights(altitude: float, origin_alt: float | None) -> None:
+    """``--altitude`` and ``--origin-alt`` within their ranges (NaN fails too)."""
+    low, high = ALTITUDE_RANGE_M
+    if not low < altitude <= high:
+        raise InputError(
+            f"--altitude: got {altitude:g}, expected a height above the ground, more than "
+            f"{low:g} and at most {high:g} m"
+        )
+    low, high = ORIGIN_ALT_RANGE_M
+    if origin_alt is not None and not low <= origin_alt <= high:
+        raise InputError(
+            f"--origin-alt: got {origin_alt:g}, expected {low:g} to {high:g} m above mean sea level"
+        )
 
 
 def _limits(
@@ -262,12 +307,10 @@ class _BudgetBar:
 
 def _progress() -> Progress:
     """Step, and the budget spent (moved at every step: each LP solve, each check)."""
-    from rich.progress import BarColumn, Progress, TextColumn
+    from rich.progress import BarColumn, TextColumn
 
-    return Progress(
+    return progress_bar(
         TextColumn("planning: {task.description}"),
         BarColumn(),
         TextColumn("{task.completed:.0f} s of the {task.total:.0f} s time limit"),
-        console=console,
-        transient=True,
     )

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Annotated, Any
 
@@ -9,11 +10,13 @@ import typer
 from rich.markup import escape
 
 from skyquill.cli.main import (
+    Altitude,
     Amax,
     AmaxAxis,
     Force,
     Jmax,
     JmaxAxis,
+    MinAltitude,
     NormSides,
     OutDir,
     Target,
@@ -22,20 +25,30 @@ from skyquill.cli.main import (
     app,
     check_out,
     console,
+    in_range,
+    min_altitude,
     positive_rate,
     say_done,
     upload_target,
     user_errors,
 )
+from skyquill.cli.pictures import NoPictures, Pictures
 from skyquill.errors import InputError
 from skyquill.io.outputs import staged_output
 from skyquill.io.plan_dir import write_plan
 from skyquill.io.points import read_points_csv
 from skyquill.io.trajectory_json import PlannedTrajectory
-from skyquill.limits import VehicleLimits
+from skyquill.limits import VehicleLimits, lifted_limits
 from skyquill.optimize.budget import lifted
 from skyquill.optimize.fit import FitOptions, PointFit, fit_points
+from skyquill.phases import DEFAULT_ALTITUDE_M, MIN_ALTITUDE_M, check_altitude
 from skyquill.validation import FloatArray
+
+#: ``--weight`` of the point deviation: beyond 1e9 the solver's conditioning, not the fit,
+#: decides (1e300 did not end).
+WEIGHT_RANGE = (0.0, 1e9)
+#: ``--tolerance``, m: more than a kilometre from the points is no fit of them.
+TOLERANCE_RANGE_M = (0.0, 1000.0)
 
 
 def fit_summary(fit: PointFit, options: FitOptions, rate: float) -> dict[str, Any]:
@@ -75,6 +88,14 @@ def fit_summary(fit: PointFit, options: FitOptions, rate: float) -> dict[str, An
     return summary if fit.budget is None else summary | {"target": fit.budget.summary()}
 
 
+@dataclass(frozen=True)
+class Flight:
+    """Where a fit is flown: a 2-D input's altitude (``None`` for 3-D), the minimum altitude."""
+
+    altitude_m: float | None = DEFAULT_ALTITUDE_M
+    min_altitude_m: float = MIN_ALTITUDE_M
+
+
 def run_fit(
     points: FloatArray,
     times: FloatArray | None,
@@ -83,30 +104,48 @@ def run_fit(
     rate: float,
     source: Path,
     force: bool = False,
+    flight: Flight | None = None,
+    pictures: bool = True,
 ) -> dict[str, Any]:
-    """Fit the points of ``source``, then write the plan directory ``out``."""
+    """Fit the points of ``source``, then write the plan directory ``out``.
+
+    2-D points are fitted in the plane and flown at ``flight.altitude_m``; 3-D ones as
+    they are. Either way the mission keeps ``flight.min_altitude_m`` (else refused).
+    ``pictures``: draw ``plot.png`` (``--no-pictures`` skips it).
+    """
     from skyquill.viz.fit_plot import plot_fit
 
+    flight = flight or Flight()
     title = source.stem
     with console.status(f"fitting {points.shape[0]} points ({escape(title)})"):
         fit = fit_points(points, times, options)
+    flat = fit.trajectory.dim == 2
+    altitude = flight.altitude_m if flat and flight.altitude_m is not None else 0.0
+    planned = PlannedTrajectory(
+        lifted(fit.trajectory, altitude),
+        limits=lifted_limits(fit.limits) if flat else fit.limits,
+    )
+    fields = fit_summary(fit, options, rate) | {"altitude_m": altitude if flat else None}
+    drawn = Pictures(pictures)
     with (
         console.status("writing and checking the plan"),
         staged_output(out, "fit", force=force, inputs=[source]) as stage,
     ):
         summary = write_plan(
             stage,
-            [PlannedTrajectory(lifted(fit.trajectory, 0.0), limits=fit.limits)],
+            [planned],
             rate=rate,
             guaranteed=True,
-            summary=fit_summary(fit, options, rate),
-            plot=lambda path: plot_fit(fit, path, title),
+            summary=fields | {"pictures": drawn.entry},
+            plot=drawn.plot(lambda path: plot_fit(fit, path, title)),
+            min_altitude_m=flight.min_altitude_m,
         )
     uploads = "" if fit.budget is None else f", {len(fit.budget.uploads)} upload(s)"
+    where = f", flown at {altitude:g} m (--altitude)" if flat else ""
     say_done(
         f"{out}: duration {summary['duration_s']:.2f} s, solve "
         f"{1e3 * summary['solve_time_s']:.1f} ms, max excess {summary['max_excess']:.1e}, "
-        f"rms deviation {1e3 * summary['rms_deviation_m']:.2f} mm{uploads}"
+        f"rms deviation {1e3 * summary['rms_deviation_m']:.2f} mm{uploads}{where}"
     )
     return summary
 
@@ -147,7 +186,10 @@ def fit(
         bool, typer.Option(help="Write the fit even if it misses the points by more.")
     ] = False,
     target: Target = None,
+    altitude: Altitude = None,
+    min_altitude_m: MinAltitude = MIN_ALTITUDE_M,
     force: Force = False,
+    no_pictures: NoPictures = False,
 ) -> None:
     """Fit a smooth trajectory to POINTS_CSV that starts and ends at rest.
 
@@ -157,6 +199,9 @@ def fit(
     """
     with user_errors():
         check_out(out)
+        in_range("--weight", weight, *WEIGHT_RANGE, "(no unit)")
+        if tolerance is not None:
+            in_range("--tolerance", tolerance, *TOLERANCE_RANGE_M, "m", open_low=True)
         options = FitOptions(
             limits=VehicleLimits(vmax, amax, jmax, vmax_axis, amax_axis, jmax_axis),
             norm_sides=norm_sides,
@@ -177,7 +222,32 @@ def fit(
             raise InputError(f"--timing: got 'given', but {points_csv.name} has no t column")
         if timing in ("path", "segments"):
             times = None
-        run_fit(points, times, options, out, positive_rate(rate), points_csv, force)
+        flight = _flight(points, altitude, min_altitude(min_altitude_m))
+        run_fit(
+            points,
+            times,
+            options,
+            out,
+            positive_rate(rate),
+            points_csv,
+            force,
+            flight,
+            not no_pictures,
+        )
+
+
+def _flight(points: FloatArray, altitude: float | None, floor: float) -> Flight:
+    """``--altitude`` for 2-D points (default :data:`DEFAULT_ALTITUDE_M`, or the minimum
+    altitude when that is higher); refused for 3-D."""
+    if points.shape[1] == 3:
+        if altitude is not None:
+            raise InputError(
+                f"--altitude: got {altitude:g} m for 3-D points (x, y, z), expected it only "
+                "with 2-D points (x, y): 3-D points are flown at their own z"
+            )
+        return Flight(None, floor)
+    chosen = max(DEFAULT_ALTITUDE_M, floor) if altitude is None else altitude
+    return Flight(check_altitude("--altitude", chosen, floor), floor)
 
 
 def _hull(name: str) -> Any:

@@ -20,6 +20,7 @@ from skyquill.cli.main import (
     say_done,
     user_errors,
 )
+from skyquill.cli.pictures import NoPictures, Pictures
 from skyquill.errors import InputError
 from skyquill.io.atomic import write_json
 from skyquill.io.outputs import staged_output
@@ -65,12 +66,14 @@ def fly(
         typer.Option(help="Fly a trajectory that does not start and end at rest (a cut-out)."),
     ] = False,
     force: Force = False,
+    no_pictures: NoPictures = False,
 ) -> None:
     """Fly every trajectory of PLAN in closed loop; write summary.json, flight.csv, plot.png."""
     import numpy as np
 
     from skyquill.io.plan_dir import plan_files, read_plan
     from skyquill.sim import Disturbances, check_rest_ends
+    from skyquill.sim.bounds import MAX_RATE_HZ, MIN_RATE_HZ
     from skyquill.validation import as_seed
 
     with user_errors():
@@ -86,7 +89,7 @@ def fly(
         for option, value, most in (("--gust", gust, MAX_WIND_MPS), ("--noise", noise, 1.0)):
             if not 0.0 <= value <= most:
                 raise InputError(f"{option}: got {value:g}, expected a number from 0 to {most:g}")
-        rate = positive_rate(rate)
+        rate = positive_rate(rate, low=MIN_RATE_HZ, high=MAX_RATE_HZ)
         seed = as_seed("--seed", seed)
         plans = read_plan(plan)
         if not allow_motion:
@@ -94,9 +97,11 @@ def fly(
                 check_rest_ends(planned.trajectory)
         disturbances = Disturbances(wind_mps=wind_mps, gust_std_mps=gust, position_noise_m=noise)
         setup = _Setup(loop, sim, disturbances, seed, rate)
+        drawn = Pictures(not no_pictures)
         with staged_output(out, "fly", force=force, inputs=plan_files(plan)) as stage:
             flights = [
-                _fly_drone(name, p.trajectory, setup, stage, len(plans) > 1) for name, p in plans
+                _fly_drone(name, p.trajectory, setup, stage, (len(plans) > 1, drawn))
+                for name, p in plans
             ]
             summary = _worst(flights) | {
                 "plan": str(plan),
@@ -106,6 +111,7 @@ def fly(
                 "position_noise_m": noise,
                 "seed": seed,
                 "drones": flights,
+                "pictures": drawn.entry,
             }
             write_json(stage / "summary.json", summary)
     say_done(
@@ -124,9 +130,13 @@ class _Setup:
 
 
 def _fly_drone(
-    name: str, trajectory: Trajectory, setup: _Setup, out: Path, several: bool
+    name: str, trajectory: Trajectory, setup: _Setup, out: Path, pictures: tuple[bool, Pictures]
 ) -> dict[str, Any]:
-    """Fly one trajectory; write its flight CSV and plot; its summary entry."""
+    """Fly one trajectory; write its flight CSV and plot; its summary entry.
+
+    ``pictures``: whether the plan has several drones (files named after each), and
+    what to draw.
+    """
     import numpy as np
 
     from skyquill.errors import SolverError
@@ -142,10 +152,12 @@ def _fly_drone(
             f"{setup.sim}: the flight of {name} diverged (non-finite state), nothing written; "
             "lower the disturbances"
         )
+    several, drawn = pictures
     suffix = f"_{name}" if several else ""
     rows = write_flight_csv(out / f"flight{suffix}.csv", flight)
-    with console.status("plotting"):
-        plot_flight(flight, out / f"plot{suffix}.png", name)
+    if drawn.drawn:
+        with console.status("plotting"), drawn.timing(f"plot{suffix}.png"):
+            plot_flight(flight, out / f"plot{suffix}.png", name)
     summary = flight.summary()
     return summary | {
         "name": name,

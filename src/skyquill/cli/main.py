@@ -10,29 +10,38 @@ with status 2; no traceback.
 from __future__ import annotations
 
 import logging
-import math
+import re
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Annotated, NoReturn
+from typing import Annotated
 
 import numpy as np
 import typer
-from rich.console import Console
 from rich.text import Text
 
+from skyquill.cli.boundary import (
+    OneLineGroup,
+    as_options,
+    console,
+    fail,
+    os_error_line,
+    progress_bar,
+    quiet_warnings,
+)
 from skyquill.colors import hex_rgb
 from skyquill.errors import InputError, SkyquillError
+from skyquill.io.numbers import parse_number
 from skyquill.io.outputs import check_folder
 from skyquill.targets import TARGETS, UploadTarget
 from skyquill.validation import FloatArray
 
 app = typer.Typer(
+    cls=OneLineGroup,
     add_completion=False,
     no_args_is_help=True,
     help="Plan smooth, limit-respecting quadrotor trajectories for aerial drawing.",
 )
-console = Console(stderr=True)
 EXAMPLES = Path(__file__).resolve().parents[3] / "examples"
 
 OutDir = Annotated[Path, typer.Option("--out", help="Output directory (created).")]
@@ -64,6 +73,21 @@ NormSides = Annotated[
         "exactly (second-order cones)."
     ),
 ]
+MinAltitude = Annotated[
+    float,
+    typer.Option(
+        "--min-altitude",
+        help="Lowest altitude of the mission above the ground, m (0 to 100): between take-off "
+        "and landing nothing is planned below it (summary.json: phases).",
+    ),
+]
+Altitude = Annotated[
+    float | None,
+    typer.Option(
+        help="Altitude a 2-D input (x, y) is flown at, m (from --min-altitude to 120; default "
+        "1, or --min-altitude if higher); refused with 3-D input, which has its own z."
+    ),
+]
 Target = Annotated[
     str | None,
     typer.Option(
@@ -71,6 +95,13 @@ Target = Annotated[
         "pieces per upload, uploads changed while hovering)."
     ),
 ]
+
+
+def min_altitude(value: float) -> float:
+    """``--min-altitude``, m, checked (:func:`skyquill.phases.check_min_altitude`)."""
+    from skyquill.phases import check_min_altitude
+
+    return check_min_altitude("--min-altitude", value)
 
 
 def upload_target(name: str | None) -> UploadTarget | None:
@@ -112,6 +143,7 @@ def main(
 ) -> None:
     """skyquill: aerial drawing and painting with quadrotors."""
     logging.basicConfig(level=logging.INFO if verbose else logging.WARNING)
+    quiet_warnings(verbose)
 
 
 @contextmanager
@@ -129,10 +161,9 @@ def user_errors() -> Iterator[None]:
     except typer.Exit:
         raise
     except SkyquillError as exc:
-        fail(str(exc))
+        fail(as_options(str(exc)))
     except OSError as exc:
-        where = f" {str(exc.filename)!r}" if exc.filename else ""
-        fail(f"cannot use{where}: {exc.strerror or exc}")
+        fail(os_error_line(exc))
     except UnicodeError as exc:
         fail(f"got text that is not UTF-8 ({exc}), expected UTF-8 text")
     except MemoryError:
@@ -147,12 +178,6 @@ def user_errors() -> Iterator[None]:
         )
 
 
-def fail(message: str, status: int = 2) -> NoReturn:
-    """Print ``error: message`` as one literal line on stderr and exit with ``status``."""
-    console.print(Text("error: ", style="bold red") + Text(message), soft_wrap=True)
-    raise typer.Exit(status)
-
-
 @contextmanager
 def stage_progress() -> Iterator[Callable[[int, int, str], None]]:
     """A rich bar fed by a planner's ``progress(done, total, stage)`` callback.
@@ -160,15 +185,13 @@ def stage_progress() -> Iterator[Callable[[int, int, str], None]]:
     The planners of several drones (``write``, ``show``) report each step as it is done;
     the bar shows the stage, how many of how many, and the time so far.
     """
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+    from rich.progress import BarColumn, MofNCompleteColumn, TextColumn, TimeElapsedColumn
 
-    with Progress(
+    with progress_bar(
         TextColumn("{task.description}"),
         BarColumn(),
         MofNCompleteColumn(),
         TimeElapsedColumn(),
-        console=console,
-        transient=True,
     ) as bar:
         task = bar.add_task("planning", total=None)
 
@@ -188,21 +211,45 @@ def check_out(out: Path) -> None:
     check_folder(out, "--out")
 
 
-def positive_rate(rate: float) -> float:
-    """``--rate`` (Hz), checked to be a positive number."""
-    if not rate > 0:
-        raise InputError(f"--rate: got {rate:g}, expected a positive number of Hz")
+#: Sample rates of the files commands write (trajectory.csv, setpoints, exports), Hz: below
+#: 1 Hz a sample every second or more no longer follows a drawing's strokes; above 10 kHz
+#: only the file grows (the samples-written ceiling bounds it too).
+SAMPLE_RATE_HZ = (1.0, 10_000.0)
+
+
+def positive_rate(
+    rate: float,
+    option: str = "--rate",
+    low: float = SAMPLE_RATE_HZ[0],
+    high: float = SAMPLE_RATE_HZ[1],
+) -> float:
+    """``--rate`` (Hz), checked against ``[low, high]`` (NaN fails too)."""
+    if not low <= rate <= high:
+        raise InputError(f"{option}: got {rate:g}, expected {low:g} to {high:g} Hz")
     return rate
+
+
+def in_range(
+    option: str, value: float, low: float, high: float, unit: str, *, open_low: bool = False
+) -> float:
+    """``value`` of ``option`` within ``[low, high]`` (``(low, high]`` with ``open_low``).
+
+    NaN fails too. Every option a command takes is checked so at the entry, against
+    the range docs/ceilings.md states, before any work starts.
+    """
+    if not (low < value <= high if open_low else low <= value <= high):
+        bracket = "more than" if open_low else "from"
+        raise InputError(f"{option}: got {value:g}, expected {bracket} {low:g} to {high:g} {unit}")
+    return value
 
 
 def parse_vector3(option: str, text: str, unit: str) -> FloatArray:
     """Parse ``"x,y,z"`` into a (3,) float array; InputError naming ``option`` otherwise."""
-    parts = [p.strip() for p in text.split(",")]
     try:
-        values = [float(p) for p in parts]
+        values = [parse_number(p) for p in text.split(",")]
     except ValueError:
         values = []
-    if len(values) != 3 or not all(math.isfinite(v) for v in values):
+    if len(values) != 3:
         raise InputError(
             f"{option}: got {text!r}, expected three comma-separated finite numbers in {unit}, "
             "e.g. 2,0,0"
@@ -210,10 +257,34 @@ def parse_vector3(option: str, text: str, unit: str) -> FloatArray:
     return np.array(values)
 
 
+#: A dask.distributed scheduler address: ``local``, ``tcp://host:port`` (or tls, ws, wss,
+#: ucx, inproc) or ``host:port``.
+_SCHEDULER = re.compile(
+    r"local|(?:(?:tcp|tls|ws|wss|ucx|inproc)://)?[A-Za-z0-9._\-\[\]:]+(?::[0-9]{1,5})?", re.ASCII
+)
+
+
+def scheduler_address(text: str | None) -> str | None:
+    """``--scheduler``, checked to look like an address before dask is asked to reach it."""
+    if text is None:
+        return None
+    if not _SCHEDULER.fullmatch(text) or (
+        "://" not in text and text != "local" and ":" not in text
+    ):
+        raise InputError(
+            f"--scheduler: got {text!r}, expected 'local' or a dask scheduler address such as "
+            "tcp://10.0.0.5:8786"
+        )
+    return text
+
+
+_BYTE = re.compile(r"\s*[0-9]{1,3}\s*", re.ASCII)
+
+
 def parse_color(flag: str, text: str) -> tuple[int, int, int]:
     """A light colour given as ``R,G,B`` (integers 0..255) or ``#RRGGBB``; errors name ``flag``."""
     parts = text.split(",")
-    if len(parts) == 3 and all(p.strip().isdigit() and int(p) <= 255 for p in parts):
+    if len(parts) == 3 and all(_BYTE.fullmatch(p) and int(p) <= 255 for p in parts):
         return (int(parts[0]), int(parts[1]), int(parts[2]))
     rgb = hex_rgb(text[1:]) if text.startswith("#") else None
     if rgb is not None:
@@ -242,12 +313,15 @@ from skyquill.cli import (  # noqa: E402
 __all__ = [
     "app",
     "check_cmd",
+    "console",
     "cover_cmd",
     "export_cmd",
+    "fail",
     "fit_cmd",
     "fly_cmd",
     "hanzi_cmd",
     "paint_cmd",
+    "progress_bar",
     "render_cmd",
     "reproduce_cmd",
     "show_cmd",

@@ -16,15 +16,22 @@ import typer
 
 from skyquill.cli.main import (
     Force,
+    MinAltitude,
     OutDir,
     app,
     check_out,
     console,
+    in_range,
+    min_altitude,
     parse_vector3,
+    positive_rate,
+    progress_bar,
     say_done,
     user_errors,
 )
+from skyquill.cli.pictures import NoPictures, Pictures
 from skyquill.errors import InputError
+from skyquill.phases import MIN_ALTITUDE_M
 
 if TYPE_CHECKING:  # the painting package is imported lazily
     from rich.progress import Progress
@@ -35,6 +42,10 @@ if TYPE_CHECKING:  # the painting package is imported lazily
 
 #: Largest |gamma| accepted, deg: beyond it the drone does not face the wall.
 MAX_GAMMA_DEG = 60.0
+#: Widest probing pass spacing, m (wider is one probe at each end of any drawing).
+MAX_PROBE_SPACING_M = 10.0
+#: Largest ``--width`` of a stippled drawing, m.
+MAX_WIDTH_M = 20.0
 
 
 @app.command()
@@ -54,13 +65,40 @@ def paint(
         str, typer.Option(help="True placement offset delta x,y,z in the wall frame, m.")
     ] = "0,-1.1,0",
     wall_angles: Annotated[
-        str, typer.Option(help="Segment angles left to right, deg, e.g. -10,0,10 (0: flat).")
+        str,
+        typer.Option(
+            help="Segment angles left to right, deg, e.g. -10,0,10 (0: flat), splitting the "
+            "drawing's width equally."
+        ),
     ] = "0",
-    estimator: Annotated[str, typer.Option(help="none, svd or robust.")] = "svd",
+    wall: Annotated[
+        Path | None,
+        typer.Option(
+            help="The wall from a TOML file instead: [[segment]]s, a [cylinder] or a [recess] "
+            "(docs/wall-painting-estimation.md)."
+        ),
+    ] = None,
+    estimator: Annotated[
+        str,
+        typer.Option(
+            help="joint (placement and wall shape together), or paper 002's none, svd, robust."
+        ),
+    ] = "joint",
     localization: Annotated[str, typer.Option(help="onboard or truth.")] = "onboard",
-    order: Annotated[str, typer.Option(help="given, paper (right-left, top-bottom), shortest.")] = (
-        "given"
-    ),
+    order: Annotated[
+        str,
+        typer.Option(
+            help="shortest (a short tour), spread (first dots far apart), paper (right-left, "
+            "top-bottom) or given."
+        ),
+    ] = "shortest",
+    probe_spacing: Annotated[
+        float,
+        typer.Option(
+            help="joint: touch the wall without painting every this many m across the drawing "
+            "before the first dot (0: no probing pass)."
+        ),
+    ] = 0.4,
     update: Annotated[
         str, typer.Option(help="Segmented walls: depth (eq. 15) or normal (fresco).")
     ] = "depth",
@@ -71,7 +109,10 @@ def paint(
         float, typer.Option(help="Probability of a missed contact per approach.")
     ] = 0.0,
     seed: Annotated[int, typer.Option(help="Seed of the random generator.")] = 0,
+    rate: Annotated[float, typer.Option(help="Sample rate of trajectory.csv, Hz.")] = 100.0,
+    min_altitude_m: MinAltitude = MIN_ALTITUDE_M,
     force: Force = False,
+    no_pictures: NoPictures = False,
 ) -> None:
     """Paint DOTS.csv (or a stippled --image) on a wall; write summary.json, painted.csv, plot."""
     import numpy as np
@@ -79,23 +120,22 @@ def paint(
     from skyquill.io.outputs import staged_output
     from skyquill.io.plan_dir import write_plan
     from skyquill.io.trajectory_json import PlannedTrajectory
-    from skyquill.painting.dots import drawing_span
+    from skyquill.painting.dots import MAX_DOTS, drawing_span
     from skyquill.painting.flight import painting_flight
-    from skyquill.painting.mission import ESTIMATORS, MissionConfig, run_mission
-    from skyquill.painting.order import ORDERS
+    from skyquill.painting.mission import MissionConfig, check_on_wall, run_mission
     from skyquill.painting.wall import Placement, Wall, parse_angles
-    from skyquill.validation import as_seed
+    from skyquill.painting.wall_file import read_wall
+    from skyquill.validation import as_int, as_seed
     from skyquill.viz.painting_plot import plot_mission
 
     with user_errors():
         check_out(out)
+        floor = min_altitude(min_altitude_m)
         seed = as_seed("--seed", seed)
-        if estimator not in ESTIMATORS:
-            raise InputError(
-                f"--estimator: got {estimator!r}, expected one of {', '.join(ESTIMATORS)}"
-            )
-        if order not in ORDERS:
-            raise InputError(f"--order: got {order!r}, expected one of {', '.join(ORDERS)}")
+        positive_rate(rate)  # a long painting needs a lower one: trajectory.csv has a ceiling
+        as_int("--dots", dots, low=1, high=MAX_DOTS)  # checked with a CSV too: never ignored
+        in_range("--width", width, 0.0, MAX_WIDTH_M, "m", open_low=True)
+        _check_choices(estimator, order, false_contacts, missed_contacts)
         update_mode = _update(update)
         if not -MAX_GAMMA_DEG <= gamma <= MAX_GAMMA_DEG:
             raise InputError(
@@ -109,68 +149,115 @@ def paint(
                 "-20 <= y < 0 m and every component within 20 m"
             )
         angles = parse_angles(wall_angles)
-        for option, rate in (
-            ("--false-contacts", false_contacts),
-            ("--missed-contacts", missed_contacts),
-        ):
-            if not 0.0 <= rate < 1.0:
-                raise InputError(f"{option}: got {rate:g}, expected a probability in [0, 1)")
+        if wall is not None and wall_angles != "0":
+            raise InputError(
+                f"--wall / --wall-angles: got both ({wall.name}, {wall_angles!r}), expected one"
+            )
+        if not (math.isfinite(probe_spacing) and 0.0 <= probe_spacing <= MAX_PROBE_SPACING_M):
+            raise InputError(
+                f"--probe-spacing: got {probe_spacing:g}, expected 0 (no probing pass) to "
+                f"{MAX_PROBE_SPACING_M:g} m"
+            )
+        surface = None if wall is None else read_wall(wall)
         with _progress() as bar:
             points = _dots(dots_csv, image, dots, width, seed, bar)
-            lo, hi = drawing_span(points)
-            wall = Wall.segmented(angles, (lo, hi))
+            if surface is None:
+                surface = Wall.segmented(angles, drawing_span(points))
+            check_on_wall(
+                points,
+                surface,
+                name=str(dots_csv.name if dots_csv else "--image"),
+                wall_name=wall.name if wall else "--wall-angles",
+            )
             task = bar.add_task("painting", total=None)
             result = run_mission(
                 points,
-                wall=wall,
+                wall=surface,
                 truth=Placement(delta, math.radians(gamma)),
                 estimator=estimator,
                 localization=localization,
                 order=order,
                 update=update_mode,
                 config=MissionConfig(
-                    false_contact_rate=false_contacts, missed_contact_rate=missed_contacts
+                    false_contact_rate=false_contacts,
+                    missed_contact_rate=missed_contacts,
+                    probe_spacing_m=probe_spacing,
                 ),
                 rng=np.random.default_rng(seed),
                 progress=lambda done, total: bar.update(task, completed=done, total=total),
             )
-        inputs = [p for p in (dots_csv, image) if p is not None]
+        inputs = [p for p in (dots_csv, image, wall) if p is not None]
         with (
             console.status("timing the flight's legs, writing and checking the plan"),
             staged_output(out, "paint", force=force, inputs=inputs) as stage,
         ):
             _write_painted(stage / "painted.csv", result)
             flown = painting_flight(result)
+            drawn = Pictures(not no_pictures)
+            name = (dots_csv or image or Path("")).name
             write_plan(
                 stage,
                 [PlannedTrajectory(flown.trajectory, flown.pen_windows_s, flown.limits)],
-                rate=100.0,
+                rate=rate,
                 guaranteed=True,
                 summary=result.summary()
                 | {
                     "source": str(dots_csv or image),
+                    "wall": str(wall) if wall else f"--wall-angles {wall_angles}",
                     "seed": seed,
                     "order": order,
                     "gamma_deg": gamma,
                     "offset_m": [float(v) for v in delta],
                     "trajectory_duration_s": flown.trajectory.duration,
+                    "pictures": drawn.entry,
                 },
-                plot=lambda path: plot_mission(result, path, (dots_csv or image or Path("")).name),
+                plot=drawn.plot(lambda path: plot_mission(result, path, name)),
+                min_altitude_m=floor,
             )
     say_done(
         f"{out}: {result.painted.sum()} of {len(result.reference)} dots, RMSE "
         f"{100 * result.rmse_m:.2f} cm, max {100 * result.max_error_m:.2f} cm, "
-        f"{result.flight_time_s / 60:.1f} min, {result.landings} landing(s)"
+        f"{result.flight_time_s / 60:.1f} min ({result.battery_use:.1f} batteries), "
+        f"{result.landings} landing(s)" + _wall_note(result)
+    )
+
+
+def _wall_note(result: MissionResult) -> str:
+    """What the joint estimator says of the wall, when it does not fit its model."""
+    fit = result.wall_fit
+    if fit is None or fit.fits:
+        return ""
+    return (
+        f"; the wall does not fit the plane-pieces model ({fit.pieces} pieces, "
+        f"{100 * fit.residual_m:.1f} cm off, {fit.outliers} contacts dropped): the painting "
+        "follows the closest model"
     )
 
 
 def _progress() -> Progress:
     """A rich progress bar on stderr (the console the CLI prints to)."""
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn
+    from rich.progress import BarColumn, MofNCompleteColumn, TextColumn
 
-    return Progress(
-        TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), console=console
-    )
+    return progress_bar(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn())
+
+
+def _check_choices(
+    estimator: str, order: str, false_contacts: float, missed_contacts: float
+) -> None:
+    """Refuse an unknown ``--estimator`` or ``--order``, or a contact chance outside [0, 1)."""
+    from skyquill.painting.mission import ESTIMATORS
+    from skyquill.painting.order import ORDERS
+
+    if estimator not in ESTIMATORS:
+        raise InputError(f"--estimator: got {estimator!r}, expected one of {', '.join(ESTIMATORS)}")
+    if order not in ORDERS:
+        raise InputError(f"--order: got {order!r}, expected one of {', '.join(ORDERS)}")
+    for option, chance in (
+        ("--false-contacts", false_contacts),
+        ("--missed-contacts", missed_contacts),
+    ):
+        if not 0.0 <= chance < 1.0:
+            raise InputError(f"{option}: got {chance:g}, expected a probability in [0, 1)")
 
 
 def _update(name: str) -> UpdateMode:
@@ -195,8 +282,6 @@ def _dots(
         )
     if dots_csv is not None:
         return read_dots_csv(dots_csv)
-    if not (math.isfinite(width) and 0.0 < width <= 20.0):
-        raise InputError(f"--width: got {width:g}, expected a width in (0, 20] m")
     assert image is not None  # narrowed by the check above
     darkness = load_darkness(image)
     task = bar.add_task("stippling", total=None)

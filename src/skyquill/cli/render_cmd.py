@@ -53,6 +53,8 @@ def render(
         check_out(out)
         if not paths:
             raise InputError("PATH: got none, expected a plan directory or a trajectory .json")
+        if not -360.0 <= azimuth <= 360.0:  # NaN fails too
+            raise InputError(f"--azimuth: got {azimuth:g}, expected -360 to 360 degrees")
         if math.isnan(trail) or trail < 0:
             raise InputError(f"--trail: got {trail:g}, expected a number of seconds >= 0 or inf")
         view = View(azimuth, elevation, fov)

@@ -7,6 +7,7 @@ from typing import Annotated, Any
 
 import typer
 
+from skyquill.cli.boundary import OneLineGroup
 from skyquill.cli.main import (
     EXAMPLES,
     Force,
@@ -14,12 +15,15 @@ from skyquill.cli.main import (
     app,
     check_out,
     console,
+    progress_bar,
     say_done,
     user_errors,
 )
 from skyquill.io.outputs import staged_output
 
-reproduce_app = typer.Typer(no_args_is_help=True, help="Reproduce the papers' experiments.")
+reproduce_app = typer.Typer(
+    cls=OneLineGroup, no_args_is_help=True, help="Reproduce the papers' experiments."
+)
 app.add_typer(reproduce_app, name="reproduce")
 
 
@@ -31,15 +35,13 @@ def reproduce_corridor(
     force: Force = False,
 ) -> None:
     """Paper 003 §5.4 (Fig. 10): coupled vs decoupled limits in a 7-box S corridor."""
-    from rich.progress import Progress
-
     from skyquill.reproduce.corridor import run_corridor_study
 
     with user_errors():
         check_out(out)
     with (
         user_errors(),
-        Progress(console=console, transient=True) as progress,
+        progress_bar() as progress,
         staged_output(out, "reproduce corridor", force=force, inputs=[corridor]) as stage,
     ):
         task = progress.add_task("control-point counts", total=None)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import time
+from dataclasses import replace
 from pathlib import Path
 from typing import Annotated, Any
 
@@ -10,19 +11,25 @@ import typer
 
 from skyquill.cli.main import (
     Force,
+    MinAltitude,
     OutDir,
     app,
     check_out,
     console,
+    min_altitude,
     say_done,
+    scheduler_address,
     stage_progress,
     user_errors,
 )
+from skyquill.cli.pictures import NoPictures, Pictures
 from skyquill.errors import InfeasibleError, InputError
 from skyquill.io.atomic import write_json
 from skyquill.io.outputs import staged_output
 from skyquill.io.plan_dir import trajectory_names, write_plan
+from skyquill.io.points import check_rows_written
 from skyquill.io.trajectory_json import PlannedTrajectory
+from skyquill.phases import MIN_ALTITUDE_M
 from skyquill.show import ShowDrone, ShowLimits, ShowReport, check_show, load_show
 from skyquill.show.build import ShowPlan, build_show
 from skyquill.show.script import ShowScript, load_script
@@ -30,6 +37,8 @@ from skyquill.show.script import ShowScript, load_script
 #: Relative round-off allowed over the planned limits in the independent check
 #: (Ruckig's profiles touch the limits exactly; the writing QP holds them to its tolerance).
 CHECK_ROUND_OFF = 1e-6
+#: Most ``--workers`` (processes planning the writing): more than any machine's cores is a typo.
+MAX_WORKERS = 256
 
 
 @app.command()
@@ -43,7 +52,9 @@ def show(
         str | None,
         typer.Option(help="dask.distributed scheduler address (or 'local') for the writing."),
     ] = None,
+    min_altitude_m: MinAltitude = MIN_ALTITUDE_M,
     force: Force = False,
+    no_pictures: NoPictures = False,
 ) -> None:
     """Plan a show script: formations, transitions, writing, take-off and landing.
 
@@ -53,8 +64,10 @@ def show(
     """
     with user_errors():
         check_out(out)
-        if workers is not None and workers < 1:
-            raise InputError(f"--workers: got {workers}, expected at least 1")
+        floor = min_altitude(min_altitude_m)
+        if workers is not None and not 1 <= workers <= MAX_WORKERS:
+            raise InputError(f"--workers: got {workers}, expected 1 to {MAX_WORKERS}")
+        scheduler = scheduler_address(scheduler)
         show_script = load_script(script)
         stages: dict[str, float] = {}
         plan = _plan(show_script, workers, scheduler)
@@ -63,11 +76,14 @@ def show(
             report = _check(plan, show_script)
         stages["check"] = time.perf_counter() - clock
         with staged_output(out, "show", force=force, inputs=[script]) as stage:
-            summary = _write(stage, plan, show_script, report, stages)
+            drawn = Pictures(not no_pictures)
+            summary = _write(stage, plan, show_script, report, stages, drawn, floor)
     say_done(
         f"{out}: {summary['drones']} drones, {summary['duration_s']:.1f} s, no two closer than "
         f"{summary['min_separation_m']['guaranteed']:.3f} m (guaranteed; "
-        f"{show_script.safety_m:g} m asked), in {sum(summary['planning_time_s'].values()):.1f} s"
+        f"{show_script.safety_m:g} m asked); show.skyc as Skybrush plays it: "
+        f"{summary['skyc']['as_played']['verdict']} (skyc.as_played in summary.json), in "
+        f"{sum(summary['planning_time_s'].values()):.1f} s"
     )
 
 
@@ -118,6 +134,8 @@ def _write(
     script: ShowScript,
     report: ShowReport,
     stages: dict[str, float],
+    drawn: Pictures,
+    min_altitude_m: float,
 ) -> dict[str, Any]:
     from skyquill.viz.light_painting import write_pictures
 
@@ -129,9 +147,10 @@ def _write(
     clock = time.perf_counter()
     studio = _studio_csv(stage, plans, script)
     stages["skybrush_csv"] = time.perf_counter() - clock
-    clock = time.perf_counter()
-    pictures = write_pictures(plan.drones, stage)
-    stages["pictures"] = time.perf_counter() - clock
+    if drawn.drawn:
+        with drawn.timing("long_exposure.png", "preview.gif"):
+            drawn.entry |= write_pictures(plan.drones, stage)
+    stages["pictures"] = drawn.entry["time_s"]
     sep = report.separation
     summary = {
         "command": "show",
@@ -159,10 +178,19 @@ def _write(
         ],
         "skyc": skyc,
         "skybrush_csv": studio,
-        "pictures": pictures,
+        "pictures": drawn.entry,
     }
     clock = time.perf_counter()
-    full = write_plan(stage, plan.drones, rate=script.rate_hz, guaranteed=True, summary=summary)
+    for drone in plan.drones:  # the script's rate, named as written there (show has no --rate)
+        check_rows_written(drone.trajectory.duration, script.rate_hz, "[show].rate")
+    full = write_plan(
+        stage,
+        plan.drones,
+        rate=script.rate_hz,
+        guaranteed=True,
+        summary=summary,
+        min_altitude_m=min_altitude_m,
+    )
     full["planning_time_s"]["files"] = time.perf_counter() - clock
     write_json(stage / "summary.json", full)
     return full
@@ -189,34 +217,39 @@ def _skyc(
 ) -> dict[str, Any]:
     """Write ``show.skyc``, load it back as the drones play it and check it again.
 
-    Skybrush stores whole millimetres and milliseconds, so the show as played is up to
-    the export's ``max_error_m`` from the plan: its guaranteed separation is checked
-    against the safety distance less twice that (two drones), and the show is refused
-    below it. Its speeds and acceleration are reported, not refused: the rounding can
-    cross a limit the plan touches (``limits`` says by how much).
+    Skybrush stores whole millimetres and milliseconds. The exporter already keeps every
+    drone's played speed and acceleration within 1 % of the script's limits and its jerk
+    within 5 % (refitting, or refusing). Here the whole show as played goes through
+    ``skyquill check`` again: its guaranteed separation against the safety distance less
+    twice the export's ``max_error_m`` (two drones, each up to that far from its plan), its
+    speeds and acceleration against the script's limits with that 1 % (``--tolerance
+    0.01``); a show that fails either is refused.
     """
-    from skyquill.export.base import ExportOptions
+    from skyquill.export.base import ALLOWED_EXCESS, ExportOptions
     from skyquill.export.skybrush.skyc_exporter import SkycExporter
 
     exported = SkycExporter()(plans, stage / "show", ExportOptions())
     played = load_show([stage / "show.skyc"])
     allowed = max(0.0, script.safety_m - 2.0 * exported.max_error_m)
-    back = check_show(played, allowed, check_limits(script))
-    if not back.separation.passed:
-        e = back.separation.encounters[0]
+    limits = replace(check_limits(script), tolerance=ALLOWED_EXCESS[2])
+    back = check_show(played, allowed, limits)
+    if not back.passed:
+        v = back.violations[0]
         raise InfeasibleError(
-            f"show.skyc: as Skybrush plays it, {played[e.drones[0]].name} and "
-            f"{played[e.drones[1]].name} come within {e.closest_m:.4f} m at "
-            f"t = {e.closest_time_s:.2f} s, expected at least {allowed:.4f} m",
-            ("separation",),
+            f"show.skyc: as Skybrush plays it, {v.check} of {', '.join(v.drones)} at "
+            f"t = {v.first_time_s:.2f} s is {v.worst:.4g}, expected within {v.limit:.4g}"
+            + (" (1 % allowed over the limits)" if v.check != "separation" else ""),
+            (v.check,),
         )
     return {
         "file": "show.skyc",
         "message": exported.message,
         "details": exported.details,
+        "as_played": exported.as_played.as_dict(),
         "played_back": {
             "guaranteed_separation_m": back.separation.lower_bound_m,
             "checked_against_m": allowed,
+            "tolerance": limits.tolerance,
             "check": back.as_dict(),
         },
     }

@@ -5,6 +5,7 @@ from __future__ import annotations
 import dataclasses
 import inspect
 import math
+import re
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any
@@ -18,6 +19,7 @@ from skyquill.cli.main import (
     Force,
     Jmax,
     JmaxAxis,
+    MinAltitude,
     NormSides,
     OutDir,
     Target,
@@ -26,13 +28,17 @@ from skyquill.cli.main import (
     app,
     check_out,
     console,
+    in_range,
+    min_altitude,
     parse_color,
     positive_rate,
     say_done,
+    scheduler_address,
     stage_progress,
     upload_target,
     user_errors,
 )
+from skyquill.cli.pictures import NoPictures, Pictures
 from skyquill.colors import RGB
 from skyquill.errors import InputError
 from skyquill.io.atomic import atomic_path, write_json
@@ -40,7 +46,11 @@ from skyquill.io.outputs import staged_output
 from skyquill.io.plan_dir import trajectory_names, write_plan
 from skyquill.io.trajectory_json import PlannedTrajectory
 from skyquill.limits import VehicleLimits
+from skyquill.phases import MIN_ALTITUDE_M
 from skyquill.show.lights import COLOR_BY, window_palette
+
+#: ``--separation`` between drones, m: more than 100 m apart is no show of one drawing.
+SEPARATION_RANGE_M = (0.0, 100.0)
 
 if TYPE_CHECKING:
     from skyquill.calligraphy.board import BoardKind
@@ -219,18 +229,28 @@ def write(
         str, typer.Option(help="drone (each drone the next colour) or stroke (each stroke).")
     ] = "drone",
     target: Target = None,
+    min_altitude_m: MinAltitude = MIN_ALTITUDE_M,
     force: Force = False,
+    no_pictures: NoPictures = False,
 ) -> None:
     """Plan pen-up / pen-down writing flights; write CSVs, input_strokes.json, plot, summary.
+
+    Each drone's mission starts and ends hovering at --min-altitude above its home (the
+    vehicle takes off to it and lands from it); nothing between is planned below it.
 
     On a sky board (light painting) also long_exposure.png, the photograph of the lights
     from in front, and preview.gif (``skyquill render`` shows them from any view).
     """
+    from skyquill.calligraphy.mission import MAX_ALTITUDE_M
     from skyquill.calligraphy.show import MAX_DRONES, plan_show
 
     with user_errors():
         check_out(out)
         rate = positive_rate(rate)
+        floor = min_altitude(min_altitude_m)
+        scheduler = scheduler_address(scheduler)
+        in_range("--board-height", board_height, 0.0, MAX_ALTITUDE_M, "m", open_low=True)
+        in_range("--separation", separation, *SEPARATION_RANGE_M, "m", open_low=True)
         palette = _palette(light_color, color_by)
         kind = _board_kind(board, fly)
         pose = _sky_pose(kind, board_yaw, board_tilt, plane_weight, grid, lift)
@@ -272,10 +292,19 @@ def write(
                 board_tilt_deg=pose.tilt_deg,
                 grid=pose.grid,
                 places=places.places if sharing.split else None,
+                home_altitude_m=floor,
             )
         inputs = [p for p in (strokes, svg, hanzi) if p is not None]
         summary = write_outputs(
-            show, out, rate, force=force, inputs=inputs, extra=extra(show), palette=palette
+            show,
+            out,
+            rate,
+            force=force,
+            inputs=inputs,
+            extra=extra(show),
+            palette=palette,
+            min_altitude_m=floor,
+            pictures=not no_pictures,
         )
     say_done(
         f"{out}: {summary['duration_s']:.1f} s of flight, planned in "
@@ -359,14 +388,24 @@ def _sky_pose(
     return _Pose(yaw, tilt, None if grid is None else _grid(grid))
 
 
+_DIGITS = re.compile(r"[0-9]{1,6}", re.ASCII)
+
+
 def _grid(text: str) -> tuple[int, int]:
     """``"4x5"`` to ``(4, 5)``."""
     rows, sep, columns = text.lower().partition("x")
-    if not (sep and rows.strip().isdigit() and columns.strip().isdigit()):
+    if not (sep and _DIGITS.fullmatch(rows.strip()) and _DIGITS.fullmatch(columns.strip())):
         raise InputError(f"--grid: got {text!r}, expected ROWSxCOLUMNS, e.g. 4x5")
+    from skyquill.calligraphy.show import MAX_DRONES
+
     shape = int(rows), int(columns)
     if min(shape) < 1:
         raise InputError(f"--grid: got {text!r}, expected at least one row and one column")
+    if shape[0] * shape[1] > MAX_DRONES:
+        raise InputError(
+            f"--grid: got {text!r} ({shape[0] * shape[1]:,} boards), expected at most "
+            f"{MAX_DRONES} boards, one per drone (rows x columns <= {MAX_DRONES})"
+        )
     return shape
 
 
@@ -465,8 +504,13 @@ def write_outputs(
     inputs: Sequence[Path] = (),
     extra: dict[str, Any] | None = None,
     palette: tuple[Sequence[RGB], str] | None = None,
+    min_altitude_m: float = MIN_ALTITUDE_M,
+    pictures: bool = True,
 ) -> dict[str, Any]:
     """The plan directory: trajectories, ``input_strokes.json``, ``plot.png``, ``summary.json``.
+
+    ``pictures``: draw them (``--no-pictures`` skips every picture; ``summary.json``'s
+    ``pictures`` says which were drawn and how long they took).
 
     ``extra``: more top-level sections of ``summary.json`` (``--split``'s balance).
     ``palette``: the light colours and how they are given out (``"drone"`` or
@@ -506,10 +550,13 @@ def write_outputs(
         "first_stroke_of_drone": firsts,
     }
     closest = show.min_separation_m if len(missions) > 1 else None
+    drawn = Pictures(pictures)
     with staged_output(out, "write", force=force, inputs=inputs) as stage:
         write_json(stage / "input_strokes.json", payload, indent=None)
-        _write_ink_pictures(stage, inks)
-        pictures = _light_pictures(stage, missions, planned)
+        if drawn.drawn:
+            with drawn.timing(*inks):
+                _write_ink_pictures(stage, inks)
+            _light_pictures(stage, missions, planned, drawn)
         return write_plan(
             stage,
             planned,
@@ -520,10 +567,11 @@ def write_outputs(
                 "vehicle_limits": missions[0].options.limits.as_dict(),
                 "min_separation_m": closest,
                 "drones": per_drone,
+                "pictures": drawn.entry,
             }
-            | pictures
             | (extra or {}),
-            plot=lambda path: plot_missions(missions, path, "skyquill write"),
+            plot=drawn.plot(lambda path: plot_missions(missions, path, "skyquill write")),
+            min_altitude_m=min_altitude_m,
         )
 
 
@@ -546,15 +594,16 @@ def _window_colors(
 
 
 def _light_pictures(
-    stage: Path, missions: Sequence[Any], planned: Sequence[PlannedTrajectory]
-) -> dict[str, Any]:
+    stage: Path, missions: Sequence[Any], planned: Sequence[PlannedTrajectory], drawn: Pictures
+) -> None:
     """Light painting (sky boards): the long exposure and the preview; else nothing."""
     if missions[0].board.kind != "sky":
-        return {}
+        return
     from skyquill.viz.light_painting import write_pictures
 
     # The preview keeps every light on screen: it builds up the photograph.
-    return {"pictures": write_pictures(planned, stage, trail_s=math.inf)}
+    with drawn.timing("long_exposure.png", "preview.gif"):
+        drawn.entry |= write_pictures(planned, stage, trail_s=math.inf)
 
 
 def _ink_fidelity(mission: Any, flight: Any) -> InkFidelity | None:

@@ -32,7 +32,7 @@ from shapely.geometry import Polygon
 
 from skyquill.coverage.regions import MAX_COORDINATE_M, load_region
 from skyquill.errors import InputError
-from skyquill.io.json_read import check_depth, parse_json
+from skyquill.io.json_read import check_depth, read_json_file
 from skyquill.validation import FloatArray, as_float
 
 #: The ``crs`` values that mean "the positions are local metres already".
@@ -381,7 +381,7 @@ def plan_frame(plan: Path) -> GeoFrame | None:
     summary = plan / "summary.json" if plan.is_dir() else None
     if summary is None or not summary.is_file():
         return None
-    data = parse_json(summary.read_bytes(), str(summary), "skyquill's summary.json")
+    data = read_json_file(summary, "skyquill's summary.json")  # a regular file, strictly
     geo = data.get("geo") if isinstance(data, dict) else None
     if not isinstance(geo, dict) or geo.get("origin") is None:
         return None

@@ -11,6 +11,7 @@ a disc of the coverage diameter (issue 5's metric).
 from __future__ import annotations
 
 import itertools
+import re
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any, TypeAlias
@@ -21,7 +22,9 @@ from shapely.geometry import LineString, MultiPolygon, Polygon, shape
 from shapely.geometry.base import BaseGeometry
 
 from skyquill.errors import InputError
-from skyquill.io.json_read import check_depth, decode_utf8, parse_json
+from skyquill.io.json_read import check_depth, parse_json
+from skyquill.io.numbers import NUMBER, is_number
+from skyquill.io.source import decode_text, read_bytes
 from skyquill.validation import FloatArray, as_array, as_float
 
 #: Region coordinates beyond this (m) are refused: a local metric frame, not degrees or mm.
@@ -93,31 +96,61 @@ def load_region(source: str | Path, project: Callable[[Any, str], Any] | None = 
         Naming the file (or ``region``) and what is wrong.
     """
     text = str(source)
-    if text.lstrip().upper().startswith(("POLYGON", "MULTIPOLYGON")):
+    # A file called polygon_field.geojson is a file, not WKT text.
+    if _WKT_TEXT.match(text) and not _names_a_file(text):
         return _from_wkt(text, "region")
     path = Path(text)
-    try:
-        is_file = path.is_file()
-    except OSError:  # a name too long for the file system is no file
-        is_file = False
-    if not is_file:
+    if not _names_a_file(text):
         raise InputError(
             f"region: got {_shown(text)!r}, expected an existing GeoJSON or WKT file or a WKT "
             "string"
         )
-    size = path.stat().st_size
-    if size > MAX_BYTES:
-        raise InputError(
-            f"{path.name}: got {size:,} bytes, expected a region of at most {MAX_BYTES:,}"
-        )
-    raw = path.read_bytes()
+    raw = read_bytes(path, "a region", max_bytes=MAX_BYTES, name=path.name)
     if path.suffix.lower() == ".wkt":
-        return _from_wkt(decode_utf8(raw, path.name, "a WKT POLYGON"), path.name)
+        return _from_wkt(decode_text(raw, path.name, "a WKT POLYGON"), path.name)
     data = parse_json(raw, path.name, _WHAT)
     return _from_geojson(data if project is None else project(data, path.name), path.name)
 
 
+#: WKT text given in place of a file: ``POLYGON ((...``, ``MULTIPOLYGON Z EMPTY``.
+_WKT_TEXT = re.compile(r"\s*(MULTI)?POLYGON\s*(ZM|Z|M)?\s*(\(|EMPTY)", re.IGNORECASE)
+
+
+def _names_a_file(text: str) -> bool:
+    """Whether ``text`` is the path of something that exists (a name too long is no file)."""
+    try:
+        return Path(text).exists()
+    except (OSError, ValueError):
+        return False
+
+
+#: What WKT text may hold: words (POLYGON, EMPTY, Z), brackets, commas, spaces, numbers.
+_WKT_TOKEN = re.compile(rf"\s+|[A-Za-z]+|[(),]|{NUMBER}", re.ASCII)
+
+
+def check_wkt_numbers(text: str, name: str) -> None:
+    """Refuse WKT numbers that are not plain decimals (GEOS reads ``nan``, ``1e999``, ...)."""
+    at = 0
+    while at < len(text):
+        match = _WKT_TOKEN.match(text, at)
+        word = match.group(0) if match else ""
+        bad = not word or (word.isalpha() and word.upper() not in _WKT_WORDS)
+        if not bad and not word.isalpha() and word not in "(),":
+            bad = not word.isspace() and not is_number(word)
+        if bad:
+            got = re.split(r"[\s,()]", text[at:], maxsplit=1)[0][:20] or text[at : at + 1]
+            raise InputError(
+                f"{name}: got {got!r} at character {at}, expected WKT of plain decimal "
+                "numbers (such as 1.5, -2 or 3e-4)"
+            )
+        at = match.end() if match else at + 1
+
+
+_WKT_WORDS = {"POLYGON", "MULTIPOLYGON", "EMPTY", "Z", "M", "ZM"}
+
+
 def _from_wkt(text: str, name: str) -> Region:
+    check_wkt_numbers(text, name)
     try:
         geometry = shapely.from_wkt(text.strip())
     except shapely.errors.GEOSException as exc:
@@ -162,6 +195,18 @@ def _from_geojson(data: Any, name: str) -> Region:
     return _checked(geometry, name)
 
 
+def check_geojson_polygon(data: Any, name: str) -> None:
+    """Refuse a GeoJSON Polygon or MultiPolygon whose coordinates break RFC 7946.
+
+    Positions are ``[x, y]`` JSON numbers, rings closed with four or more
+    positions; anything else (other geometry types) is left to the caller.
+    """
+    if isinstance(data, dict) and data.get("type") == "Polygon":
+        _check_coordinates(data.get("coordinates"), name)
+    elif isinstance(data, dict) and data.get("type") == "MultiPolygon":
+        _check_multi_coordinates(data.get("coordinates"), name)
+
+
 def _check_multi_coordinates(polygons: Any, name: str) -> None:
     """Refuse MultiPolygon coordinates that are not lists of Polygon coordinates."""
     if not isinstance(polygons, list) or not polygons:
@@ -204,6 +249,24 @@ def _check_coordinates(rings: Any, name: str) -> None:
             )
         for k, position in enumerate(ring):
             _check_position(position, f"{name}: coordinates[{r}][{k}]")
+        _check_closed(ring, f"{name}: coordinates[{r}]")
+
+
+def _check_closed(ring: list[Any], where: str) -> None:
+    """RFC 7946 §3.1.6: a ring has four or more positions, its last identical to its first.
+
+    shapely would close an open ring silently (and GEOS draw a lone triangle of three).
+    """
+    if len(ring) < 4:
+        raise InputError(
+            f"{where}: got a ring of {len(ring)} position(s), expected at least 4 with the last "
+            "identical to the first (RFC 7946 section 3.1.6)"
+        )
+    if ring[0] != ring[-1]:
+        raise InputError(
+            f"{where}: got a ring from {repr(ring[0])[:40]} to {repr(ring[-1])[:40]}, expected "
+            "a closed ring whose last position is identical to its first (RFC 7946 section 3.1.6)"
+        )
 
 
 def _check_position(position: Any, where: str) -> None:

@@ -2,7 +2,8 @@
 
 An interrupted run leaves the previous file or the new one, never half of one
 (docs/architecture.md "Outputs and errors"); the rename is atomic on POSIX within one file
-system, which a temporary file in the same folder guarantees.
+system, which a temporary file in the same folder guarantees. The file gets the mode any
+new file of the user's gets (``0666`` less the umask), not the ``0600`` of a temporary file.
 """
 
 from __future__ import annotations
@@ -14,6 +15,17 @@ import tempfile
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
+
+
+def _umask() -> int:
+    """The process's umask (read by setting it and putting it back: there is no getter)."""
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+#: Read once at import, while the program is single-threaded.
+_UMASK = _umask()
 
 
 @contextlib.contextmanager
@@ -31,6 +43,7 @@ def atomic_path(path: str | Path) -> Iterator[Path]:
     temporary = Path(name)
     try:
         yield temporary
+        os.chmod(temporary, 0o666 & ~_UMASK)
         os.replace(temporary, target)
     finally:
         temporary.unlink(missing_ok=True)

@@ -63,7 +63,7 @@ def _short(value: object, limit: int = 80) -> str:
 def _error(field: str, got: str, expected: str, source: str = "") -> InputError:
     """Build an :class:`InputError` whose message names field, received value and expectation."""
     where = f" in {source}" if source else ""
-    return InputError(f"{field}{where}: expected {expected}, got {got}")
+    return InputError(f"{field}{where}: got {got}, expected {expected}")
 
 
 def _is_number(x: object) -> bool:
@@ -258,6 +258,7 @@ class BoxCorridor:
         if waypoints.shape[0] < 2:
             raise _error("waypoints", f"{waypoints.shape[0]} point(s)", "at least 2 points")
         _check_inside(boxes[0], start, "start", "a point inside boxes[0]")
+        _check_chained(boxes)
         _check_inside(
             boxes[-1], goal, "goal", f"a point inside boxes[{len(boxes) - 1}] (the last box)"
         )
@@ -265,6 +266,29 @@ class BoxCorridor:
         object.__setattr__(self, "start", start)
         object.__setattr__(self, "goal", goal)
         object.__setattr__(self, "waypoints", waypoints)
+
+
+def _check_chained(boxes: tuple[OrientedBox, ...]) -> None:
+    """Raise :class:`InputError` unless every box overlaps the next (a path can pass).
+
+    Two boxes overlap when one point satisfies both half-space forms: a linear
+    feasibility problem (HiGHS through scipy), exact for rotated boxes.
+    """
+    from scipy.optimize import linprog
+
+    for k in range(len(boxes) - 1):
+        A0, b0 = boxes[k].halfspaces()
+        A1, b1 = boxes[k + 1].halfspaces()
+        found = linprog(
+            np.zeros(3), A_ub=np.vstack([A0, A1]), b_ub=np.concatenate([b0, b1]),
+            bounds=[(None, None)] * 3, method="highs",
+        )  # fmt: skip
+        if found.status == 2:  # infeasible: the boxes are apart
+            raise _error(
+                f"boxes[{k + 1}]",
+                f"a box apart from boxes[{k}]",
+                "each box to overlap the next (a chain from start to goal)",
+            )
 
 
 def _check_inside(box: OrientedBox, p: FloatArray, field: str, expected: str) -> None:
@@ -299,9 +323,8 @@ def load_box_corridor(path: str | Path) -> BoxCorridor:
     """
     src = str(path)
     file = Path(path)
-    if not file.is_file():
-        raise _error("path", repr(src), "an existing corridor JSON file")
-    data = read_json_file(file, "a corridor JSON file")  # UTF-8, bounded size and depth
+    # A regular file (a named pipe would block), UTF-8, bounded size and depth, strict JSON.
+    data = read_json_file(file, "a corridor JSON file")
     if not isinstance(data, Mapping):
         raise _error("(top level)", type(data).__name__, "a JSON object {...}", src)
     _check_keys(data, "(top level)", _TOP_KEYS, _OPTIONAL_TOP_KEYS, src)

@@ -1,24 +1,26 @@
 """Parse untrusted JSON: one set of refusals for every JSON file skyquill reads.
 
-The text must be UTF-8 (a leading byte-order mark is accepted, as editors on
-Windows write one). Everything else is an :class:`~skyquill.errors.InputError`
-whose message names the file, what came and what was expected: a missing or
-unreadable file, a file larger than the caller's ceiling (checked before it is
-read), UTF-16 or binary bytes, malformed JSON, an integer literal too long for
-Python to convert, or nesting deeper than :data:`MAX_DEPTH` (checked without
-recursion, so that the readers' own messages, which ``repr`` the values, and
-numpy's array conversion never meet a structure deep enough to overflow the
-stack).
+The file is opened and decoded by :mod:`skyquill.io.source` (a regular file, its
+size checked before reading; UTF-8 with or without a byte-order mark). Everything
+else is an :class:`~skyquill.errors.InputError` whose message names the file, what
+came and what was expected: malformed JSON; what RFC 8259 does not allow but
+Python's parser takes -- ``NaN``, ``Infinity``, a number beyond the float range
+(``1e400``, which Python reads as infinity) and a key repeated in one object
+(Python keeps the last one silently); an integer literal too long for Python to
+convert; or nesting deeper than :data:`MAX_DEPTH` (checked without recursion, so
+that the readers' own messages, which ``repr`` the values, and numpy's array
+conversion never meet a structure deep enough to overflow the stack).
 """
 
 from __future__ import annotations
 
-import codecs
 import json
+import math
 from pathlib import Path
 from typing import Any
 
 from skyquill.errors import InputError
+from skyquill.io.source import decode_text, read_bytes
 
 #: Deepest nesting of arrays and objects accepted. skyquill's own files nest at
 #: most 6 deep; 64 leaves room for any honest producer and stays far below the
@@ -28,7 +30,14 @@ MAX_DEPTH = 64
 #: Largest JSON file read by default, bytes (64 MiB); a reader may pass its own.
 MAX_BYTES = 64 * 2**20
 
-_UTF16_BOMS = (codecs.BOM_UTF16_LE, codecs.BOM_UTF16_BE)
+
+class _RefusedError(Exception):
+    """Raised inside the parser's hooks: what came, and the rule it broke."""
+
+    def __init__(self, got: str, rule: str) -> None:
+        super().__init__(got)
+        self.got = got
+        self.rule = rule
 
 
 def read_json_file(path: str | Path, what: str, *, max_bytes: int = MAX_BYTES) -> Any:
@@ -54,18 +63,7 @@ def read_json_file(path: str | Path, what: str, *, max_bytes: int = MAX_BYTES) -
         See the module docstring; the message starts with the file's path.
     """
     file = Path(path)
-    try:
-        size = file.stat().st_size
-    except FileNotFoundError:
-        raise InputError(f"{file}: no such file, expected {what}") from None
-    except OSError as exc:
-        raise InputError(f"{file}: cannot be read ({exc}), expected {what}") from None
-    if size > max_bytes:
-        raise InputError(f"{file}: got {size:,} bytes, expected {what} of at most {max_bytes:,}")
-    try:
-        raw = file.read_bytes()
-    except OSError as exc:
-        raise InputError(f"{file}: cannot be read ({exc}), expected {what}") from None
+    raw = read_bytes(file, what, max_bytes=max_bytes)
     return parse_json(raw, str(file), what)
 
 
@@ -77,9 +75,11 @@ def parse_json(raw: bytes, name: str, what: str) -> Any:
     InputError
         See the module docstring.
     """
-    text = decode_utf8(raw, name, what)
+    text = decode_text(raw, name, what)
     try:
-        data = json.loads(text)
+        data = json.loads(text, object_pairs_hook=_unique_keys, parse_constant=_no_constant)
+    except _RefusedError as exc:
+        raise InputError(f"{name}: got {exc.got}, expected {what} ({exc.rule})") from None
     except json.JSONDecodeError as exc:
         raise InputError(
             f"{name}: got malformed JSON at line {exc.lineno}, column {exc.colno} ({exc.msg}), "
@@ -95,29 +95,25 @@ def parse_json(raw: bytes, name: str, what: str) -> Any:
     return data
 
 
-def decode_utf8(raw: bytes, name: str, what: str) -> str:
-    """``raw`` as UTF-8 text, a leading byte-order mark dropped.
+def _unique_keys(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
+    """An object's pairs as a dict; a repeated key is refused, not overwritten."""
+    data = dict(pairs)
+    if len(data) < len(pairs):
+        seen: set[str] = set()
+        for key, _ in pairs:
+            if key in seen:
+                raise _RefusedError(f"the key {_short(key)!r} twice in one object", "each key once")
+            seen.add(key)
+    return data
 
-    Raises
-    ------
-    InputError
-        Naming UTF-16 (by its byte-order mark), binary data (a NUL byte) or the
-        first byte that is not UTF-8.
-    """
-    if raw.startswith(_UTF16_BOMS):
-        raise InputError(f"{name}: got UTF-16 text, expected {what} in UTF-8")
-    nul = raw.find(b"\x00")
-    if nul >= 0:
-        raise InputError(
-            f"{name}: got binary data (a NUL byte at offset {nul}), expected {what} in UTF-8"
-        )
-    try:
-        return raw.decode("utf-8-sig")
-    except UnicodeDecodeError as exc:
-        raise InputError(
-            f"{name}: got bytes that are not UTF-8 (at offset {exc.start}), "
-            f"expected {what} in UTF-8"
-        ) from None
+
+def _no_constant(word: str) -> Any:
+    """``NaN``, ``Infinity`` and ``-Infinity``: not JSON (RFC 8259), refused."""
+    raise _RefusedError(word, "finite JSON numbers: NaN and Infinity are not JSON")
+
+
+def _short(text: str) -> str:
+    return text if len(text) <= 40 else text[:37] + "..."
 
 
 def check_depth(data: Any, name: str, what: str) -> None:
@@ -130,6 +126,11 @@ def check_depth(data: Any, name: str, what: str) -> None:
         elif isinstance(item, list):
             children = item
         else:
+            if isinstance(item, float) and not math.isfinite(item):
+                # Python reads 1e400 as infinity (NaN and Infinity are refused while parsing).
+                raise InputError(
+                    f"{name}: got a number beyond the float range (about 1.8e308), expected {what}"
+                )
             continue
         if depth >= MAX_DEPTH:
             raise InputError(f"{name}: got JSON nested more than {MAX_DEPTH} deep, expected {what}")

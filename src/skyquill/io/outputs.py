@@ -1,39 +1,85 @@
-"""Where commands put their files: staged, checked, then moved in; nobody else's file replaced.
+"""Where commands put their files: staged, checked, then moved in; nobody else's file touched.
 
 A command writes into a staging folder inside its output folder
 (:func:`staged_output`); when it has finished, every file is checked and then
 moved into place by an atomic rename, ``summary.json`` last:
 
-* a file already there is replaced only if the same command wrote it in an
-  earlier run (the folder's :data:`MANIFEST` says who wrote what), or with
+* a file already there is replaced only if it is the command's own -- the same
+  command wrote it in an earlier run and it is still exactly that file -- or with
   ``force``; otherwise nothing is replaced and the message says which file and
   how to proceed;
 * a file that is one of the command's own inputs is never written over;
 * files the same command wrote earlier and does not write now (a plan for two
   drones replaced by one for one drone) are removed, so the folder holds one
-  result.
+  result -- again only a file that is provably still the one skyquill wrote.
+
+**The manifest is a record, never an authority.** The folder's :data:`MANIFEST`
+says who wrote which file, with the file's SHA-256 and inode as written. A plan
+folder can come from someone else, so nothing in it is trusted: a name is acted
+on (replaced or removed) only if it is a plain file name inside ``out`` (no
+folder part, no ``..``) naming a regular file (not a link, not a folder) whose
+inode and content are still those recorded when skyquill moved it in. A crafted
+manifest naming ``../../victim.txt``, or the user's own ``notes.txt``, or a link,
+makes skyquill touch nothing; a folder copied from elsewhere (new inodes) is
+treated as another program's. Nothing outside ``out`` is ever removed or
+replaced: every rename and removal is of ``out / <plain name>`` itself, never
+through a link.
 
 An interrupted run leaves the previous files or the new ones, each whole; a
-refused or failed run leaves the folder as it was.
+refused or failed run leaves the folder as it was. A run killed outright leaves
+its staging folder behind: the next run into the same folder removes every
+staging folder whose run has ended (each run holds a lock on its own while it
+lives), and commits under a lock of the folder, so two runs into one folder end
+one after the other, each whole.
 """
 
 from __future__ import annotations
 
 import contextlib
-import json
+import fcntl
+import hashlib
+import logging
 import os
+import re
 import shutil
+import stat
 import tempfile
+import time
 from collections.abc import Iterator, Sequence
+from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 from skyquill.errors import InputError
 from skyquill.io.atomic import write_json
 
-#: Who wrote which file in a folder: ``{"files": {name: command}}``.
+logger = logging.getLogger(__name__)
+
+#: Who wrote which file in a folder: ``{"files": {name: {"command", "sha256", "inode"}}}``.
 MANIFEST = ".skyquill-files.json"
 #: Moved in last: it names the others, so a reader never sees it ahead of them.
 LAST = "summary.json"
+#: Staging folders are named ``.staging-<random>`` inside the output folder.
+STAGING_PREFIX = ".staging-"
+#: The lock file a run holds in its staging folder while it lives.
+_LOCK = ".lock"
+#: A staging folder without a lock (made by an older skyquill) is removed once this old, s.
+_ORPHAN_AGE_S = 3600.0
+#: Largest manifest read, bytes; a larger one is ignored (the folder is then nobody's).
+_MANIFEST_BYTES = 4 * 2**20
+_STAGING_PART = re.compile(rf"{re.escape(STAGING_PREFIX)}[^/\\]*[/\\]")
+
+
+@dataclass(frozen=True)
+class _Record:
+    """What the manifest says of one file: who wrote it, and the file as written."""
+
+    command: str
+    sha256: str
+    inode: int
+
+    def as_dict(self) -> dict[str, Any]:
+        return {"command": self.command, "sha256": self.sha256, "inode": self.inode}
 
 
 @contextlib.contextmanager
@@ -61,10 +107,13 @@ def staged_output(
     """
     check_folder(out)
     out.mkdir(parents=True, exist_ok=True)
-    staging = Path(tempfile.mkdtemp(prefix=".staging-", dir=out))
+    _clear_leftovers(out)
+    staging = Path(tempfile.mkdtemp(prefix=STAGING_PREFIX, dir=out))
     try:
-        yield staging
-        _commit(staging, out, command, force, inputs)
+        with _held(staging / _LOCK, create=True):
+            yield staging
+            with _folder_locked(out):
+                _commit(staging, out, command, force, inputs)
     finally:
         shutil.rmtree(staging, ignore_errors=True)
 
@@ -83,9 +132,17 @@ def check_folder(out: Path, name: str = "out") -> None:
             return
 
 
+def shown_path(path: str | os.PathLike[str]) -> str:
+    """``path`` as the user knows it: a file in a staging folder named as in ``--out``."""
+    return _STAGING_PART.sub("", str(path))
+
+
 def _commit(staging: Path, out: Path, command: str, force: bool, inputs: Sequence[Path]) -> None:
-    names = sorted((p.name for p in staging.iterdir() if p.is_file()), key=lambda n: n == LAST)
-    owners = _owners(out)
+    names = sorted(
+        (p.name for p in staging.iterdir() if p.is_file() and p.name != _LOCK),
+        key=lambda n: n == LAST,
+    )
+    records = _records(out)
     protected = {p.resolve() for p in inputs}
     for name in names:
         target = out / name
@@ -94,30 +151,163 @@ def _commit(staging: Path, out: Path, command: str, force: bool, inputs: Sequenc
                 f"out: {str(target)!r} is one of this command's inputs; expected another "
                 "file or folder to write to"
             )
-        owner = owners.get(name)
-        if target.exists() and owner != command and not force:
-            who = f"skyquill {owner}" if owner else "another program"
-            raise InputError(
-                f"out: {str(target)!r} exists and was written by {who}; expected a folder "
-                f"without it (choose another --out, or --force to replace it)"
-            )
-    stale = [n for n, who in owners.items() if who == command and n not in names]
+        _check_replaceable(out, name, records.get(name), command, force)
+    stale = [
+        name for name, record in records.items() if record.command == command and name not in names
+    ]
     for name in names:
         os.replace(staging / name, out / name)
-        owners[name] = command
+        records[name] = _record_of(out / name, command)
     for name in stale:
-        (out / name).unlink(missing_ok=True)
-        owners.pop(name)
-    write_json(out / MANIFEST, {"files": owners})
+        if _is_as_recorded(out, name, records.pop(name)):
+            (out / name).unlink()
+    write_json(out / MANIFEST, {"files": {n: r.as_dict() for n, r in records.items()}})
 
 
-def _owners(out: Path) -> dict[str, str]:
-    """``{file: command}`` of the folder's manifest (empty when there is none or it is damaged)."""
+def _check_replaceable(
+    out: Path, name: str, record: _Record | None, command: str, force: bool
+) -> None:
+    """Refuse to replace ``out / name`` unless it is the command's own file (or ``force``)."""
+    target = out / name
     try:
-        data = json.loads((out / MANIFEST).read_text(encoding="utf-8"))
-        files = data["files"]
-    except (OSError, ValueError, KeyError, TypeError, RecursionError):
+        mode = os.lstat(target).st_mode
+    except FileNotFoundError:
+        return
+    if stat.S_ISDIR(mode):
+        raise InputError(
+            f"out: {str(target)!r} exists and is a folder; expected a folder without it "
+            "(choose another --out)"
+        )
+    if force:
+        return
+    if record is not None and _is_as_recorded(out, name, record):
+        if record.command == command:
+            return
+        who = f"was written by skyquill {record.command}"
+    elif record is not None:
+        who = f"was changed since skyquill {record.command} wrote it"
+    else:
+        who = "was written by another program"
+    raise InputError(
+        f"out: {str(target)!r} exists and {who}; expected a folder without it "
+        "(choose another --out, or --force to replace it)"
+    )
+
+
+def _records(out: Path) -> dict[str, _Record]:
+    """The manifest's well-formed records of plain file names (empty when damaged or absent)."""
+    from skyquill.io.json_read import parse_json
+    from skyquill.io.source import read_bytes
+
+    try:
+        raw = read_bytes(out / MANIFEST, "a manifest", max_bytes=_MANIFEST_BYTES)
+        files = parse_json(raw, MANIFEST, "a manifest")["files"]
+    except (InputError, KeyError, TypeError):
         return {}
     if not isinstance(files, dict):
         return {}
-    return {str(k): str(v) for k, v in files.items() if isinstance(k, str) and isinstance(v, str)}
+    records = {}
+    for name, entry in files.items():
+        record = _parsed(entry)
+        if record is not None and _plain_name(name):
+            records[name] = record
+    return records
+
+
+def _parsed(entry: Any) -> _Record | None:
+    """A record from its JSON form; None for anything else (an old or crafted entry)."""
+    if not isinstance(entry, dict):
+        return None
+    command, digest, inode = entry.get("command"), entry.get("sha256"), entry.get("inode")
+    if not (isinstance(command, str) and isinstance(digest, str) and isinstance(inode, int)):
+        return None
+    return _Record(command, digest, inode)
+
+
+def _plain_name(name: str) -> bool:
+    """A file name with no folder part that can only mean a file directly inside the folder."""
+    return (
+        bool(name)
+        and name not in (".", "..", MANIFEST)
+        and "/" not in name
+        and "\\" not in name
+        and "\x00" not in name
+        and not name.startswith(STAGING_PREFIX)
+        and Path(name).name == name
+    )
+
+
+def _is_as_recorded(out: Path, name: str, record: _Record) -> bool:
+    """Whether ``out / name`` is a regular file, not a link, with the recorded inode and hash."""
+    if not _plain_name(name):
+        return False
+    try:
+        info = os.lstat(out / name)
+        if not stat.S_ISREG(info.st_mode) or info.st_ino != record.inode:
+            return False
+        return _sha256(out / name) == record.sha256
+    except OSError:
+        return False
+
+
+def _record_of(path: Path, command: str) -> _Record:
+    return _Record(command, _sha256(path), os.lstat(path).st_ino)
+
+
+def _sha256(path: Path) -> str:
+    fd = os.open(path, os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_NONBLOCK", 0))
+    with open(fd, "rb") as handle:
+        return hashlib.file_digest(handle, "sha256").hexdigest()
+
+
+def _clear_leftovers(out: Path) -> None:
+    """Remove the staging folders of runs into ``out`` that have ended (killed, not cleaned)."""
+    try:
+        entries = list(os.scandir(out))
+    except OSError:
+        return
+    for entry in entries:
+        if not entry.name.startswith(STAGING_PREFIX) or not entry.is_dir(follow_symlinks=False):
+            continue
+        folder = Path(entry.path)
+        if _run_has_ended(folder):
+            shutil.rmtree(folder, ignore_errors=True)
+            logger.info("removed %s, left by an interrupted run", folder)
+
+
+def _run_has_ended(folder: Path) -> bool:
+    """Whether no live run holds ``folder``'s lock (one without a lock: when it is old)."""
+    lock = folder / _LOCK
+    try:
+        with _held(lock, create=False, wait=False):
+            return True
+    except FileNotFoundError:
+        try:
+            return time.time() - folder.stat().st_mtime > _ORPHAN_AGE_S
+        except OSError:
+            return False
+    except OSError:  # held by a live run
+        return False
+
+
+@contextlib.contextmanager
+def _held(lock: Path, *, create: bool, wait: bool = True) -> Iterator[None]:
+    """Hold an exclusive lock on the file ``lock`` (released when the process ends, too)."""
+    flags = os.O_RDWR | (os.O_CREAT if create else 0) | getattr(os, "O_NOFOLLOW", 0)
+    fd = os.open(lock, flags, 0o600)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | (0 if wait else fcntl.LOCK_NB))
+        yield
+    finally:
+        os.close(fd)
+
+
+@contextlib.contextmanager
+def _folder_locked(out: Path) -> Iterator[None]:
+    """Hold an exclusive lock on the folder ``out`` itself while moving files in."""
+    fd = os.open(out, os.O_RDONLY)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX)
+        yield
+    finally:
+        os.close(fd)

@@ -7,10 +7,11 @@ One writer for ``fit``, ``write``, ``cover`` and ``paint``:
   ``yaw`` and ``pen``;
 * ``trajectory.json`` (``trajectory_<i>.json``): the exact trajectory, naming
   its kind (:mod:`skyquill.io.trajectory_json`);
-* ``summary.json``: the command's own fields plus ``plan``: the files per drone
-  and the dense check of each trajectory *as read back from the file written*
-  (what is verified is what is delivered), and the largest difference between
-  the CSV's samples and the exact trajectory;
+* ``summary.json``: the command's own fields plus ``plan``: the files per drone,
+  their flight phases (take-off, mission, landing; :mod:`skyquill.phases`) and the
+  minimum altitude they keep, and the dense check of each trajectory *as read back
+  from the file written* (what is verified is what is delivered), and the largest
+  difference between the CSV's samples and the exact trajectory;
 * ``plot.png`` when the command draws one.
 
 Every file is written atomically (:mod:`skyquill.io.atomic`).
@@ -18,8 +19,8 @@ Every file is written atomically (:mod:`skyquill.io.atomic`).
 
 from __future__ import annotations
 
-import json
 from collections.abc import Callable, Sequence
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -27,15 +28,21 @@ import numpy as np
 
 from skyquill.errors import InputError
 from skyquill.io.atomic import atomic_path, write_json
-from skyquill.io.points import write_table_csv
+from skyquill.io.json_read import parse_json
+from skyquill.io.points import check_rows_written, write_table_csv
+from skyquill.io.source import read_bytes, special_kind
 from skyquill.io.trajectory_csv import read_trajectory_csv
 from skyquill.io.trajectory_json import (
     PlannedTrajectory,
     read_trajectory_json,
     write_trajectory_json,
 )
+from skyquill.phases import MIN_ALTITUDE_M, flight_phases
 from skyquill.trajectory import SampledTrajectory, Trajectory, sample
 from skyquill.verify import verify
+
+#: Largest summary.json read when looking for a plan's files, bytes.
+SUMMARY_BYTES = 64 * 2**20
 
 PLAN_FORMAT = "skyquill-plan"
 
@@ -55,6 +62,7 @@ def write_plan(
     guaranteed: bool,
     summary: dict[str, Any],
     plot: Callable[[Path], None] | None = None,
+    min_altitude_m: float | None = MIN_ALTITUDE_M,
 ) -> dict[str, Any]:
     """Write the plan directory ``out`` and return the ``summary.json`` written.
 
@@ -74,12 +82,24 @@ def write_plan(
         The command's own summary fields.
     plot
         Draws ``plot.png`` to the path it is given.
+    min_altitude_m
+        The mission's minimum altitude above the ground, m: each trajectory's phases are
+        found (:func:`~skyquill.phases.flight_phases`, unless given) and recorded in its
+        ``trajectory.json`` and in ``summary.json``. ``None`` records none: trajectories
+        that are not a vehicle's flight (a test's synthetic show); exporters find them then.
+
+    Raises
+    ------
+    InfeasibleError
+        A trajectory whose mission goes below ``min_altitude_m``.
     """
     if not planned:
         raise InputError("planned: got no trajectory, expected at least one")
     for i, p in enumerate(planned):
         if p.trajectory.dim != 3:
             raise InputError(f"planned[{i}]: got {p.trajectory.dim} axes, expected 3 (x, y, z)")
+    if min_altitude_m is not None:
+        planned = [_with_phases(p, min_altitude_m) for p in planned]
     out.mkdir(parents=True, exist_ok=True)
     drones = [
         _write_drone(out, names, p, rate, guaranteed)
@@ -94,12 +114,20 @@ def write_plan(
             "version": 1,
             "rate_hz": rate,
             "limits_guaranteed": guaranteed,
+            "min_altitude_m": min_altitude_m,
             "max_excess": max(d["verification"]["max_excess"] for d in drones),
             "drones": drones,
         }
     }
     write_json(out / "summary.json", full)
     return full
+
+
+def _with_phases(planned: PlannedTrajectory, min_altitude_m: float) -> PlannedTrajectory:
+    """``planned`` with its phases (found at ``min_altitude_m`` unless it has them)."""
+    if planned.phases is not None:
+        return planned
+    return replace(planned, phases=flight_phases(planned.trajectory, min_altitude_m))
 
 
 def _write_drone(
@@ -110,6 +138,7 @@ def _write_drone(
     guaranteed: bool,
 ) -> dict[str, Any]:
     csv_name, json_name = names
+    check_rows_written(planned.trajectory.duration, rate)  # its read-back would refuse more
     write_trajectory_json(out / json_name, planned)
     s = sample(planned.trajectory, rate)
     table = np.column_stack([s.t, s.p, s.v, s.a, s.j])
@@ -125,6 +154,7 @@ def _write_drone(
         "json": json_name,
         "kind": _kind(exact),
         "duration_s": exact.duration,
+        "phases": back.phases.as_dict() if back.phases is not None else None,
         "rows": rows,
         "verification": {
             "n_samples": check.n_samples,
@@ -161,7 +191,9 @@ def plan_files(path: Path) -> list[Path]:
     if path.is_file():
         return [path]
     if not path.is_dir():
-        raise InputError(f"plan: got {str(path)!r}, expected a plan directory or a trajectory file")
+        kind = special_kind(path)
+        got = repr(str(path)) if kind is None else f"{kind} {str(path)!r}"
+        raise InputError(f"plan: got {got}, expected a plan directory or a trajectory file")
     files = _listed(path) or _found(path)
     if not files:
         raise InputError(
@@ -186,10 +218,9 @@ def _listed(directory: Path) -> list[Path]:
     summary = directory / "summary.json"
     if not summary.is_file():
         return []
-    try:
-        plan = json.loads(summary.read_text(encoding="utf-8")).get("plan")
-    except (json.JSONDecodeError, UnicodeDecodeError, AttributeError, RecursionError):
-        raise InputError(f"{summary}: got a damaged summary, expected skyquill's JSON") from None
+    what = "skyquill's summary.json"
+    data = parse_json(read_bytes(summary, what, max_bytes=SUMMARY_BYTES), str(summary), what)
+    plan = data.get("plan") if isinstance(data, dict) else None
     if not isinstance(plan, dict) or plan.get("format") != PLAN_FORMAT:
         return []
     names = [d.get("json") for d in plan.get("drones", []) if isinstance(d, dict)]

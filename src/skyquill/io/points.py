@@ -8,12 +8,14 @@ trajectories are written with ``z = 0``.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
 
-from skyquill.io.table import read_table
+from skyquill.errors import InputError
+from skyquill.io.table import MAX_ROWS, read_table
 from skyquill.trajectory import Samples, Trajectory, sample
 from skyquill.validation import FloatArray
 
@@ -43,13 +45,43 @@ def read_points_csv(path: str | Path) -> tuple[FloatArray, FloatArray | None]:
 
 
 def trajectory_table(traj: Trajectory, rate: float) -> FloatArray:
-    """Samples as the ``trajectory.csv`` table, shape (N, 13); 2-D gets ``z = 0``."""
+    """Samples as the ``trajectory.csv`` table, shape (N, 13); 2-D gets ``z = 0``.
+
+    Raises
+    ------
+    InputError
+        More rows than a trajectory file is read back with (:data:`MAX_ROWS`): the
+        file would be written, then refused by its own read-back (a 10,000-dot
+        painting at 100 Hz wrote 813 MB of it).
+    """
+    check_rows_written(traj.duration, rate)
     s: Samples = sample(traj, rate)
 
     def as3(x: FloatArray) -> FloatArray:
         return x if x.shape[1] == 3 else np.column_stack([x, np.zeros(x.shape[0])])
 
     return np.column_stack([s.t, as3(s.p), as3(s.v), as3(s.a), as3(s.j)])
+
+
+def check_rows_written(duration: float, rate: float, argument: str = "rate") -> None:
+    """Refuse a ``trajectory.csv`` of more rows than its readers take, before sampling.
+
+    Parameters
+    ----------
+    duration
+        The flight's duration, s.
+    rate
+        Sample rate, Hz.
+    argument
+        What the refusal names: where the rate came from.
+    """
+    rows = math.floor(duration * rate + 1e-9) + 2  # the samples, and the end when off the grid
+    if rows > MAX_ROWS:
+        raise InputError(
+            f"{argument}: got {rate:g} Hz over a {duration:.6g} s flight ({rows:,} rows), "
+            f"expected at most {MAX_ROWS:,} rows in trajectory.csv, the most it is read back "
+            "with (a lower rate)"
+        )
 
 
 def write_trajectory_csv(

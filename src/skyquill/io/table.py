@@ -4,7 +4,10 @@ The first non-blank line is the header (names stripped and lower-cased, so ``" X
 ``x``); every later non-blank line is a row with one cell per header column. The caller
 names the columns it needs (``required``), the ones it takes when present (``optional``)
 and whether other columns are ignored or refused; only those columns are parsed, as
-finite floats. Text is UTF-8, with or without the byte-order mark spreadsheets write.
+finite floats written as plain ASCII decimal literals (:mod:`skyquill.io.numbers`: not
+``1_0``, ``٠.١`` or ``０.５``, which Python's ``float()`` would take). The file is opened
+by :mod:`skyquill.io.source` (a regular file: a named pipe or a device is refused) and
+is UTF-8, with or without the byte-order mark spreadsheets write.
 
 Everything else is an :class:`~skyquill.errors.InputError` naming the file (and the line
 and column where there is one): a missing file, bytes that are not UTF-8 (UTF-16, binary),
@@ -18,7 +21,6 @@ character or row too many is read, so a huge file is never read whole).
 from __future__ import annotations
 
 import csv
-import math
 from array import array
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
@@ -29,6 +31,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from skyquill.errors import InputError
+from skyquill.io.numbers import parse_number
+from skyquill.io.source import open_text
 from skyquill.validation import FloatArray
 
 #: Most data rows one CSV may hold: 1,000,000 rows is 2.8 h of a 100 Hz trajectory and
@@ -135,17 +139,11 @@ def read_table(
         was expected.
     """
     file = Path(path)
-    if not file.is_file():
+    if not file.exists():
         raise InputError(f"{name}: got {str(file)!r}, expected an existing CSV file")
     wanted = _Wanted(tuple(required), tuple(optional), unknown)
     try:
-        size = file.stat().st_size
-        if size > MAX_BYTES:
-            raise InputError(
-                f"{file.name}: got {size} bytes, expected at most {MAX_BYTES} "
-                f"({MAX_BYTES >> 20} MiB)"
-            )
-        with file.open(newline="", encoding="utf-8-sig") as handle:
+        with open_text(file, "a CSV file", max_bytes=MAX_BYTES, name=file.name) as handle:
             return _parse(file.name, _lines(file.name, handle), wanted, min_rows, max_rows)
     except UnicodeDecodeError as exc:
         raise InputError(
@@ -270,29 +268,20 @@ def _check_header(name: str, header: list[str], wanted: _Wanted) -> tuple[str, .
 def _row_values(name: str, line: int, row: list[str], index: list[tuple[str, int]]) -> list[float]:
     """The cells ``index`` (column, position) of ``row`` as finite floats."""
     try:
-        # Fast path: float() strips spaces itself; the named error is found only on failure.
-        values = [float(row[i]) for _, i in index]
-        if all(map(math.isfinite, values)):
-            return values
-    except ValueError:
-        pass
-    return [_cell(name, line, c, row, i) for c, i in index]
+        return [parse_number(row[i]) for _, i in index]
+    except ValueError:  # the named error is found only on failure
+        return [_cell(name, line, c, row, i) for c, i in index]
 
 
 def _cell(name: str, line: int, column: str, row: Sequence[str], i: int) -> float:
     """Cell ``i`` of a CSV ``row`` as a finite float; InputError naming file, line, column."""
     text = row[i].strip()
     try:
-        value = float(text)
-    except ValueError:
+        return parse_number(text)
+    except ValueError as exc:
         raise InputError(
-            f"{name} line {line}, column {column}: got {_shorten(text)!r}, expected a number"
+            f"{name} line {line}, column {column}: got {_shorten(text)!r}, {exc}"
         ) from None
-    if not math.isfinite(value):
-        raise InputError(
-            f"{name} line {line}, column {column}: got {_shorten(text)!r}, expected a finite number"
-        )
-    return value
 
 
 def _names(columns: Sequence[str]) -> str:

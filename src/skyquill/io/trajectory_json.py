@@ -9,7 +9,9 @@ trajectory itself::
      "trajectory": {"kind": "bspline" | "polynomial" | "retimed" | "sequence" | "sampled", ...},
      "pen_windows_s": [[t0, t1], ...],
      "pen_rgb": [[r, g, b], ...],              (optional: one light colour per window)
-     "limits": [{"type": "BoxLimit" | "CylinderLimit" | ..., <its fields>}, ...]}
+     "limits": [{"type": "BoxLimit" | "CylinderLimit" | ..., <its fields>}, ...],
+     "phases": {"takeoff_s": [0, t1], "mission_s": [t1, t2], "landing_s": [t2, T],
+                "min_altitude_m": ..., ...}}      (optional: :class:`~skyquill.phases.FlightPhases`)
 
 (:mod:`skyquill.trajectory.codec` gives each kind's fields.) Version 1 files,
 ``{"format": "skyquill-bspline", "degree", "duration_s", "control_points"}``,
@@ -32,7 +34,9 @@ from skyquill.colors import RGB, window_colors
 from skyquill.errors import InputError
 from skyquill.io.atomic import write_text
 from skyquill.io.json_read import parse_json
+from skyquill.io.source import read_bytes
 from skyquill.limits import BoxLimit, CylinderLimit, DerivativeLimit, NormLimit
+from skyquill.phases import MIN_ALTITUDE_M, FlightPhases, flight_phases
 from skyquill.trajectory import Trajectory
 from skyquill.trajectory.codec import decode, encode
 from skyquill.validation import FloatArray, as_array
@@ -61,12 +65,20 @@ class PlannedTrajectory:
     pen_rgb
         The light's colour in each pen window, three integers 0..255 each (light
         painting, shows); empty: the exporter's one colour for every window.
+    phases
+        When it takes off, flies its mission and lands (:mod:`skyquill.phases`), or
+        ``None`` when not recorded (an older plan, a CSV): :meth:`flight` computes them.
     """
 
     trajectory: Trajectory
     pen_windows_s: tuple[tuple[float, float], ...] = ()
     limits: tuple[DerivativeLimit, ...] = ()
     pen_rgb: tuple[RGB, ...] = ()
+    phases: FlightPhases | None = None
+
+    def flight(self, min_altitude_m: float = MIN_ALTITUDE_M) -> FlightPhases:
+        """The recorded phases, else those of the trajectory at ``min_altitude_m``."""
+        return self.phases or flight_phases(self.trajectory, min_altitude_m)
 
     def __post_init__(self) -> None:
         if self.pen_rgb:
@@ -116,6 +128,7 @@ def write_trajectory_json(path: str | Path, planned: PlannedTrajectory) -> None:
         "pen_windows_s": [list(w) for w in planned.pen_windows_s],
         **({"pen_rgb": [list(c) for c in planned.pen_rgb]} if planned.pen_rgb else {}),
         "limits": [_encode_limit(lim) for lim in planned.limits],
+        **({"phases": planned.phases.as_dict()} if planned.phases is not None else {}),
     }
     write_text(path, json.dumps(data, allow_nan=False) + "\n")
 
@@ -130,12 +143,10 @@ def read_trajectory_json(path: str | Path) -> PlannedTrajectory:
         nested too deep, another format, or a malformed trajectory.
     """
     file = Path(path)
-    if not file.is_file():
+    if not file.exists():
         raise InputError(f"trajectory file: got {str(file)!r}, expected an existing JSON file")
-    size = file.stat().st_size
-    if size > MAX_BYTES:
-        raise InputError(f"{file.name}: got {size:,} bytes, expected at most {MAX_BYTES:,}")
-    data = parse_json(file.read_bytes(), file.name, f"a {FORMAT} JSON file")
+    what = f"a {FORMAT} JSON file"
+    data = parse_json(read_bytes(file, what, max_bytes=MAX_BYTES, name=file.name), file.name, what)
     try:
         return _planned(data)
     except InputError as exc:
@@ -154,11 +165,13 @@ def _planned(data: object) -> PlannedTrajectory:
         raise InputError(f"limits: got a JSON {type(limits).__name__}, expected a list")
     windows = _windows(data)
     colors = data.get("pen_rgb", [])
+    phases = data.get("phases")
     return PlannedTrajectory(
         decode(data.get("trajectory")),
         windows,
         tuple(_decode_limit(item) for item in limits),
         window_colors("pen_rgb", windows, colors) if colors != [] else (),
+        None if phases is None else FlightPhases.from_dict(phases),
     )
 
 

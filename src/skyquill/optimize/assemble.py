@@ -18,6 +18,7 @@ evaluated term by term by :func:`problem_cost`, never from these matrices.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from functools import lru_cache
 
@@ -34,6 +35,7 @@ from skyquill.optimize.problem import (
     SmoothingProblem,
 )
 from skyquill.spline import HullKind, basis_for
+from skyquill.spline.local import LocalBasis
 from skyquill.validation import FloatArray
 
 
@@ -156,8 +158,11 @@ class AssemblyCache:
         self._key: tuple[object, ...] | None = None
         self._fixed: _Fixed | None = None
         self._design: dict[tuple[object, ...], tuple[FloatArray, sp.csr_array]] = {}
-        #: How often the blocks were re-used (for tests and benchmarks).
+        self._local: dict[tuple[object, ...], tuple[FloatArray, LocalBasis]] = {}
+        self._band: tuple[sp.csr_array, int, FloatArray] | None = None
+        #: How often the blocks were re-used, and built (for tests and benchmarks).
         self.hits = 0
+        self.builds = 0
 
     def design_matrix(
         self, problem: SmoothingProblem, times: FloatArray, order: int = 0
@@ -174,9 +179,53 @@ class AssemblyCache:
             return held[1]
         if len(self._design) >= _DESIGN_ENTRIES:
             self._design.clear()
-        matrix = problem.basis.design_matrix(_params(problem, times), order)
+        if order > min(_LOCAL_ORDERS, problem.degree):
+            matrix = problem.basis.design_matrix(_params(problem, times), order)
+        else:
+            local = self.local_basis(problem, times)
+            matrix = problem.basis.rows(local.first, local.values[order])
         self._design[key] = (times, matrix)
         return matrix
+
+    def local_basis(self, problem: SmoothingProblem, times: FloatArray) -> LocalBasis:
+        """The nonzero basis functions and their ``s``-derivatives 0 to 3 (at most the
+        degree) at a term's ``times``: what its design matrices, its banded normal
+        matrix (:mod:`skyquill.optimize.banded`) and its time gradient are made of.
+        Kept like :meth:`design_matrix`."""
+        key = (id(times), problem.alpha, problem.degree, problem.n_ctrl)
+        held = self._local.get(key)
+        if held is not None and held[0] is times:
+            return held[1]
+        if len(self._local) >= _DESIGN_ENTRIES:
+            self._local.clear()
+        local = local_basis(problem, times)
+        self._local[key] = (times, local)
+        return local
+
+    def band(
+        self, matrix: sp.csr_array, k: int, build: Callable[[sp.csr_array, int], FloatArray]
+    ) -> FloatArray:
+        """``build(matrix, k)`` (a band of the smoothness block), kept while ``matrix`` is the
+        very object :meth:`fixed` hands out again."""
+        if self._band is None or self._band[0] is not matrix or self._band[1] != k:
+            self._band = (matrix, k, build(matrix, k))
+        return self._band[2]
+
+    def local_bases(self, problem: SmoothingProblem, times: list[FloatArray]) -> list[LocalBasis]:
+        """:meth:`local_basis` of several terms' ``times`` at once (one evaluation for
+        those not kept yet: the terms of a writing route are four views of its samples)."""
+        key = (problem.alpha, problem.degree, problem.n_ctrl)
+        held = [self._local.get((id(t), *key)) for t in times]
+        missing = [t for t, h in zip(times, held, strict=True) if h is None or h[0] is not t]
+        if missing:
+            if len(self._local) + len(missing) > _DESIGN_ENTRIES:
+                self._local.clear()
+            fresh = _split_local(
+                local_basis(problem, np.concatenate(missing)), [t.size for t in missing]
+            )
+            for t, local in zip(missing, fresh, strict=True):
+                self._local[(id(t), *key)] = (t, local)
+        return [self.local_basis(problem, t) for t in times]
 
     def fixed(self, problem: SmoothingProblem) -> _Fixed:
         """The time-independent blocks of ``problem``, built or re-used."""
@@ -185,11 +234,31 @@ class AssemblyCache:
             self.hits += 1
             return self._fixed
         self._key, self._fixed = key, _build_fixed(problem)
+        self.builds += 1
         return self._fixed
 
 
 #: Design matrices an :class:`AssemblyCache` keeps (a few terms of one or two problems).
 _DESIGN_ENTRIES = 16
+
+
+#: Derivatives of the basis kept per term (:meth:`AssemblyCache.local_basis`): the tip's
+#: first-order model needs the acceleration, its time gradient the jerk.
+_LOCAL_ORDERS = 3
+
+
+def _split_local(local: LocalBasis, sizes: list[int]) -> list[LocalBasis]:
+    """``local`` of concatenated times cut back into one per part of ``sizes``."""
+    cuts = np.cumsum(sizes)[:-1]
+    firsts = np.split(local.first, cuts)
+    values = np.split(local.values, cuts, axis=1)
+    return [LocalBasis(f, v) for f, v in zip(firsts, values, strict=True)]
+
+
+def local_basis(problem: SmoothingProblem, times: FloatArray) -> LocalBasis:
+    """The nonzero basis rows and their ``s``-derivatives up to 3 (or the degree) at ``times``."""
+    order = min(_LOCAL_ORDERS, problem.degree)
+    return problem.basis.local_values(_params(problem, times), order)
 
 
 def design_matrix(
@@ -312,15 +381,66 @@ def problem_cost(
     deviation = 0.0
     for term in problem.deviations:
         if isinstance(term, PointDeviation):
-            for mask, H in point_rows(problem, term, cache):
-                residual = (H @ C - term.points) * mask
-                deviation += term.weight * float(np.sum(residual**2))
+            residual = point_model(problem, term, C, cache) - term.points
+            deviation += term.weight * float(np.sum(residual**2))
         else:
             Q, w = term.quadratic()
             active = _window_controls(problem, term.t_start, term.t_end) > 0
             diff = C[active] - w
             deviation += term.weight * float(np.sum(diff * (diff @ Q)))
     return {"smoothness": smooth, "deviation": deviation, "total": smooth + deviation}
+
+
+def curve_at(
+    problem: SmoothingProblem,
+    times: FloatArray,
+    C: FloatArray,
+    order: int,
+    cache: AssemblyCache | None = None,
+) -> FloatArray:
+    """The ``order``-th ``s``-derivative of the curve of ``C`` (M, d) at ``times``: (N, d).
+
+    From the local basis rows (:meth:`AssemblyCache.local_basis`, kept per
+    term), the same numbers as ``design_matrix(problem, times, order) @ C``
+    without the sparse matrix.
+    """
+    local = cache.local_basis(problem, times) if cache is not None else local_basis(problem, times)
+    if order >= local.values.shape[0]:
+        return np.asarray(design_matrix(problem, times, order) @ C)
+    width = local.values.shape[2]
+    gathered = C[local.first[:, None] + np.arange(width)]  # (N, k + 1, d)
+    return np.asarray(np.einsum("nr,nrd->nd", local.values[order], gathered))
+
+
+def curves_at(
+    problem: SmoothingProblem,
+    times: FloatArray,
+    C: FloatArray,
+    orders: int,
+    cache: AssemblyCache | None = None,
+) -> FloatArray:
+    """The ``s``-derivatives ``0 .. orders - 1`` of the curve of ``C`` at ``times``:
+    (orders, N, d), from one gather of the control points (:func:`curve_at`'s)."""
+    local = cache.local_basis(problem, times) if cache is not None else local_basis(problem, times)
+    if orders > local.values.shape[0]:
+        return np.stack([curve_at(problem, times, C, n, cache) for n in range(orders)])
+    width = local.values.shape[2]
+    gathered = C[local.first[:, None] + np.arange(width)]  # (N, k + 1, d)
+    return np.asarray(np.einsum("onr,nrd->ond", local.values[:orders], gathered))
+
+
+def point_model(
+    problem: SmoothingProblem,
+    term: PointDeviation,
+    C: FloatArray,
+    cache: AssemblyCache | None = None,
+) -> FloatArray:
+    """What ``term`` compares with its points: ``p + c a`` at its times (N, d), m."""
+    position = curve_at(problem, term.times, C, 0, cache)
+    if term.accel_gain is None:
+        return position
+    acc = problem.alpha**2 * curve_at(problem, term.times, C, 2, cache)
+    return np.asarray(position + term.accel_gain * acc)
 
 
 def point_rows(

@@ -44,7 +44,8 @@ import scipy.sparse as sp
 from numpy.typing import NDArray
 
 from skyquill.errors import InfeasibleError, InputError, SolverError
-from skyquill.optimize.assemble import Assembled, NormCones, assemble, problem_cost
+from skyquill.optimize.assemble import Assembled, NormCones, _Fixed, assemble, problem_cost
+from skyquill.optimize.banded import banded_closed_form
 from skyquill.optimize.kkt import SingularKKTError, solve_equality_qp
 from skyquill.optimize.problem import SmoothingProblem
 from skyquill.optimize.workspace import Workspace
@@ -61,6 +62,9 @@ from skyquill.validation import FloatArray
 from skyquill.verify import Verification
 
 log = logging.getLogger(__name__)
+
+#: The closed form's solver when the Hessian is banded (:mod:`skyquill.optimize.banded`).
+BANDED = "banded-cholesky"
 
 #: Hull constraints must hold to this relative tolerance (docs/architecture.md: 1e-9).
 GUARANTEE_RTOL = 1e-9
@@ -80,7 +84,8 @@ class FitResult:
         With a workspace, also ``"closed_form"`` for a problem with
         inequalities that its equality-only minimiser meets (:func:`solve`).
     solver
-        ``"sparse-lu"`` or the QP backend's name.
+        ``"banded-cholesky"`` (:data:`BANDED`) or ``"sparse-lu"`` for the closed form,
+        else the QP backend's name.
     cost
         Total cost ``smoothness + deviation`` (paper 003 eq. 7).
     cost_terms
@@ -197,9 +202,8 @@ def solve(
         C, (y, z, cone_z), used, margin, asm = _solve_qp(problem, solver, workspace)
         method = "qp"
     else:
-        asm = workspace.assemble(problem) if workspace is not None else assemble(problem)
-        (C, y), z, used, margin = _closed_form(asm), np.zeros(0), "sparse-lu", 0.0
-        cone_z = None
+        C, y, used, asm = _equality_optimum(problem, workspace)
+        z, margin, cone_z = np.zeros(0), 0.0, None
         method = "closed_form"
     solved = (C, (y, z, cone_z), used, margin, asm)
     return _fit_result(problem, solved, method, time.perf_counter() - start, workspace)
@@ -263,20 +267,40 @@ def _inside_optimum(problem: SmoothingProblem, workspace: Workspace) -> _Solved 
     """
     if not problem.has_inequalities:
         return None
-    asm = workspace.assemble(problem)
-    try:
-        C, y = _closed_form_kkt(asm)
-    except SingularKKTError:
-        return None
+    fast = banded_closed_form(problem, workspace.assembly)
+    blocks: Assembled | _Fixed
+    if fast is not None:
+        C, y, used, blocks = fast.C, fast.y, BANDED, fast.fixed
+    else:
+        asm = workspace.assemble(problem)
+        try:
+            C, y = _closed_form_kkt(asm)
+        except SingularKKTError:
+            return None
+        used, blocks = "sparse-lu", asm
     x = C.ravel()
-    if not np.all(np.isfinite(x)) or np.any(asm.G_ineq @ x > asm.h_ineq):
+    if not np.all(np.isfinite(x)) or np.any(blocks.G_ineq @ x > blocks.h_ineq):
         return None
     cone_z = None
-    if asm.cones is not None:
-        if np.any(asm.cones.norms(x) > asm.cones.radius):
+    if blocks.cones is not None:
+        if np.any(blocks.cones.norms(x) > blocks.cones.radius):
             return None
-        cone_z = np.zeros(asm.cones.radius.size * (problem.dim + 1))
-    return C, (y, np.zeros(asm.G_ineq.shape[0]), cone_z), "sparse-lu", 0.0, asm
+        cone_z = np.zeros(blocks.cones.radius.size * (problem.dim + 1))
+    return C, (y, np.zeros(blocks.G_ineq.shape[0]), cone_z), used, 0.0, blocks
+
+
+def _equality_optimum(
+    problem: SmoothingProblem, workspace: Workspace | None
+) -> tuple[FloatArray, FloatArray, str, Assembled | _Fixed]:
+    """The closed form subject to the equalities: banded Cholesky where the problem is
+    of that form (:mod:`skyquill.optimize.banded`), else one sparse LU of the KKT system.
+    Control points, multipliers, the solver's name and the blocks it met."""
+    fast = banded_closed_form(problem, workspace.assembly if workspace is not None else None)
+    if fast is not None:
+        return fast.C, fast.y, BANDED, fast.fixed
+    asm = workspace.assemble(problem) if workspace is not None else assemble(problem)
+    C, y = _closed_form(asm)
+    return C, y, "sparse-lu", asm
 
 
 def _closed_form(asm: Assembled) -> tuple[FloatArray, FloatArray]:
@@ -431,8 +455,11 @@ def _hull_excess(asm: Assembled, x: FloatArray) -> float:
     return excess
 
 
-#: Control points, the duals ``(y, z, cone_z)``, the backend, the margin, the assembly.
-_Solved = tuple[FloatArray, tuple[FloatArray, FloatArray, FloatArray | None], str, float, Assembled]
+#: Control points, the duals ``(y, z, cone_z)``, the backend, the margin, the assembly
+#: (or, from the banded closed form, the time-independent blocks alone).
+_Solved = tuple[
+    FloatArray, tuple[FloatArray, FloatArray, FloatArray | None], str, float, Assembled | _Fixed
+]
 
 
 def _solve_qp(problem: SmoothingProblem, solver: str, workspace: Workspace | None) -> _Solved:

@@ -120,12 +120,20 @@ def allocate_path_times(
         vmax, np.sqrt(amax / np.maximum(_curvature(pts, ds, resolution), 1e-12))
     )
     v_cap[0] = v_cap[-1] = 0.0
-    v = v_cap.copy()
-    for i in range(1, v.size):  # forward: v_i^2 <= v_{i-1}^2 + 2 a ds
-        v[i] = min(v[i], np.sqrt(v[i - 1] ** 2 + 2 * amax * ds[i - 1]))
-    for i in range(v.size - 2, -1, -1):  # backward
-        v[i] = min(v[i], np.sqrt(v[i + 1] ** 2 + 2 * amax * ds[i]))
+    v = np.sqrt(_reachable(_reachable(v_cap**2, 2.0 * amax * ds)[::-1], 2.0 * amax * ds[::-1]))
+    v = v[::-1]
     return np.concatenate([[0.0], np.cumsum(_interval_times(ds, v[:-1], v[1:], vmax, amax))])
+
+
+def _reachable(cap: FloatArray, gain: FloatArray) -> FloatArray:
+    """The forward pass ``w_i = min(cap_i, w_{i-1} + gain_{i-1})``, ``w_0 = cap_0``, at once.
+
+    With ``S_i = sum_{k<i} gain_k``, ``w_i - S_i = min(cap_i - S_i, w_{i-1} - S_{i-1})``: a
+    running minimum. In squared speeds (``w = v^2``, ``gain = 2 a ds``) this is the
+    profile's pass ``v_i^2 <= v_{i-1}^2 + 2 a ds``, without a Python loop over the samples.
+    """
+    S = np.concatenate([[0.0], np.cumsum(gain)])
+    return np.asarray(np.maximum(np.minimum.accumulate(cap - S) + S, 0.0))
 
 
 def _interval_times(

@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 
 from skyquill.errors import InputError
+from skyquill.io.source import open_binary
 from skyquill.io.table import read_table
 from skyquill.validation import FloatArray, as_array, as_int
 
@@ -33,6 +34,8 @@ MAX_DOTS = 10_000
 #: Largest picture accepted, pixels (checked from the header, before decoding): a 40 Mpx
 #: photo decodes to ~160 MB of RGBA; Pillow's own bomb check stops only at twice 89 Mpx.
 MAX_IMAGE_PIXELS = 40_000_000
+#: Largest picture file read, bytes (a 40 Mpx PNG of noise compresses to ~120 MB).
+MAX_IMAGE_BYTES = 256 * 2**20
 #: The picture formats read: Pillow's others (EPS runs Ghostscript, for one) are refused.
 IMAGE_FORMATS = ("PNG", "JPEG")
 #: Most pixels :func:`stipple` takes: every Lloyd step queries every pixel's
@@ -91,16 +94,19 @@ def load_darkness(path: str | Path) -> FloatArray:
     from PIL import Image
 
     file = Path(path)
-    if not file.is_file():
+    if not file.exists():
         raise InputError(f"--image: got {str(file)!r}, expected an existing PNG or JPEG file")
     try:
-        with warnings.catch_warnings():
+        with (
+            open_binary(file, "a PNG or JPEG picture", max_bytes=MAX_IMAGE_BYTES) as stream,
+            warnings.catch_warnings(),
+        ):
             # Pillow warns from 89 Mpx; our own ceiling, checked next, is lower
             warnings.simplefilter("ignore", Image.DecompressionBombWarning)
-            img = Image.open(file, formats=IMAGE_FORMATS)
-        with img:
+            img = Image.open(stream, formats=IMAGE_FORMATS)
             _check_pixels(file, img.size)
-            img.load()
+            img.load()  # decoded while the file is open
+        with img:
             gray = _gray(img)
     except InputError:
         raise

@@ -226,6 +226,11 @@ class Estimator:
     def update(self, ref_w: FloatArray, contact_rho: FloatArray) -> None:
         """Take one contact: ``ref_w`` the dot aimed at (3,), ``contact_rho`` where (3,), m."""
 
+    def tick(self, battery: int, airborne_s: float) -> None:
+        """The mission's clock before each approach: the battery (0 for the first flight,
+        +1 at every landing) and the time since its take-off, s. The paper's estimators do
+        not use it; one that models the localization's drift (reset at landing) does."""
+
     def plan(self, ref_w: FloatArray) -> Plan:
         """Target and yaw for the dot ``ref_w`` (shape (3,), m, ``R_w``)."""
         return Plan(self.prior.to_rho(ref_w), -self.prior.gamma_rad)

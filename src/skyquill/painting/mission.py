@@ -54,18 +54,20 @@ from skyquill.painting.dots import check_dots
 from skyquill.painting.estimate import (
     Estimator,
     NoEstimator,
+    Plan,
     RigidEstimator,
     SegmentEstimator,
     UpdateMode,
     line_params,
 )
+from skyquill.painting.joint import JointEstimator, WallFit
 from skyquill.painting.order import order_dots
 from skyquill.painting.wall import Placement, Wall, rot2
 from skyquill.validation import FloatArray, as_float
 
 G = 9.81
-EstimatorName = Literal["none", "svd", "robust"]
-ESTIMATORS: tuple[EstimatorName, ...] = ("none", "svd", "robust")
+EstimatorName = Literal["none", "svd", "robust", "joint"]
+ESTIMATORS: tuple[EstimatorName, ...] = ("none", "svd", "robust", "joint")
 WallModel = Literal["auto", "flat", "segments"]
 
 
@@ -203,6 +205,11 @@ class MissionConfig:
     probe
         Touch an extra point far from the first dot before it (§4.1), for the flat-wall
         estimators; it is not painted.
+    probe_spacing_m
+        The joint estimator's probing pass: before the first dot, touch the wall without
+        painting every ``probe_spacing_m`` across the drawing's width (at its mid-height),
+        so that the first dot is painted with the wall and the placement already known.
+        0: no probing pass.
     false_contact_rate, missed_contact_rate
         Probability per approach of a false detection before the wall / of no detection.
     contact
@@ -222,6 +229,7 @@ class MissionConfig:
     tracking_std_m: float = 0.03
     max_travel_factor: float = 2.0
     probe: bool = True
+    probe_spacing_m: float = 0.4
     false_contact_rate: float = 0.0
     missed_contact_rate: float = 0.0
     contact: ContactModel = field(default_factory=ContactModel)
@@ -241,6 +249,7 @@ class MissionConfig:
         ):
             as_float(name, getattr(self, name), positive=True)
         as_float("settle_s", self.settle_s, nonneg=True)
+        as_float("probe_spacing_m", self.probe_spacing_m, nonneg=True)
         as_float("tracking_std_m", self.tracking_std_m, nonneg=True)
         if as_float("max_travel_factor", self.max_travel_factor) <= 1.0:
             raise InputError(
@@ -274,6 +283,10 @@ class MissionResult:
     errors_m
         Painting error per dot, shape (N,), m (NaN if not painted): in the front view
         ``(x, z)`` for ``update="depth"``, the 3-D distance on the wall for ``"normal"``.
+    aim_errors_m
+        The estimate's own share of each dot's error, shape (N,), m: where the dot would
+        land if the drone flew its plan exactly -- no hover error, no localization drift or
+        noise -- measured like ``errors_m`` (NaN if that ray misses the wall within reach).
     order
         Indices into ``reference`` in painting order, shape (N,).
     history
@@ -295,6 +308,7 @@ class MissionResult:
     target_w: FloatArray
     painted_w: FloatArray
     errors_m: FloatArray
+    aim_errors_m: FloatArray
     order: np.ndarray
     flight_time_s: float
     landings: int
@@ -314,6 +328,8 @@ class MissionResult:
     transit_m: float
     path_w: FloatArray
     leg_kinds: tuple[str, ...]
+    battery_s: float
+    wall_fit: WallFit | None = None
 
     @property
     def painted(self) -> np.ndarray:
@@ -332,6 +348,28 @@ class MissionResult:
         e = self.errors_m[self.painted]
         return float(e.max()) if e.size else math.nan
 
+    @property
+    def aim_rmse_m(self) -> float:
+        """Root mean square of :attr:`aim_errors_m` over the dots it exists for, m."""
+        e = self.aim_errors_m[np.isfinite(self.aim_errors_m)]
+        return float(np.sqrt(np.mean(e**2))) if e.size else math.nan
+
+    @property
+    def aim_max_error_m(self) -> float:
+        """Largest of :attr:`aim_errors_m`, m."""
+        e = self.aim_errors_m[np.isfinite(self.aim_errors_m)]
+        return float(e.max()) if e.size else math.nan
+
+    @property
+    def probes(self) -> int:
+        """Approaches that painted nothing on purpose (§4.1's point, the probing pass)."""
+        return int(np.count_nonzero(self.history["dot"] < 0))
+
+    @property
+    def battery_use(self) -> float:
+        """Flight time in batteries (``flight_time_s / battery_s``): 2.4 is two and a half."""
+        return self.flight_time_s / self.battery_s
+
     def summary(self) -> dict[str, Any]:
         """The JSON-able summary (``summary.json``)."""
 
@@ -341,11 +379,15 @@ class MissionResult:
         return {
             "rmse_m": self.rmse_m,
             "max_error_m": self.max_error_m,
+            "aim_rmse_m": self.aim_rmse_m,
+            "aim_max_error_m": self.aim_max_error_m,
             "n_dots": len(self.reference),
             "painted_dots": int(self.painted.sum()),
             "flight_time_s": self.flight_time_s,
+            "battery_use": self.battery_use,
             "transit_m": self.transit_m,
             "landings": self.landings,
+            "probes": self.probes,
             "contacts": self.contacts,
             "false_contacts": self.false_contacts,
             "missed_contacts": self.missed_contacts,
@@ -356,6 +398,7 @@ class MissionResult:
             "localization": self.localization,
             "update": self.update,
             "wall_angles_deg": [math.degrees(a) for a in self.wall.angles_rad],
+            "wall_fit": None if self.wall_fit is None else self.wall_fit.summary(),
         }
 
 
@@ -365,19 +408,31 @@ def make_estimator(
     *,
     segments: bool,
     update: UpdateMode = "depth",
+    localization: Localization | None = None,
 ) -> Estimator:
-    """``none`` / ``svd`` / ``robust``; with ``segments`` the line model of §5 is used."""
+    """``none`` / ``svd`` / ``robust`` (paper 002: with ``segments`` the line model of §5) or
+    ``joint`` (placement and wall together, :mod:`skyquill.painting.joint`)."""
     if name not in ESTIMATORS:
         raise InputError(f"--estimator: got {name!r}, expected one of {', '.join(ESTIMATORS)}")
     if name == "none":
         return NoEstimator(prior)
+    if name == "joint":
+        spec = localization or Localization()
+        return JointEstimator(
+            prior,
+            update=update,
+            noise_m=spec.noise_m,
+            drift_m_per_sqrt_s=spec.drift_m_per_sqrt_s,
+        )
     if segments:
         return SegmentEstimator(prior, update=update, robust=name == "robust")
     return RigidEstimator(prior, robust=name == "robust")
 
 
-def check_on_wall(dots: FloatArray, wall: Wall) -> None:
-    """InputError if a dot lies outside the wall's extent."""
+def check_on_wall(
+    dots: FloatArray, wall: Wall, *, name: str = "dots", wall_name: str = "the wall"
+) -> None:
+    """InputError naming ``name`` (and ``wall_name``) if a dot lies outside the wall's extent."""
     x0, x1 = wall.x_range_m
     outside = (
         (dots[:, 0] < x0) | (dots[:, 0] > x1) | (dots[:, 1] < 0) | (dots[:, 1] > wall.height_m)
@@ -385,9 +440,9 @@ def check_on_wall(dots: FloatArray, wall: Wall) -> None:
     if outside.any():
         i = int(np.flatnonzero(outside)[0])
         raise InputError(
-            f"dots: got {int(outside.sum())} dot(s) outside the wall, the first (row {i + 1}) at "
-            f"x={dots[i, 0]:g}, z={dots[i, 1]:g} m; expected {x0:g} <= x <= {x1:g} and "
-            f"0 <= z <= {wall.height_m:g} m"
+            f"{name}: got {int(outside.sum())} dot(s) outside the wall, the first (row {i + 1}) "
+            f"at x={dots[i, 0]:g}, z={dots[i, 1]:g} m; expected {x0:g} <= x <= {x1:g} and "
+            f"0 <= z <= {wall.height_m:g} m ({wall_name})"
         )
 
 
@@ -404,6 +459,12 @@ class _Flight:
         rng: np.random.Generator,
     ) -> None:
         self.wall, self.truth, self.loc, self.cfg, self.rng = wall, truth, loc, config, rng
+        # Each approach draws its hover error, IMU noise, faults and localization noise from
+        # its own stream, keyed by the dot (or probe) it is for: the same dot gets the same
+        # draws whatever the estimator, the order or the probes before it, so that two
+        # missions differ by what they decide, not by which dot drew which luck (common random
+        # numbers). The drift, a function of the time flown, stays on ``rng``.
+        self.base = int(rng.integers(2**62))
         self.t = 0.0  # flight time, s
         self.t_air = 0.0  # since the last take-off, s
         self.drift = np.zeros(3)
@@ -456,8 +517,11 @@ class _Flight:
         self.yaw_drift = 0.0
         return True
 
-    def touch(self, wait_rho: FloatArray, yaw_rad: float) -> tuple[FloatArray | None, FloatArray]:
-        """Approach from ``wait_rho`` with yaw ``yaw_rad``; retreat.
+    def touch(
+        self, wait_rho: FloatArray, yaw_rad: float, key: tuple[int, int]
+    ) -> tuple[FloatArray | None, FloatArray]:
+        """Approach from ``wait_rho`` with yaw ``yaw_rad``; retreat. ``key``: (0, dot) or
+        (1, probe), the approach's random stream.
 
         Returns
         -------
@@ -466,7 +530,7 @@ class _Flight:
         painted_w : numpy.ndarray (3,)
             The touch point on the wall (NaN if the tool never touched it).
         """
-        cfg, rng = self.cfg, self.rng
+        cfg, rng = self.cfg, np.random.default_rng([self.base, *key])
         self.transit(wait_rho)
         self.fly(cfg.settle_s)
         # the drone holds the *believed* waiting point: truly it is off by the drift
@@ -483,7 +547,7 @@ class _Flight:
             short = rng.uniform(0.05, max(0.06, min(hit, travel_max) - 0.02))
             stop = max(min(hit, travel_max) - short, 0.0)
             self.false_contacts += 1
-            return self._measure(start_w, u, stop), nan3
+            return self._measure(start_w, u, stop, rng), nan3
         if hit > travel_max:  # nothing within reach (or parallel): give up, come back
             self.fly(travel_max / cfg.approach_speed_mps + travel_max / cfg.retreat_speed_mps)
             self._reach(np.array([*(start_w[:2] + travel_max * u), start_w[2]]), "approach")
@@ -500,16 +564,31 @@ class _Flight:
             self._reach(start_w, "retreat")
             return None, painted
         self.fly(delay)
-        return self._measure(start_w, u, hit + squeeze), painted
+        return self._measure(start_w, u, hit + squeeze, rng), painted
 
-    def _measure(self, start_w: FloatArray, u: FloatArray, stop: float) -> FloatArray:
+    def aim(self, wait_rho: FloatArray, yaw_rad: float) -> FloatArray:
+        """Where the tool would touch flying the plan exactly, (3,), ``R_w`` (NaN: no wall).
+
+        The drone truly at the believed waiting point, no hover error, heading truly as
+        planned: what is left of the dot's error is the estimate's.
+        """
+        start_w = self.truth.to_w(wait_rho)
+        u = rot2(self.truth.gamma_rad + yaw_rad) @ np.array([0.0, 1.0])
+        hit = self.wall.hit(start_w[:2], u)
+        if hit > self.cfg.max_travel_factor * self.cfg.waiting_distance_m:
+            return np.full(3, np.nan)
+        return np.array([*(start_w[:2] + max(hit, 0.0) * u), start_w[2]])
+
+    def _measure(
+        self, start_w: FloatArray, u: FloatArray, stop: float, rng: np.random.Generator
+    ) -> FloatArray:
         """Contact detected after ``stop`` m of approach: record it and retreat."""
         where_w = np.array([*(start_w[:2] + stop * u), start_w[2]])
         self.fly(stop / self.cfg.approach_speed_mps)
         self.contacts += 1
         self.contacts_w.append(where_w)
         believed = self.truth.to_rho(where_w) + self.drift  # the drift at the contact
-        measured = believed + self.rng.normal(0.0, self.loc.noise_m, 3)
+        measured = believed + rng.normal(0.0, self.loc.noise_m, 3)
         self.fly(stop / self.cfg.retreat_speed_mps)
         self._reach(where_w, "approach")
         self._reach(start_w, "retreat")
@@ -522,6 +601,16 @@ def _probe_dot(dots: FloatArray, first: int) -> FloatArray:
     lo, hi = dots[:, 0].min(), dots[:, 0].max()
     x_far = lo if abs(x_first - lo) >= abs(x_first - hi) else hi
     return np.array([x_far, 0.0, dots[first, 1]])
+
+
+def probing_pass(dots: FloatArray, spacing_m: float) -> FloatArray:
+    """Points to touch before painting: across the drawing's width every ``spacing_m`` (at
+    least its two ends), at its mid-height, left to right; shape (P, 3), ``R_w`` (y = 0)."""
+    lo, hi = float(dots[:, 0].min()), float(dots[:, 0].max())
+    count = max(2, math.ceil((hi - lo) / spacing_m - 1e-9) + 1) if hi > lo else 1
+    x = np.linspace(lo, hi, count)
+    z = 0.5 * float(dots[:, 1].min() + dots[:, 1].max())
+    return np.column_stack([x, np.zeros_like(x), np.full_like(x, z)])
 
 
 def _target_w(dots: FloatArray, wall: Wall, update: str) -> FloatArray:
@@ -563,7 +652,8 @@ def run_mission(
     localization
         ``"onboard"``, ``"truth"`` or a :class:`Localization`.
     order
-        ``"given"``, ``"paper"`` (right to left, top to bottom) or ``"shortest"``.
+        ``"given"``, ``"paper"`` (right to left, top to bottom), ``"shortest"`` or
+        ``"spread"`` (:mod:`skyquill.painting.order`).
     update
         Segment model only: ``"depth"`` (eq. 15) or ``"normal"`` (fresco).
     wall_model
@@ -590,24 +680,41 @@ def run_mission(
     est = (
         estimator
         if isinstance(estimator, Estimator)
-        else make_estimator(estimator, cfg.prior, segments=segments, update=update)
+        else make_estimator(
+            estimator, cfg.prior, segments=segments, update=update, localization=loc
+        )
     )
     home_w = truth.to_w(np.zeros(3))
-    route = order_dots(dots, order, start_xz=np.array([home_w[0], 0.0]))
+    probes = np.zeros((0, 3))
+    if isinstance(est, JointEstimator) and cfg.probe_spacing_m > 0 and len(dots) > 1:
+        probes = probing_pass(dots, cfg.probe_spacing_m)
+    # after a probing pass the dots start in front of the take-off point, where a turned
+    # estimate moves a dot least (the lever is the distance from the take-off point), and
+    # move out as the contacts pin the placement down
+    start_xz = np.array([home_w[0], probes[0, 2]]) if len(probes) else np.array([home_w[0], 0.0])
+    route = order_dots(dots, order, start_xz=start_xz)
     flight = _Flight(wall=wall, truth=truth, loc=loc, config=cfg, rng=rng)
     painted = np.full((len(dots), 3), np.nan)
+    aimed = np.full((len(dots), 3), np.nan)
     hist: dict[str, list[Any]] = {k: [] for k in _HISTORY_KEYS}
     target = _target_w(dots, wall, update)
-    queue = [(int(i), np.array([dots[i, 0], 0.0, dots[i, 1]])) for i in route]
+    queue = [(-1, p) for p in probes]
+    queue += [(int(i), np.array([dots[i, 0], 0.0, dots[i, 1]])) for i in route]
     if cfg.probe and isinstance(est, RigidEstimator) and len(dots) > 1:
         queue.insert(0, (-1, _probe_dot(dots, int(route[0]))))
     for done, (i, ref_w) in enumerate(queue):
-        plan = est.plan(ref_w)
-        wait = plan.target_rho.copy()
-        wait[:2] -= cfg.waiting_distance_m * plan.direction_rho
+        est.tick(flight.landings, flight.t_air)
+        plan, wait = _planned(est, ref_w, cfg)
         landed = flight.land_if_needed(wait)
-        measured, touch_w = flight.touch(wait, plan.yaw_rad)
+        if landed:  # the localization was reset on the ground: plan again for the new flight
+            est.tick(flight.landings, flight.t_air)
+            plan, wait = _planned(est, ref_w, cfg)
+        if i >= 0:
+            aimed[i] = flight.aim(wait, plan.yaw_rad)
+        key = (0, i) if i >= 0 else (1, done)
+        measured, touch_w = flight.touch(wait, plan.yaw_rad, key)
         if measured is not None:
+            est.tick(flight.landings, flight.t_air)
             est.update(ref_w, measured)
         if i >= 0:
             painted[i] = touch_w
@@ -618,6 +725,7 @@ def run_mission(
             progress(done + 1, len(queue))
     flight.transit(np.zeros(3))  # home for good
     errors = _errors(painted, target, update)
+    aim_errors = _errors(aimed, target, update)
     dot_of = np.array(hist["dot"], dtype=int)
     hist["error_m"] = list(np.where(dot_of >= 0, errors[np.maximum(dot_of, 0)], np.nan))
     return MissionResult(
@@ -625,6 +733,7 @@ def run_mission(
         target_w=target,
         painted_w=painted,
         errors_m=errors,
+        aim_errors_m=aim_errors,
         order=route,
         flight_time_s=flight.t,
         landings=flight.landings,
@@ -636,15 +745,34 @@ def run_mission(
         truth=truth,
         history={k: np.array(v) for k, v in hist.items()},
         contacts_w=np.array(flight.contacts_w, dtype=float).reshape(-1, 3),
-        lines_rho=line_params(est.lines) if isinstance(est, SegmentEstimator) else np.zeros((0, 4)),
+        lines_rho=_lines_rho(est),
         wall=wall,
         estimator=est.name,
         localization=loc.name,
-        update=update if isinstance(est, SegmentEstimator) else "rigid",
+        update=update if isinstance(est, SegmentEstimator | JointEstimator) else "rigid",
         transit_m=flight.transit_m,
         path_w=np.array(flight.path_w),
         leg_kinds=tuple(flight.leg_kinds),
+        battery_s=cfg.battery_s,
+        wall_fit=est.fit if isinstance(est, JointEstimator) else None,
     )
+
+
+def _planned(est: Estimator, ref_w: FloatArray, cfg: MissionConfig) -> tuple[Plan, FloatArray]:
+    """The estimator's plan for ``ref_w`` and its waiting point ``Delta`` before the target."""
+    plan = est.plan(ref_w)
+    wait = plan.target_rho.copy()
+    wait[:2] -= cfg.waiting_distance_m * plan.direction_rho
+    return plan, wait
+
+
+def _lines_rho(est: Estimator) -> FloatArray:
+    """The wall lines an estimator holds, ``[a, b, x_lo, x_hi]`` in ``R_rho``, (L, 4)."""
+    if isinstance(est, SegmentEstimator):
+        return line_params(est.lines)
+    if isinstance(est, JointEstimator):
+        return est.lines_rho()
+    return np.zeros((0, 4))
 
 
 _HISTORY_KEYS = (

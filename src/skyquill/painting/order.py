@@ -8,10 +8,15 @@
   point: nearest neighbour, then 2-opt (segment reversals) until no reversal shortens it. The
   flight between two dots is a straight transit between their waiting points, which lie on a
   copy of the drawing moved off the wall, so the distance between dots is the transit length.
+* ``spread`` -- information early: first one dot every ``spacing_m`` across the drawing's
+  width (the dot nearest each mark at mid-height, swept from the end nearer the start), so
+  that the first contacts span the wall; then the shortest tour over the rest. (The other way
+  to get them, a probing pass that does not paint, is the mission's ``probe_spacing_m``.)
 """
 
 from __future__ import annotations
 
+import math
 from typing import Literal
 
 import numpy as np
@@ -20,28 +25,72 @@ from skyquill.errors import InputError
 from skyquill.painting.dots import nearest_spacing
 from skyquill.validation import FloatArray
 
-OrderName = Literal["given", "paper", "shortest"]
-ORDERS: tuple[OrderName, ...] = ("given", "paper", "shortest")
+OrderName = Literal["given", "paper", "shortest", "spread"]
+ORDERS: tuple[OrderName, ...] = ("given", "paper", "shortest", "spread")
+#: Distance between the first dots of the ``spread`` order, m.
+SPREAD_SPACING_M = 0.4
 #: Above this many dots 2-opt (O(N^2) per pass) is skipped; nearest neighbour alone is used.
 TWO_OPT_MAX_DOTS = 3000
 
 
-def order_dots(dots: FloatArray, method: str, *, start_xz: FloatArray | None = None) -> np.ndarray:
+def order_dots(
+    dots: FloatArray,
+    method: str,
+    *,
+    start_xz: FloatArray | None = None,
+    spacing_m: float = SPREAD_SPACING_M,
+) -> np.ndarray:
     """Indices of ``dots`` (N, 2) in painting order, shape (N,), ints.
 
     ``start_xz`` (2,) is where the drone comes from (the take-off point seen on the wall), used
-    by ``shortest`` only; ``None`` means ``(0, 0)``.
+    by ``shortest`` and ``spread``; ``None`` means ``(0, 0)``. ``spacing_m``: ``spread`` only.
     """
+    start = np.zeros(2) if start_xz is None else np.asarray(start_xz, dtype=float)
     if method == "given":
         return np.arange(len(dots))
     if method == "paper":
         return paper_order(dots)
     if method == "shortest":
-        start = np.zeros(2) if start_xz is None else start_xz
         first = int(np.argmin(np.linalg.norm(dots - start, axis=1)))
-        route = nearest_neighbour(dots, first)
-        return two_opt(dots, route) if len(dots) <= TWO_OPT_MAX_DOTS else route
+        return _tour(dots, np.arange(len(dots)), first)
+    if method == "spread":
+        return spread_order(dots, start, spacing_m)
     raise InputError(f"--order: got {method!r}, expected one of {', '.join(ORDERS)}")
+
+
+def _tour(dots: FloatArray, among: np.ndarray, first: int) -> np.ndarray:
+    """Nearest neighbour + 2-opt over ``dots[among]`` from ``among[first]``: indices into dots."""
+    sub = dots[among]
+    route = nearest_neighbour(sub, first)
+    if len(sub) <= TWO_OPT_MAX_DOTS:
+        route = two_opt(sub, route)
+    out: np.ndarray = among[route]
+    return out
+
+
+def spread_order(dots: FloatArray, start_xz: FloatArray, spacing_m: float) -> np.ndarray:
+    """The ``spread`` order: dots one ``spacing_m`` apart across the width, then a short tour."""
+    lo, hi = float(dots[:, 0].min()), float(dots[:, 0].max())
+    count = max(2, math.ceil((hi - lo) / spacing_m - 1e-9) + 1) if hi > lo else 1
+    marks = np.linspace(lo, hi, count)
+    if abs(start_xz[0] - hi) < abs(start_xz[0] - lo):
+        marks = marks[::-1]  # sweep from the end nearer the start
+    mid = 0.5 * float(dots[:, 1].min() + dots[:, 1].max())
+    first: list[int] = []
+    taken = np.zeros(len(dots), dtype=bool)
+    for x in marks:
+        cost = np.abs(dots[:, 0] - x) + 0.1 * np.abs(dots[:, 1] - mid)
+        cost[taken] = np.inf
+        k = int(np.argmin(cost))
+        if np.isfinite(cost[k]):
+            first.append(k)
+            taken[k] = True
+    rest = np.flatnonzero(~taken)
+    if rest.size == 0:
+        return np.array(first, dtype=int)
+    last = dots[first[-1]]
+    begin = int(np.argmin(np.linalg.norm(dots[rest] - last, axis=1)))
+    return np.concatenate([np.array(first, dtype=int), _tour(dots, rest, begin)])
 
 
 def paper_order(dots: FloatArray) -> np.ndarray:

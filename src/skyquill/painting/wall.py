@@ -29,6 +29,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from skyquill.errors import InputError
+from skyquill.io.numbers import parse_number
 from skyquill.validation import FloatArray, as_array, as_float
 
 #: Largest segment angle accepted, deg: a steeper segment is no longer a wall in front of the
@@ -111,6 +112,8 @@ class Wall:
     x_range_m: tuple[float, float] = (-4.0, 4.0)
     height_m: float = 4.0
     _y_at_breaks: FloatArray = field(init=False, repr=False)
+    _anchors: FloatArray = field(init=False, repr=False)
+    _normals: FloatArray = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
         angles = as_array("wall angles", self.angles_rad, ndim=1)
@@ -134,6 +137,9 @@ class Wall:
         object.__setattr__(self, "angles_rad", angles)
         object.__setattr__(self, "breaks_m", breaks)
         object.__setattr__(self, "_y_at_breaks", self._corner_depths())
+        lines = [self.line(k) for k in range(self.n_segments)]
+        object.__setattr__(self, "_anchors", np.array([a for a, _ in lines]))
+        object.__setattr__(self, "_normals", np.array([[-u[1], u[0]] for _, u in lines]))
 
     @classmethod
     def flat(cls, *, x_range_m: tuple[float, float] = (-4.0, 4.0), height_m: float = 4.0) -> Wall:
@@ -160,6 +166,90 @@ class Wall:
             raise InputError(f"wall span: got {span_m}, expected x_min < x_max")
         breaks = lo + (hi - lo) * np.arange(1, angles.size) / angles.size
         return cls(np.radians(angles), breaks, x_range_m, height_m)
+
+    @classmethod
+    def cylinder(
+        cls,
+        radius_m: float,
+        *,
+        x_range_m: tuple[float, float] = (-4.0, 4.0),
+        height_m: float = 4.0,
+        step_deg: float = 0.5,
+    ) -> Wall:
+        """A vertical cylinder touching ``y_w = 0`` at ``x_w = 0``, as a fine polygon.
+
+        ``radius_m > 0`` puts the axis behind the wall (a round tower seen from outside: the
+        wall recedes from the drone on both sides); ``radius_m < 0`` in front of it (inside a
+        round hall). The polygon is circumscribed: its segments are tangent to the circle at
+        every ``step_deg`` of arc, the one holding ``x_w = 0`` along ``x_w`` through the origin,
+        so it stays within ``|R| (1 / cos(step / 2) - 1)`` of the circle (0.2 mm for R = 20 m).
+
+        Raises
+        ------
+        InputError
+            A radius so small that the wall over ``x_range_m`` turns by more than
+            :data:`MAX_WALL_ANGLE_DEG`.
+        """
+        r = as_float("cylinder radius", radius_m)
+        x0, x1 = (as_float("wall x range", v) for v in x_range_m)
+        reach = max(abs(x0), abs(x1))
+        step = math.radians(as_float("step_deg", step_deg, positive=True))
+        # the outermost tangent point the extent needs, and its angle
+        need = math.sin(math.radians(MAX_WALL_ANGLE_DEG)) * abs(r)
+        if not math.isfinite(r) or abs(r) <= 0 or reach >= need:
+            smallest = reach / math.sin(math.radians(MAX_WALL_ANGLE_DEG))
+            raise InputError(
+                f"cylinder radius: got {r:g} m, expected |radius| > {smallest:.3g} m so that the "
+                f"wall over x from {x0:g} to {x1:g} m turns by less than {MAX_WALL_ANGLE_DEG:g} deg"
+            )
+        half = math.asin(reach / abs(r))
+        m = math.ceil(half / step + 0.5)
+        k = np.arange(-m, m + 1)
+        angles = (k * step * math.copysign(1.0, r)).astype(np.float64)
+        # corner between the tangents at k * step and (k + 1) * step
+        mid = (k[:-1] + 0.5) * step
+        breaks = abs(r) / math.cos(step / 2) * np.sin(mid)
+        first = int(np.searchsorted(breaks, x0, side="right"))  # the segments over the extent
+        last = int(np.searchsorted(breaks, x1, side="left"))
+        return cls(angles[first : last + 1], breaks[first:last], (x0, x1), height_m)
+
+    @classmethod
+    def recess(
+        cls,
+        x_from_m: float,
+        x_to_m: float,
+        depth_m: float,
+        *,
+        side_deg: float = MAX_WALL_ANGLE_DEG,
+        x_range_m: tuple[float, float] = (-4.0, 4.0),
+        height_m: float = 4.0,
+    ) -> Wall:
+        """The flat wall ``y_w = 0`` with a recess ``depth_m`` deep from ``x_from_m`` to ``x_to_m``.
+
+        The recess's sides slope at ``side_deg`` (a ``y = f(x)`` wall cannot have sides at 90
+        deg; at 60 deg a 10 cm recess has 5.8 cm wide sides). It must not hold ``x_w = 0``: the
+        wall frame is the wall in front of the take-off point.
+        """
+        a, b = as_float("recess from", x_from_m), as_float("recess to", x_to_m)
+        depth = as_float("recess depth", depth_m, positive=True)
+        side = as_float("recess side angle", side_deg, positive=True)
+        if side > MAX_WALL_ANGLE_DEG:
+            raise InputError(
+                f"recess side angle: got {side:g} deg, expected at most {MAX_WALL_ANGLE_DEG:g} deg"
+            )
+        run = depth / math.tan(math.radians(side))
+        if not b - a > 2 * run:
+            raise InputError(
+                f"recess: got from {a:g} to {b:g} m, expected a recess wider than its two sides "
+                f"({2 * run:.3g} m at {depth:g} m deep and {side:g} deg)"
+            )
+        if a <= 0.0 <= b:
+            raise InputError(
+                f"recess: got from {a:g} to {b:g} m, expected it beside x = 0 (the wall frame "
+                "is the wall in front of the take-off point)"
+            )
+        angles = np.radians([0.0, side, 0.0, -side, 0.0])
+        return cls(angles, np.array([a, a + run, b - run, b]), x_range_m, height_m)
 
     @property
     def n_segments(self) -> int:
@@ -220,17 +310,14 @@ class Wall:
         within 90 deg of every normal, ``g(t) = y(t) - f(x(t))`` increases with ``t``, so the
         root is unique: each segment's line is tried and the root inside that segment kept.
         """
-        for k in range(self.n_segments):
-            anchor, u = self.line(k)
-            n = np.array([-u[1], u[0]])
-            along = float(direction @ n)
-            if along <= 1e-12:
-                continue
-            t = float((anchor - start) @ n) / along
-            x = float(start[0] + t * direction[0])
-            if int(self.segment_of(np.array([x]))[0]) == k:
-                return t
-        return math.inf
+        along = self._normals @ direction
+        facing = along > 1e-12
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t = np.einsum("kj,kj->k", self._anchors - start, self._normals) / along
+        x = start[0] + t * direction[0]
+        own = facing & (self.segment_of(np.where(facing, x, 0.0)) == np.arange(self.n_segments))
+        hits = np.flatnonzero(own)
+        return float(t[hits[0]]) if hits.size else math.inf
 
     def foot(self, p_w: FloatArray) -> FloatArray:
         """Foot of the perpendicular from ``p_w`` (xy, shape (N, 2)) to the wall, shape (N, 2).
@@ -255,10 +342,10 @@ def parse_angles(text: str) -> list[float]:
     """``"-10,0,10"`` (or ``"-10|0|10"``) into degrees; InputError naming ``--wall-angles``."""
     parts = [p.strip() for p in text.replace("|", ",").split(",")]
     try:
-        values = [float(p) for p in parts]
+        values = [parse_number(p) for p in parts]
     except ValueError:
         values = []
-    if not values or not all(math.isfinite(v) for v in values):
+    if not values:
         raise InputError(
             f"--wall-angles: got {text!r}, expected comma-separated finite angles in degrees, "
             "e.g. -10,0,10"

@@ -413,6 +413,15 @@ def run_corridor_study(
         if on_step is not None:
             on_step(ms.index(m) + 1, len(ms))
 
+    if not any(r["feasible"] for r in records):
+        # Nothing to compare: a study with no solve is not a reproduction (and would
+        # otherwise report every claim about no data as held).
+        raise InfeasibleError(
+            f"corridor: got no feasible solve for any of M = {ms[0]}..{ms[-1]} control points "
+            f"and {len(names)} variant(s) in {Path(corridor_path).name}, expected boxes that "
+            "overlap in a chain from start to goal",
+            ("corridor",),
+        )
     summary = _summarise(records, ms, names)
     summary["settings"] = {
         "corridor": str(corridor_path),
@@ -508,7 +517,7 @@ def _summarise(records: list[dict[str, Any]], ms: list[int], names: list[str]) -
         dec_smallest is None or min(coupled_smallest) < dec_smallest
     )
     any_both = any(ratios[n] is not None for n in names[1:])
-    lower_all = all(lower.values())
+    lower_all = any_both and all(lower.values())  # no pair of solves compared: not held
     time_vals = [t for t in time_ratios.values() if t is not None]
     if violations:
         log.warning("coupled cost above decoupled at %s", violations)

@@ -27,6 +27,7 @@ from scipy.optimize import linear_sum_assignment
 from scipy.spatial.distance import cdist
 
 from skyquill.io.trajectory_json import PlannedTrajectory
+from skyquill.show.capt import CAPT_SPREAD
 from skyquill.show.check import require_separation
 from skyquill.show.formation import (
     Formation,
@@ -35,10 +36,11 @@ from skyquill.show.formation import (
     home_grid,
     shape_formation,
 )
+from skyquill.show.layers import step_out
 from skyquill.show.limits import check_inside
 from skyquill.show.load import ShowDrone
 from skyquill.show.moves import hold, staggered
-from skyquill.show.route import leg_limits, plan_moves, route_to
+from skyquill.show.route import Route, leg_limits, plan_moves, route_to
 from skyquill.show.script import (
     RGB,
     FormationScene,
@@ -49,7 +51,7 @@ from skyquill.show.script import (
     Takeoff,
     WriteScene,
 )
-from skyquill.show.transition import Transition
+from skyquill.show.transition import PLAN_MARGIN, Transition
 from skyquill.show.writing import plan_writing_scene
 from skyquill.trajectory import PiecewisePolynomial, Trajectory, concatenate
 from skyquill.validation import FloatArray
@@ -214,16 +216,17 @@ def _fly(
     scene: Scene, script: ShowScript, line: _Timeline, homes: FloatArray, where: _Where
 ) -> tuple[str, dict[str, Any]]:
     if isinstance(scene, Takeoff):
-        _climb(line, homes, homes + np.array([0.0, 0.0, scene.altitude_m]), scene.stagger_s, script)
+        _climb(line, homes, _air(homes, scene.altitude_m, script), scene.stagger_s, script)
         return "takeoff", {"altitude_m": scene.altitude_m}
     if isinstance(scene, FormationScene):
         formation = make_formation(scene, script)
-        _, curtain = _reform(line, formation.points, script)
+        route = _reform(line, formation.points, script)
         line.hold(scene.hold_s, scene.color)
         return "formation", {
             "shape": formation.name,
             "spacing_m": formation.spacing_m,
-            "via_curtain": curtain,
+            "via_curtain": route.via_curtain,
+            "transition": _described(route),
         }
     if isinstance(scene, WriteScene):
         return "write", _write(scene, script, line, where)
@@ -231,10 +234,15 @@ def _fly(
         line.hold(scene.duration_s, scene.color)
         return "hold", {}
     assert isinstance(scene, Land)
-    air = homes + np.array([0.0, 0.0, scene.altitude_m])
-    pads, curtain = _reform(line, air, script)
+    air = _air(homes, scene.altitude_m, script)
+    route = _reform(line, air, script)
+    pads = route.chosen
     _climb(line, air[pads], homes[pads], scene.stagger_s, script)
-    return "land", {"altitude_m": scene.altitude_m, "via_curtain": curtain}
+    return "land", {
+        "altitude_m": scene.altitude_m,
+        "via_curtain": route.via_curtain,
+        "transition": _described(route),
+    }
 
 
 def make_formation(scene: FormationScene, script: ShowScript) -> Formation:
@@ -258,6 +266,18 @@ def make_formation(scene: FormationScene, script: ShowScript) -> Formation:
     return shape_formation(strokes, n, origin=scene.origin, size_m=scene.size_m, spacing_m=spacing)
 
 
+def _air(homes: FloatArray, altitude_m: float, script: ShowScript) -> FloatArray:
+    """Where the drones climb to above the pads (N, 3): ``altitude_m`` up, in layers if tight.
+
+    Pads closer than ``sqrt(2)`` times the safety distance would need a step out of
+    the air grid's plane before every transition (:mod:`skyquill.show.capt`); the
+    climb takes every other drone a layer higher instead (:func:`~skyquill.show.layers.step_out`).
+    """
+    air = homes + np.array([0.0, 0.0, altitude_m])
+    layers = step_out(air, CAPT_SPREAD * script.safety_m * (1.0 + PLAN_MARGIN))
+    return air if layers is None else layers.points
+
+
 def _climb(
     line: _Timeline, starts: FloatArray, goals: FloatArray, stagger_s: float, script: ShowScript
 ) -> None:
@@ -267,12 +287,23 @@ def _climb(
     line.append(list(flights), duration)
 
 
-def _reform(line: _Timeline, targets: FloatArray, script: ShowScript) -> tuple[IntArray, bool]:
-    """Fly to ``targets`` (:func:`~skyquill.show.route.route_to`): targets taken, curtain flown."""
+def _reform(line: _Timeline, targets: FloatArray, script: ShowScript) -> Route:
+    """Fly to ``targets`` (:func:`~skyquill.show.route.route_to`): the route flown."""
     route = route_to(line.positions, targets, script)
     for moves in route.legs:
         _append(line, moves)
-    return route.chosen, route.via_curtain
+    return route
+
+
+def _described(route: Route) -> dict[str, Any]:
+    """A transition for ``summary.json``: how, how long, and against its lower bound."""
+    bound = route.lower_bound_s
+    return {
+        "route": route.how,
+        "duration_s": route.duration,
+        "lower_bound_s": bound,
+        "over_lower_bound": route.duration / bound if bound > 0.0 else 1.0,
+    }
 
 
 def _append(line: _Timeline, moves: Transition) -> None:

@@ -78,13 +78,25 @@ def _resampled(paths: tuple[FloatArray, ...], step: float) -> list[FloatArray]:
 
 
 def _greedy(paths: tuple[FloatArray, ...], spacing: float) -> FloatArray:
-    """Points along ``paths`` in drawing order, each kept if ``spacing`` from all kept, (M, 2)."""
-    kept: list[FloatArray] = []
+    """Points along ``paths`` in drawing order, each kept if ``spacing`` from all kept, (M, 2).
+
+    The kept points are binned in square cells of side ``spacing``: one closer than
+    ``spacing`` lies in the sample's cell or one of its eight neighbours, so each
+    sample is compared with a few points, not with all of them (a thousand drones'
+    shape was 70 s of comparisons).
+    """
+    kept: list[tuple[float, float]] = []
+    cells: dict[tuple[int, int], list[tuple[float, float]]] = {}
     for sample in _resampled(paths, spacing / DENSITY):
-        for p in sample:
-            if not kept or np.min(np.hypot(*(np.asarray(kept) - p).T)) >= spacing:
-                kept.append(p)
-    return np.asarray(kept)
+        for u, v in sample.tolist():
+            i, j = math.floor(u / spacing), math.floor(v / spacing)
+            near = (
+                q for di in (-1, 0, 1) for dj in (-1, 0, 1) for q in cells.get((i + di, j + dj), ())
+            )
+            if all(math.hypot(q[0] - u, q[1] - v) >= spacing for q in near):
+                kept.append((u, v))
+                cells.setdefault((i, j), []).append((u, v))
+    return np.asarray(kept, dtype=float).reshape(-1, 2)
 
 
 def shape_formation(

@@ -18,8 +18,10 @@ import numpy as np
 import shapely
 from shapely.geometry import MultiPolygon, Polygon, shape
 
+from skyquill.coverage.regions import check_geojson_polygon, check_wkt_numbers
 from skyquill.errors import InputError
 from skyquill.io.json_read import parse_json
+from skyquill.io.source import read_text
 from skyquill.validation import FloatArray
 
 #: Largest geofence file read, bytes.
@@ -59,16 +61,14 @@ def read_geofence(path: Path, name: str = "--geofence") -> Geofence:
         unreadable file, malformed GeoJSON or WKT, a geometry that is not one valid,
         non-empty polygon (or multipolygon), a ceiling that is not a finite number.
     """
-    if not path.is_file():
+    if not path.exists():
         raise InputError(f"{name}: got {str(path)!r}, expected an existing GeoJSON or WKT file")
-    raw = path.read_bytes()
-    if len(raw) > MAX_BYTES:
-        raise InputError(f"{name}: got {len(raw):,} bytes, expected at most {MAX_BYTES:,}")
-    text = raw.lstrip()
-    if text.startswith(b"{"):
-        area, ceiling = _from_geojson(parse_json(raw, name, "a GeoJSON polygon"), name)
+    text = read_text(path, "a GeoJSON or WKT polygon", max_bytes=MAX_BYTES, name=name)
+    if text.lstrip().startswith("{"):
+        area, ceiling = _from_geojson(parse_json(text.encode(), name, "a GeoJSON polygon"), name)
     else:
-        area, ceiling = _from_wkt(raw.decode("utf-8", errors="replace"), name), None
+        check_wkt_numbers(text, name)
+        area, ceiling = _from_wkt(text, name), None
     return Geofence(_checked(area, name), ceiling)
 
 
@@ -90,6 +90,7 @@ def _from_geojson(data: Any, name: str) -> tuple[Any, float | None]:
             properties.get("ceiling_m") if isinstance(properties, dict) else None, name
         )
         data = data.get("geometry")
+    check_geojson_polygon(data, name)
     try:
         return shape(data), ceiling
     except (AttributeError, KeyError, TypeError, ValueError, IndexError) as exc:

@@ -21,6 +21,9 @@ from skyquill.show.report import Measured, Violation
 from skyquill.trajectory import dense_times
 from skyquill.validation import FloatArray, as_float
 
+#: Largest relative excess over the speed and acceleration limits a check may allow.
+MAX_TOLERANCE = 0.05
+
 
 @dataclass(frozen=True)
 class ShowLimits:
@@ -38,6 +41,10 @@ class ShowLimits:
         Altitude range (z), m.
     geofence
         Where the drones may fly (x, y) and its ceiling.
+    tolerance
+        Relative excess allowed over the speed and acceleration limits, in [0, 0.05]: a show
+        as Skybrush plays it may be up to 1 % over its plan's limits (what its millimetre
+        grid cannot avoid, ``skyquill.export.base.ALLOWED_EXCESS``); 0 holds them exactly.
     """
 
     max_speed_xy: float | None = 8.0
@@ -47,8 +54,12 @@ class ShowLimits:
     min_altitude: float | None = None
     max_altitude: float | None = 150.0
     geofence: Geofence | None = None
+    tolerance: float = 0.0
 
     def __post_init__(self) -> None:
+        tol = as_float("tolerance", self.tolerance, nonneg=True)
+        if tol > MAX_TOLERANCE:
+            raise InputError(f"tolerance: got {tol:g}, expected 0 to {MAX_TOLERANCE:g}")
         for name in ("max_speed_xy", "max_speed_up", "max_speed_down", "max_acceleration"):
             value = getattr(self, name)
             if value is not None:
@@ -121,7 +132,7 @@ def check_limits(
     series = [_sampled(d) for d in drones]
     violations: list[Violation] = []
     measured: list[Measured] = []
-    for check, limit, value_of, sense in _checks(limits):
+    for check, limit, value_of, sense, slack in _checks(limits):
         worst: Measured | None = None
         for s in series:
             values = value_of(s)
@@ -129,7 +140,7 @@ def check_limits(
             if worst is None or values[k] * sense > worst.value * sense:
                 worst = Measured(check, float(values[k]) + 0.0, limit, s.name, float(s.t[k]))
             if limit is not None:
-                bad = np.flatnonzero(values * sense > limit * sense)
+                bad = np.flatnonzero(values * sense > limit * sense + slack)
                 if bad.size:
                     violations.append(
                         Violation(
@@ -153,21 +164,32 @@ def _sampled(drone: ShowDrone) -> _Series:
     return _Series(drone.name, t + drone.start_s, p, v, a)
 
 
-def _checks(limits: ShowLimits) -> list[tuple[str, float | None, _ValueOf, float]]:
-    """``(name, limit, values of a drone, +1 for an upper / -1 for a lower bound)``."""
-    checks: list[tuple[str, float | None, _ValueOf, float]] = [
-        ("speed_xy", limits.max_speed_xy, _speed_xy, 1.0),
-        ("speed_up", limits.max_speed_up, _speed_up, 1.0),
-        ("speed_down", limits.max_speed_down, _speed_down, 1.0),
-        ("acceleration", limits.max_acceleration, _acceleration, 1.0),
-        ("max_altitude", limits.max_altitude, _altitude, 1.0),
-        ("min_altitude", limits.min_altitude, _altitude, -1.0),
+def _checks(limits: ShowLimits) -> list[tuple[str, float | None, _ValueOf, float, float]]:
+    """``(name, limit, values of a drone, +1 for an upper / -1 for a lower bound, slack)``:
+    the speeds and the acceleration may pass their limit by ``tolerance`` of it."""
+
+    def slack(limit: float | None) -> float:
+        return 0.0 if limit is None else limits.tolerance * abs(limit)
+
+    checks: list[tuple[str, float | None, _ValueOf, float, float]] = [
+        ("speed_xy", limits.max_speed_xy, _speed_xy, 1.0, slack(limits.max_speed_xy)),
+        ("speed_up", limits.max_speed_up, _speed_up, 1.0, slack(limits.max_speed_up)),
+        ("speed_down", limits.max_speed_down, _speed_down, 1.0, slack(limits.max_speed_down)),
+        (
+            "acceleration",
+            limits.max_acceleration,
+            _acceleration,
+            1.0,
+            slack(limits.max_acceleration),
+        ),
+        ("max_altitude", limits.max_altitude, _altitude, 1.0, 0.0),
+        ("min_altitude", limits.min_altitude, _altitude, -1.0, 0.0),
     ]
     fence = limits.geofence
     if fence is not None:
-        checks.append(("geofence", 0.0, lambda s: fence.margin(s.p[:, :2]), -1.0))
+        checks.append(("geofence", 0.0, lambda s: fence.margin(s.p[:, :2]), -1.0, 0.0))
         if fence.ceiling_m is not None:
-            checks.append(("geofence_ceiling", fence.ceiling_m, _altitude, 1.0))
+            checks.append(("geofence_ceiling", fence.ceiling_m, _altitude, 1.0, 0.0))
     return checks
 
 

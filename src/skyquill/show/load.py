@@ -46,24 +46,38 @@ class ShowDrone:
         return self.start_s + self.trajectory.duration
 
 
-def load_show(paths: Sequence[Path]) -> list[ShowDrone]:
+def load_show(paths: Sequence[Path], max_drones: int | None = None) -> list[ShowDrone]:
     """Every drone of ``paths`` (plan directories, trajectory ``.json``/``.csv``, ``.skyc``).
+
+    ``max_drones``: refuse more, counted before a ``.skyc``'s drones are played back
+    (the slow part of reading one).
 
     Raises
     ------
     InputError
-        No path, a path that does not exist or has another suffix, or what the
-        file's reader refuses.
+        No path, a path that does not exist or has another suffix, more drones
+        than ``max_drones``, or what the file's reader refuses.
     """
     if not paths:
         raise InputError("PATH: got none, expected a plan directory, trajectory file or .skyc")
-    drones = [drone for path in paths for drone in _read(Path(path))]
+    drones: list[ShowDrone] = []
+    for path in paths:
+        drones += _read(Path(path), None if max_drones is None else max_drones - len(drones))
+        _check_count(len(drones), max_drones)
     if not drones:  # pragma: no cover - every reader refuses an empty input
         raise InputError("PATH: got no drone, expected at least one")
     return drones
 
 
-def _read(path: Path) -> list[ShowDrone]:
+def _check_count(count: int, max_drones: int | None) -> None:
+    if max_drones is not None and count > max_drones:
+        raise InputError(
+            f"PATH: got {count:,} drones, expected at most {max_drones:,} in one check (check "
+            "the show in parts of fewer drones)"
+        )
+
+
+def _read(path: Path, room: int | None = None) -> list[ShowDrone]:
     if not path.exists():
         raise InputError(
             f"PATH: got {str(path)!r}, which does not exist; expected a plan directory, a "
@@ -76,7 +90,7 @@ def _read(path: Path) -> list[ShowDrone]:
             f"{', '.join(SUFFIXES)}"
         )
     if suffix == ".skyc" and path.is_file():
-        return _read_skyc(path)
+        return _read_skyc(path, room)
     prefix = path.name if path.is_dir() else path.parent.name
     return [
         ShowDrone(planned.trajectory, f"{prefix}/{name}" if prefix else name)
@@ -84,10 +98,15 @@ def _read(path: Path) -> list[ShowDrone]:
     ]
 
 
-def _read_skyc(path: Path) -> list[ShowDrone]:
+def _read_skyc(path: Path, room: int | None = None) -> list[ShowDrone]:
     """The drones of a ``.skyc`` as their firmware plays them, on the show's clock."""
     show = read_show_json(path)
     drones: list[Any] = show["swarm"]["drones"]
+    if room is not None and len(drones) > room:
+        raise InputError(
+            f"PATH: got {path.name} of {len(drones):,} drones, expected at most {room:,} more "
+            "in one check (check the show in parts of fewer drones)"
+        )
     starts = [_firmware_zero(d["settings"]["trajectory"]) for d in drones]
     first = min(starts)  # a takeoff before the first keyframe moves the show's 0 earlier
     return [

@@ -1,20 +1,29 @@
-"""How the drones get from where they are to a set of places: straight, or through a curtain.
+"""How the drones get from where they are to a set of places: the fastest route proven apart.
 
-Straight means one transition (:func:`skyquill.show.transition.plan_transition`:
-assigned, in waves or depth layers, proven apart). Between a formation on a
-vertical plane and the air above the pads, straight moves converge and may
-need many waves, or none may keep the drones apart; then the drones can go
-through a *curtain*: a vertical grid on the formation's plane above the pads'
-columns, spaced at least ``sqrt(2)`` times the safety distance. On one plane
-any formation reaches any other (delays or depth layers: its drones are the
-safety distance apart in x and z, so stepping out along y keeps them apart),
-and a grid at that spacing reaches an air grid as far apart in one wave
-(CAPT). :func:`route_to` flies the shorter of the routes that can be kept apart.
+The routes, each assigned and planned before any is proven:
+
+* **straight**: the minimum-squared-distance assignment and one wave of
+  synchronised straight moves (:func:`skyquill.show.capt.straight`), when no two
+  paths come too close: as fast as the longest move;
+* **layers**: out of a tight formation's plane into depth layers, across in one
+  wave, back into the goals' plane (:func:`skyquill.show.capt.through_layers`): the
+  longest move plus two steps of a few metres;
+* **waves** (:func:`skyquill.show.transition.plan_transition`: delayed starts, or
+  depth layers coloured by conflict) and the **curtain**: a vertical grid on the
+  formation's plane above the pads' columns, spaced at least ``sqrt(2)`` times the
+  safety distance (on one plane any formation reaches any other, and such a grid
+  reaches an air grid as far apart in one wave). These take many waves at scale;
+  they are planned for small shows (:data:`SMALL_SHOW` drones) or when neither route
+  above exists (formations off any plane).
+
+:func:`route_to` proves the fastest (:func:`skyquill.show.transition.prove`) and
+flies it; one the proof refuses gives way to the next.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -22,13 +31,17 @@ from numpy.typing import NDArray
 
 from skyquill.errors import InfeasibleError, InputError
 from skyquill.optimize.legs import LegLimits
+from skyquill.show.capt import lower_bound_s, matchings, straight, straight_to, through_layers
 from skyquill.show.formation import grid_formation
 from skyquill.show.script import ShowScript
-from skyquill.show.transition import Transition, assign, plan_transition
+from skyquill.show.transition import Transition, assign, plan_transition, prove
 from skyquill.validation import FloatArray
 
 #: Spread of y within which points count as one vertical plane, m.
 PLANE_TOLERANCE_M = 1e-6
+#: Shows of at most this many drones also try waves and the curtain (each is planned
+#: and proven in well under a second there; at a thousand drones, many waves).
+SMALL_SHOW = 100
 
 IntArray = NDArray[np.intp]
 
@@ -43,15 +56,22 @@ class Route:
         One transition, or two through the curtain.
     chosen
         Each drone's place: an index into the targets (N,).
+    how
+        ``"straight"``, ``"layers"``, ``"waves"`` or ``"curtain"``.
+    lower_bound_s
+        The shortest any transition to the targets can last (the bottleneck move at
+        the limits, :func:`skyquill.show.capt.lower_bound_s`), s.
     """
 
     legs: tuple[Transition, ...]
     chosen: IntArray
+    how: str = "straight"
+    lower_bound_s: float = 0.0
 
     @property
     def via_curtain(self) -> bool:
         """Whether the drones went through the curtain."""
-        return len(self.legs) > 1
+        return self.how == "curtain"
 
     @property
     def duration(self) -> float:
@@ -59,18 +79,39 @@ class Route:
         return sum(t.duration for t in self.legs)
 
 
+#: The moves are planned this fraction inside the limits: a time-optimal profile touches
+#: them, and the scaled, composed polynomials then exceed them by a rounding error
+#: (2 + 4.4e-16 m/s^2), which ``skyquill check`` at the script's exact limits refuses.
+INSIDE = 1e-9
+
+
 def leg_limits(script: ShowScript) -> LegLimits:
-    """The moves' limits: the show's speed, acceleration and jerk norms."""
+    """The moves' limits: the show's speed, acceleration and jerk norms (:data:`INSIDE` them)."""
     lim = script.limits
     if lim.vmax is None or lim.amax is None or lim.jmax is None:
         raise InputError("[limits]: got a missing limit, expected vmax, amax and jmax")
-    return LegLimits(lim.vmax, lim.amax, lim.jmax)
+    inside = 1.0 - INSIDE
+    return LegLimits(lim.vmax * inside, lim.amax * inside, lim.jmax * inside)
 
 
 def plan_moves(starts: FloatArray, goals: FloatArray, script: ShowScript) -> Transition:
-    """:func:`~skyquill.show.transition.plan_transition` with the show's limits and distance."""
+    """Each drone to its own goal: one wave if no paths come too close, else waves or layers.
+
+    Proven apart (:func:`~skyquill.show.transition.plan_transition` for the waves).
+    """
     names = [f"drone {i}" for i in range(len(goals))]
-    return plan_transition(starts, goals, leg_limits(script), script.safety_m, names)
+    limits, d = leg_limits(script), script.safety_m
+    direct = straight(starts, goals, limits, d)
+    if direct is not None:
+        try:
+            return prove(direct, d, names)
+        except InfeasibleError:
+            pass  # the waves below
+    return plan_transition(starts, goals, limits, d, names)
+
+
+#: A route planned but not yet proven: its duration and how to prove it.
+_Option = tuple[float, Callable[[], Route]]
 
 
 def route_to(start: FloatArray, targets: FloatArray, script: ShowScript) -> Route:
@@ -79,14 +120,63 @@ def route_to(start: FloatArray, targets: FloatArray, script: ShowScript) -> Rout
     Raises
     ------
     InfeasibleError
-        Neither straight nor through the curtain (when either set lies on one
-        vertical plane) can be kept apart: the straight transition's error.
+        No route can be kept apart: the error of the waves' straight transition.
+    """
+    limits, d = leg_limits(script), script.safety_m
+    names = [f"drone {i}" for i in range(len(targets))]
+    matching = matchings(start, targets)
+    bound = lower_bound_s(matching.bottleneck_m, limits)
+    options: list[_Option] = []
+    direct = straight_to(start, targets, limits, d, matching)
+    if direct is not None:
+        route = Route((direct[0],), direct[1], "straight", bound)
+        options.append((route.duration, _proving(route, d, names)))
+    else:
+        layered = through_layers(start, targets, limits, d)
+        if layered is not None:
+            route = Route((layered[0],), layered[1], "layers", bound)
+            options.append((route.duration, _proving(route, d, names)))
+    error: InfeasibleError | None = None
+    if not options or len(start) <= SMALL_SHOW:
+        try:
+            proven = _waves_or_curtain(start, targets, script, bound)
+            options.append((proven.duration, lambda: proven))
+        except InfeasibleError as exc:
+            error = exc
+    for _, prove_it in sorted(options, key=lambda o: o[0]):
+        try:
+            return prove_it()
+        except InfeasibleError as exc:
+            error = error or exc
+    assert error is not None
+    raise error
+
+
+def _proving(route: Route, d: float, names: list[str]) -> Callable[[], Route]:
+    """A route's proof, to run if it is the fastest left."""
+
+    def proven() -> Route:
+        legs = tuple(prove(leg, d, names) for leg in route.legs)
+        return Route(legs, route.chosen, route.how, route.lower_bound_s)
+
+    return proven
+
+
+def _waves_or_curtain(
+    start: FloatArray, targets: FloatArray, script: ShowScript, bound: float
+) -> Route:
+    """The faster of straight moves in waves and the curtain (each proven), as before 1,000 drones.
+
+    Raises
+    ------
+    InfeasibleError
+        Neither can be kept apart: the straight transition's error.
     """
     routes: list[Route] = []
     error: InfeasibleError | None = None
     try:
         chosen = assign(start, targets)
-        routes.append(Route((plan_moves(start, targets[chosen], script),), chosen))
+        routes.append(Route((_legacy(start, targets[chosen], script),), chosen, "waves", bound))
     except InfeasibleError as exc:
         error = exc
     plane = plane_y(start)
@@ -96,15 +186,21 @@ def route_to(start: FloatArray, targets: FloatArray, script: ShowScript) -> Rout
         stage = curtain(script, plane, bottom)
         try:
             staged = stage[assign(start, stage)]
-            first = plan_moves(start, staged, script)
+            first = _legacy(start, staged, script)
             chosen = assign(staged, targets)
-            routes.append(Route((first, plan_moves(staged, targets[chosen], script)), chosen))
+            second = _legacy(staged, targets[chosen], script)
+            routes.append(Route((first, second), chosen, "curtain", bound))
         except InfeasibleError:
             pass  # the straight route's error (or success) stands
     if not routes:
         assert error is not None
         raise error
     return min(routes, key=lambda r: r.duration)
+
+
+def _legacy(starts: FloatArray, goals: FloatArray, script: ShowScript) -> Transition:
+    names = [f"drone {i}" for i in range(len(goals))]
+    return plan_transition(starts, goals, leg_limits(script), script.safety_m, names)
 
 
 def plane_y(points: FloatArray) -> float | None:

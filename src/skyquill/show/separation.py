@@ -5,13 +5,19 @@ on ``[a, b]`` (:mod:`skyquill.show.motion`), ``d`` is ``w``-Lipschitz there, so
 
     d(t) >= (d(a) + d(b) - w (b - a)) / 2        for every t in [a, b].
 
-The show clock is cut into intervals of :data:`STEP_S`; pairs whose bounding
-boxes over a window of :data:`WINDOW` intervals (grown by how far a drone can
-move between samples) stay apart are pruned without looking closer; every other
-interval whose bound falls below the distance asked for (or more than
+The show clock is cut into intervals of :data:`STEP_S`. Each drone gets a
+box in space over each window of :data:`WINDOW` intervals (its samples, grown
+by how far it can move between them); only pairs whose boxes come closer than
+the closest distance seen at the windows' starts (or the distance asked for)
+are looked at, found by sweep and prune over all the space-time boxes at once
+(:mod:`skyquill.show.pairs`), so the work grows with the drones and their
+neighbours, not with every pair: a drone has a bounded number of neighbours
+within a few metres, whatever the size of the show. Every interval of those
+pairs whose bound falls below the distance asked for (or more than
 :data:`TOLERANCE_M` below the closest distance seen) is bisected until it is
 proven or a time closer than asked for is found. Everything is vectorised over
-the pairs and intervals with numpy.
+the pairs, intervals and drones with numpy (:class:`skyquill.show.fleet.Fleet`
+holds every drone's pieces in one table), in chunks of bounded memory.
 """
 
 from __future__ import annotations
@@ -22,9 +28,13 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy.spatial import cKDTree
 
 from skyquill.errors import SolverError
+from skyquill.show.fleet import Fleet
 from skyquill.show.motion import LocalMotion, Motion, taylor_bound
+from skyquill.show.pairs import close_boxes
+from skyquill.show.waves import closest_on_segments
 from skyquill.validation import FloatArray, as_float
 
 #: Grid step of the first pass, s.
@@ -35,8 +45,10 @@ WINDOW = 32
 TOLERANCE_M = 0.01
 #: Narrowest interval bisected, s: below it an interval that is still not proven is reported.
 MIN_WIDTH_S = 1e-6
-#: Pair-windows whose bounding boxes are compared at once (memory: ~100 bytes each).
-CHUNK = 2_000_000
+#: Grid intervals bounded at once (memory: ~500 bytes each with degree-7 pieces).
+CHUNK = 250_000
+#: Drone samples evaluated at once for the boxes (memory: ~250 bytes each).
+BOX_SAMPLES = 250_000
 #: Most intervals held at once (memory: ~20 float64 each).
 MAX_INTERVALS = 5_000_000
 
@@ -121,23 +133,19 @@ class _Intervals:
     db: FloatArray
     w: FloatArray
     jump: FloatArray
+    taylor: FloatArray
 
     def lower(self) -> FloatArray:
         # A jump J inside the interval (round-off where a file's pieces meet) can move the
         # distance by J at the jump and J again against the Lipschitz line: 2 J of slack.
         slack = 0.5 * (self.da + self.db - self.w * (self.b - self.a)) - 2.0 * self.jump
-        return np.minimum(np.minimum(self.da, self.db), slack)
+        return np.minimum(np.minimum(self.da, self.db), np.maximum(slack, self.taylor))
 
     def take(self, keep: NDArray[np.bool_]) -> _Intervals:
-        return _Intervals(
-            self.pair[keep],
-            self.a[keep],
-            self.b[keep],
-            self.da[keep],
-            self.db[keep],
-            self.w[keep],
-            self.jump[keep],
-        )
+        return _Intervals(*(getattr(self, f)[keep] for f in _FIELDS))
+
+
+_FIELDS = tuple(_Intervals.__dataclass_fields__)
 
 
 class _Closest:
@@ -192,150 +200,270 @@ def guaranteed_separation(
     step = as_float("step_s", step_s, positive=True)
     tolerance = as_float("tolerance_m", tolerance_m, positive=True)
     n = len(motions)
-    first, second = np.triu_indices(n, 1)
     if n < 2:
         return Separation(minimum, math.inf, math.inf, (-1, -1), math.nan, (), 0, 0, 0)
-    horizon = motions[0].horizon
-    t = np.linspace(0.0, horizon, max(1, math.ceil(horizon / step)) + 1)
-    pos = np.stack([m.position(t) for m in motions])
-    # Only the speed bounds of the whole grid are kept: the derivatives are recomputed
-    # for the intervals that survive the pruning.
-    reach = np.stack([_reach(m, t) for m in motions])
-    closest = _Closest(first.size, minimum)
-    candidates = _candidates(pos=pos, reach=reach, t=t, first=first, second=second, minimum=minimum)
-    grid = _grid_intervals(
-        candidates=candidates, pos=pos, motions=motions, t=t, first=first, second=second
+    fleet = Fleet(motions)
+    t = np.linspace(0.0, fleet.horizon, max(1, math.ceil(fleet.horizon / step)) + 1)
+    # The distance at each window's start is one the show attains: pairs whose boxes
+    # stay farther apart than it (and than the minimum) cannot hold the closest approach.
+    # (Grown by round-off: the k-d tree's distances and the boxes' gaps round differently.)
+    threshold = max(minimum, _sampled_closest(fleet, t[::WINDOW])) * (1.0 + 1e-9) + 1e-12
+    first, second, window = _candidates(fleet, t, threshold)
+    pair_of, pair_index = np.unique(first * n + second, return_inverse=True)
+    pairs = (pair_of // n, pair_of % n)
+    closest = _Closest(pair_of.size, minimum)
+    items, lower, count = _grid_intervals(
+        fleet, t, pairs, (pair_index, window), closest=closest, tolerance=tolerance
     )
-    closest.record(grid.pair, grid.a, grid.da)
-    closest.record(grid.pair, grid.b, grid.db)
-    lower, count = _refine(grid, motions, (first, second), closest, tolerance)
-    examined = np.unique(candidates[0]).size
+    lower, count = _refine(
+        items, fleet, pairs, closest=closest, tolerance=tolerance, lower=lower, count=count
+    )
     return _result(
         minimum=minimum,
         lower=lower,
         count=count,
         closest=closest,
-        first=first,
-        second=second,
-        examined=examined,
+        first=pairs[0],
+        second=pairs[1],
+        total=n * (n - 1) // 2,
     )
 
 
-def _reach(motion: Motion, t: FloatArray) -> FloatArray:
-    """How far a drone can stray from its grid samples in each interval (N - 1,), m.
+def _sampled_closest(fleet: Fleet, times: FloatArray) -> float:
+    """The smallest distance between two drones at any of ``times``, m (k-d trees)."""
+    n = len(fleet)
+    best = math.inf
+    for t in times:
+        points = fleet.position(np.arange(n), np.full(n, t))
+        distance = np.asarray(cKDTree(points).query(points, k=2)[0])
+        best = min(best, float(distance[:, 1].min()))
+    return best
 
-    Half the interval at its speed bound, plus any jump where its pieces meet.
+
+def _candidates(fleet: Fleet, t: FloatArray, threshold: float) -> tuple[IntArray, ...]:
+    """``(first, second, window)`` whose space-time boxes come within ``threshold``.
+
+    A drone's box over a window of :data:`WINDOW` grid intervals holds its grid
+    samples, grown by how far it can stray from the nearest one (half an interval at
+    its largest speed bound in the window, plus any jumps where its pieces meet).
+    The boxes of all windows are swept at once (:func:`skyquill.show.pairs.close_boxes`).
     """
-    local = motion.local(t[:-1], t[1:])
-    return np.asarray(local.speed * np.diff(t) / 2.0 + local.jump)
-
-
-def _candidates(
-    *,
-    pos: FloatArray,
-    reach: FloatArray,
-    t: FloatArray,
-    first: IntArray,
-    second: IntArray,
-    minimum: float,
-) -> tuple[IntArray, IntArray]:
-    """``(pair, window)`` whose bounding boxes come closer than needed to be sure."""
-    n_int = t.size - 1
+    n, n_int = len(fleet), t.size - 1
     starts = np.arange(0, n_int, WINDOW)
-    ends = np.minimum(starts + WINDOW, n_int)
-    # Within an interval a drone is within ``reach`` of one of its ends.
-    grow = np.maximum.reduceat(reach, starts, axis=1)[..., None]
-    lo = np.minimum(np.minimum.reduceat(pos[:, :-1], starts, axis=1), pos[:, ends]) - grow
-    hi = np.maximum(np.maximum.reduceat(pos[:, :-1], starts, axis=1), pos[:, ends]) + grow
-    chunks = _chunks(first.size, starts.size)
-    # The distance at each window's start is one the show attains: pairs whose boxes
-    # stay farther apart than it (and than the minimum) cannot hold the closest approach.
-    sampled = min(
-        float(np.linalg.norm(pos[first[c]][:, starts] - pos[second[c]][:, starts], axis=2).min())
-        for c in chunks
+    lo = np.empty((starts.size, n, 3))
+    hi = np.empty((starts.size, n, 3))
+    per_batch = max(1, BOX_SAMPLES // (n * (WINDOW + 1)))
+    for begin in range(0, starts.size, per_batch):
+        windows = np.arange(begin, min(begin + per_batch, starts.size))
+        lo[windows], hi[windows] = _boxes(fleet, t, starts[windows])
+    boxes_first, boxes_second = close_boxes(
+        lo.reshape(-1, 3), hi.reshape(-1, 3), threshold, np.repeat(np.arange(starts.size), n)
     )
-    threshold = max(minimum, sampled)
-    found = []
-    for c in chunks:
-        i, j = first[c], second[c]
-        gap = np.maximum(0.0, np.maximum(lo[i] - hi[j], lo[j] - hi[i]))
-        pair, window = np.nonzero(np.linalg.norm(gap, axis=2) <= threshold)
-        found.append((pair + c.start, window))
-    return np.concatenate([p for p, _ in found]), np.concatenate([w for _, w in found])
+    window = boxes_first // n
+    one, two = boxes_first % n, boxes_second % n
+    return np.minimum(one, two), np.maximum(one, two), window
 
 
-def _chunks(n_pairs: int, n_windows: int) -> list[slice]:
-    """Slices of the pairs that keep a chunk's (pairs, windows, 3) arrays within bounds."""
-    size = max(1, CHUNK // n_windows)
-    return [slice(s, min(s + size, n_pairs)) for s in range(0, n_pairs, size)]
+def _boxes(fleet: Fleet, t: FloatArray, starts: IntArray) -> tuple[FloatArray, FloatArray]:
+    """Every drone's box over the windows beginning at grid index ``starts`` (W,): (W, N, 3)."""
+    n, last = len(fleet), t.size - 1
+    k = np.minimum(starts[:, None] + np.arange(WINDOW + 1)[None, :], last)  # (W, WINDOW + 1)
+    times = t[k]
+    who = np.repeat(np.arange(n), times.size)
+    pos = fleet.position(who, np.tile(times.ravel(), n)).reshape(n, *times.shape, 3)
+    a, b = times[:, 0], times[:, -1]
+    first = fleet.piece(np.repeat(np.arange(n), a.size), np.tile(a, n), "right")
+    stop = fleet.piece(np.repeat(np.arange(n), b.size), np.tile(b, n), "left") + 1
+    speed = fleet.largest_whole(first, np.maximum(stop, first + 1)).reshape(n, a.size)
+    crossings = (stop - 1 - first).reshape(n, a.size)
+    step = float(np.diff(t).max()) if t.size > 1 else 0.0
+    grow = (speed * step / 2.0 + crossings * fleet.jump[:, None])[..., None]  # (N, W, 1)
+    lo = (pos.min(axis=2) - grow).transpose(1, 0, 2)
+    hi = (pos.max(axis=2) + grow).transpose(1, 0, 2)
+    return lo, hi
 
 
 def _grid_intervals(
-    *,
-    candidates: tuple[IntArray, IntArray],
-    pos: FloatArray,
-    motions: Sequence[Motion],
+    fleet: Fleet,
     t: FloatArray,
-    first: IntArray,
-    second: IntArray,
-) -> _Intervals:
-    """The grid intervals of the candidate windows with their bounds."""
+    pairs: tuple[IntArray, IntArray],
+    candidates: tuple[IntArray, IntArray],
+    *,
+    closest: _Closest,
+    tolerance: float,
+) -> tuple[_Intervals, tuple[float, int, float], int]:
+    """The grid intervals of the candidate windows, bounded, in chunks of :data:`CHUNK`.
+
+    Returns the intervals still open (their bound below what is asked for), the
+    lowest bound of those already proven, and how many intervals were bounded.
+    Every chunk's samples are recorded in ``closest`` first. Memory holds one chunk
+    (some 500 bytes per interval while both drones' motions are compared) and the
+    intervals still open (~60 bytes each).
+
+    Raises
+    ------
+    SolverError
+        More than :data:`MAX_INTERVALS` grid intervals to examine (drones crowding
+        closer than the distance asked for over much of the show): refused before
+        the work, not swapped.
+    """
     pair, window = candidates
     n_int = t.size - 1
     lengths = np.minimum(WINDOW, n_int - window * WINDOW)
+    total = int(lengths.sum())
+    if total > MAX_INTERVALS:
+        raise SolverError(
+            f"separation: got {total:,} grid intervals where drones come close, expected at "
+            f"most {MAX_INTERVALS:,} (fewer drones, or drones that keep farther apart)"
+        )
+    kept: list[_Intervals] = []
+    lower = (math.inf, -1, math.nan)
+    count = 0
+    per_chunk = max(1, CHUNK // WINDOW)
+    for begin in range(0, pair.size, per_chunk):
+        part = slice(begin, begin + per_chunk)
+        items = _window_intervals(
+            fleet,
+            t,
+            pairs,
+            pair=pair[part],
+            window=window[part],
+            lengths=lengths[part],
+            closest=closest,
+        )
+        closest.record(items.pair, items.a, items.da)
+        closest.record(items.pair, items.b, items.db)
+        count += items.a.size
+        lower, items = _settle(items, closest, tolerance, lower)
+        kept.append(items)
+    return _joined(kept), lower, count
+
+
+def _window_intervals(
+    fleet: Fleet,
+    t: FloatArray,
+    pairs: tuple[IntArray, IntArray],
+    *,
+    pair: IntArray,
+    window: IntArray,
+    lengths: IntArray,
+    closest: _Closest,
+) -> _Intervals:
+    """The grid intervals of the windows ``window`` of the pairs ``pair``, with their bounds."""
     pair = np.repeat(pair, lengths)
     offsets = np.arange(lengths.sum()) - np.repeat(np.cumsum(lengths) - lengths, lengths)
     k = np.repeat(window * WINDOW, lengths) + offsets
-    i, j = first[pair], second[pair]
-    da = np.linalg.norm(pos[i, k] - pos[j, k], axis=1)
-    db = np.linalg.norm(pos[i, k + 1] - pos[j, k + 1], axis=1)
+    i, j = pairs[0][pair], pairs[1][pair]
     a, b = t[k], t[k + 1]
-    one, two = _local(motions, i, a, b), _local(motions, j, a, b)
-    return _Intervals(pair, a, b, da, db, _relative(one, two, 0.5 * (b - a)), one.jump + two.jump)
+    da = np.linalg.norm(fleet.position(i, a) - fleet.position(j, a), axis=1)
+    db = np.linalg.norm(fleet.position(i, b) - fleet.position(j, b), axis=1)
+    return _bounded(fleet, pairs, pair, (a, b), (da, db), closest)
 
 
-def _pad(derivatives: FloatArray, width: int) -> FloatArray:
-    """Derivatives (N, Q, 3) padded with zeros to (N, width, 3): higher orders of a lower degree."""
-    return np.pad(derivatives, ((0, 0), (0, width - derivatives.shape[1]), (0, 0)))
+def _bounded(  # noqa: PLR0917 - private: one interval's every part
+    fleet: Fleet,
+    pairs: tuple[IntArray, IntArray],
+    pair: IntArray,
+    ends: tuple[FloatArray, FloatArray],
+    distances: tuple[FloatArray, FloatArray],
+    closest: _Closest,
+) -> _Intervals:
+    """Intervals ``ends`` of ``pair`` with the distances there, bounded (midpoints recorded)."""
+    a, b = ends
+    i, j = pairs[0][pair], pairs[1][pair]
+    mid = 0.5 * (a + b)
+    offset = fleet.position(i, mid) - fleet.position(j, mid)
+    closest.record(pair, mid, np.linalg.norm(offset, axis=1))
+    one, two = fleet.local(i, a, b), fleet.local(j, a, b)
+    w, taylor = _relative(one, two, 0.5 * (b - a), offset)
+    return _Intervals(pair, a, b, *distances, w, one.jump + two.jump, taylor)
 
 
-def _relative(one: LocalMotion, two: LocalMotion, half_width: FloatArray) -> FloatArray:
-    """A bound of ``|v_i - v_j|``: Taylor of the difference where both are one polynomial."""
+def _remainder(derivatives: FloatArray, r: FloatArray) -> FloatArray:
+    """``sum_{q >= 2} |D_q| r^q / q!`` for derivatives (M, Q, 3) of orders 1 to Q (M,)."""
+    norms = np.linalg.norm(derivatives[:, 1:], axis=2)
+    q = np.arange(2, derivatives.shape[1] + 1)
+    weights = r[:, None] ** q[None, :] / np.array([math.factorial(int(k)) for k in q])
+    return np.asarray((norms * weights).sum(axis=1))
+
+
+def _joined(parts: Sequence[_Intervals]) -> _Intervals:
+    if not parts:
+        empty = np.zeros(0)
+        return _Intervals(np.zeros(0, dtype=np.intp), *([empty] * (len(_FIELDS) - 1)))
+    return _Intervals(*(np.concatenate([getattr(p, f) for p in parts]) for f in _FIELDS))
+
+
+def _relative(
+    one: LocalMotion, two: LocalMotion, half_width: FloatArray, offset: FloatArray
+) -> tuple[FloatArray, FloatArray]:
+    """Two bounds where both drones are one polynomial on the interval (else the speeds').
+
+    Returns ``w``, a bound of ``|v_i - v_j|`` (the Taylor bound of the difference), and
+    a lower bound of the distance itself, ``-inf`` where both are not one polynomial.
+    The difference ``D(m + tau) = D0 + D1 tau + R(tau)`` of two polynomials is exact
+    with ``|R(tau)| <= sum_{q >= 2} |D_q| r^q / q!`` for ``|tau| <= r``, so the
+    distance is at least the closest the segment ``D0 + D1 tau`` comes to 0, less
+    that remainder: exact for drones in straight uniform motion, and second order in
+    ``r`` otherwise, where the Lipschitz bound is first order. It is what proves two
+    drones that step apart sideways from exactly the minimum distance (moving
+    across their separation, their distance grows though they move fast).
+    """
     w = one.speed + two.speed
+    taylor = np.full(w.size, -np.inf)
     both = one.inside & two.inside
-    if both.any():
+    if not one.derivatives.shape[1]:  # both stand still (constant pieces)
+        taylor[both] = np.linalg.norm(offset[both], axis=1)
+    elif both.any():
         diff = one.derivatives[both] - two.derivatives[both]
-        w[both] = np.minimum(w[both], taylor_bound(diff, half_width[both]))
-    return w
+        r = half_width[both]
+        w[both] = np.minimum(w[both], taylor_bound(diff, r))
+        d0, d1 = offset[both], diff[:, 0]
+        linear, _ = closest_on_segments(d0 - d1 * r[:, None], d0 + d1 * r[:, None])
+        taylor[both] = linear - _remainder(diff, r)
+    return w, taylor
+
+
+def _settle(
+    items: _Intervals, closest: _Closest, tolerance: float, lower: tuple[float, int, float]
+) -> tuple[tuple[float, int, float], _Intervals]:
+    """Close the intervals whose bound is high enough; the lowest closed bound so far and the rest.
+
+    An interval stays open while its bound is below what is asked for (or more than
+    ``tolerance`` below the closest distance seen), it is wider than
+    :data:`MIN_WIDTH_S` and its pair has not already been found closer than asked for.
+    """
+    lb = items.lower()
+    target = max(closest.minimum, closest.best - tolerance)
+    open_ = (
+        (lb < target)
+        & (items.b - items.a > MIN_WIDTH_S)
+        & (items.a < closest.first_bad[items.pair])
+    )
+    if (~open_).any():
+        k = int(np.argmin(np.where(open_, np.inf, lb)))
+        if lb[k] < lower[0]:
+            lower = (float(lb[k]), int(items.pair[k]), float(items.a[k]))
+    return lower, items.take(open_)
 
 
 def _refine(
     items: _Intervals,
-    motions: Sequence[Motion],
+    fleet: Fleet,
     pairs: tuple[IntArray, IntArray],
+    *,
     closest: _Closest,
     tolerance: float,
+    lower: tuple[float, int, float],
+    count: int,
 ) -> tuple[tuple[float, int, float], int]:
     """Bisect until every interval is proven.
 
     Returns the guaranteed bound with the pair and time where it is lowest, and
     the number of intervals bounded.
     """
-    lower = (math.inf, -1, math.nan)
-    count = items.a.size
     while items.a.size:
-        lb = items.lower()
-        target = max(closest.minimum, closest.best - tolerance)
-        open_ = (
-            (lb < target)
-            & (items.b - items.a > MIN_WIDTH_S)
-            & (items.a < closest.first_bad[items.pair])
-        )
-        if (~open_).any():
-            k = int(np.argmin(np.where(open_, np.inf, lb)))
-            if lb[k] < lower[0]:
-                lower = (float(lb[k]), int(items.pair[k]), float(items.a[k]))
-        items = items.take(open_)
+        lower, items = _settle(items, closest, tolerance, lower)
         if 2 * items.a.size > MAX_INTERVALS:
             if tolerance == math.inf:
                 raise SolverError(
@@ -345,60 +473,25 @@ def _refine(
             # Stop tightening the bound: only what decides pass or fail is bisected.
             tolerance = math.inf
             continue
-        items = _split(items, motions, *pairs, closest)
+        if not items.a.size:
+            break
+        items = _split(items, fleet, pairs, closest)
         count += items.a.size
     return lower, count
 
 
 def _split(
-    items: _Intervals,
-    motions: Sequence[Motion],
-    first: IntArray,
-    second: IntArray,
-    closest: _Closest,
+    items: _Intervals, fleet: Fleet, pairs: tuple[IntArray, IntArray], closest: _Closest
 ) -> _Intervals:
     """Both halves of every interval, with the distance at the midpoints recorded."""
     mid = 0.5 * (items.a + items.b)
-    i, j = first[items.pair], second[items.pair]
-    dm = np.linalg.norm(_positions(motions, i, mid) - _positions(motions, j, mid), axis=1)
+    i, j = pairs[0][items.pair], pairs[1][items.pair]
+    dm = np.linalg.norm(fleet.position(i, mid) - fleet.position(j, mid), axis=1)
     closest.record(items.pair, mid, dm)
-    a = np.concatenate([items.a, mid])
-    b = np.concatenate([mid, items.b])
-    ii, jj = np.concatenate([i, i]), np.concatenate([j, j])
-    one, two = _local(motions, ii, a, b), _local(motions, jj, a, b)
-    return _Intervals(
-        np.concatenate([items.pair, items.pair]),
-        a,
-        b,
-        np.concatenate([items.da, dm]),
-        np.concatenate([dm, items.db]),
-        _relative(one, two, 0.5 * (b - a)),
-        one.jump + two.jump,
-    )
-
-
-def _positions(motions: Sequence[Motion], who: IntArray, t: FloatArray) -> FloatArray:
-    out = np.empty((t.size, 3))
-    for d in np.unique(who):
-        mask = who == d
-        out[mask] = motions[d].position(t[mask])
-    return out
-
-
-def _local(motions: Sequence[Motion], who: IntArray, a: FloatArray, b: FloatArray) -> LocalMotion:
-    width = max(m.order for m in motions) - 1
-    derivs = np.zeros((a.size, width, 3))
-    inside = np.zeros(a.size, dtype=bool)
-    speed = np.empty(a.size)
-    jump = np.empty(a.size)
-    for d in np.unique(who):
-        mask = who == d
-        lm = motions[d].local(a[mask], b[mask])
-        derivs[mask] = _pad(lm.derivatives, width)
-        inside[mask] = lm.inside
-        speed[mask] = lm.speed
-        jump[mask] = lm.jump
-    return LocalMotion(derivs, inside, speed, jump)
+    halves = np.concatenate([items.pair, items.pair])
+    ends = (np.concatenate([items.a, mid]), np.concatenate([mid, items.b]))
+    distances = (np.concatenate([items.da, dm]), np.concatenate([dm, items.db]))
+    return _bounded(fleet, pairs, halves, ends, distances, closest)
 
 
 def _result(
@@ -409,7 +502,7 @@ def _result(
     closest: _Closest,
     first: IntArray,
     second: IntArray,
-    examined: int,
+    total: int,
 ) -> Separation:
     encounters = []
     for p in np.flatnonzero(np.isfinite(closest.first_bad)):
@@ -427,8 +520,8 @@ def _result(
         attained_drones=(int(first[best]), int(second[best])),
         attained_time_s=float(closest.t[best]),
         encounters=tuple(encounters),
-        pairs=int(first.size),
-        pairs_examined=examined,
+        pairs=total,
+        pairs_examined=int(first.size),
         intervals=count,
     )
 

@@ -178,13 +178,13 @@ def plan_transition(
     if waves is not None:
         delayed = Transition(a, b, (scheduled(a, b, waves, limits),), flat, np.inf)
         if waves.max() == 0:
-            return _proven(delayed, d, label)
+            return prove(delayed, d, label)
     layered = _layered(a, b, ok=ok, moving=moving, d=d, limits=limits)
     # Many waves flown one after another can take longer than stepping out and back.
     options = [t for t in (delayed, layered) if t is not None]
     if not options:
         raise _unresolved(a, b, pair, why, limits, label)
-    return _proven(min(options, key=lambda t: t.duration), d, label)
+    return prove(min(options, key=lambda t: t.duration), d, label)
 
 
 def _direct(a: FloatArray, b: FloatArray, d: float, limits: LegLimits) -> Moves | None:
@@ -221,7 +221,7 @@ def _layered(
     return Transition(a, b, tuple(legs), depth.astype(np.intp), np.inf)
 
 
-def _proven(planned: Transition, d: float, label: Sequence[str]) -> Transition:
+def prove(planned: Transition, d: float, label: Sequence[str]) -> Transition:
     """``planned`` with its guaranteed closest approach; refused if below ``d``."""
     drones = [ShowDrone(planned.trajectory(k), label[k]) for k in range(len(planned.starts))]
     separation = require_separation(drones, d, "transition")

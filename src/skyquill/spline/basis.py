@@ -8,8 +8,9 @@ an ``n``-th derivative map by ``alpha**n`` and a Gram matrix of order ``n`` by
 
 Every map returned is a sparse matrix acting on the control points of one
 axis, shape ``(rows, M)``; the axis-coupled problem uses their Kronecker
-product with ``I_d`` (paper 003 eq. 9). Evaluation of basis functions is
-delegated to :meth:`scipy.interpolate.BSpline.design_matrix`.
+product with ``I_d`` (paper 003 eq. 9). The rows at sample parameters come
+from the span polynomials of :mod:`skyquill.spline.local`; the Gram matrices
+from :meth:`scipy.interpolate.BSpline.design_matrix` at Gauss nodes.
 """
 
 from __future__ import annotations
@@ -24,6 +25,7 @@ from numpy.typing import NDArray
 from scipy.interpolate import BSpline
 
 from skyquill.errors import InputError
+from skyquill.spline.local import LocalBasis, uniform_local_basis
 
 FloatArray = NDArray[np.float64]
 HullKind = Literal["bspline", "bezier"]
@@ -146,10 +148,22 @@ class ClampedUniformBasis:
             )
         if s.size == 0:
             return sp.csr_array((0, self.n_ctrl))
-        basis = self._derivative_basis(s, order)
-        if order == 0:
-            return basis
-        return sp.csr_array(basis @ self.derivative_map(order))
+        local = self.local_values(s, order)
+        return self.rows(local.first, local.values[order])
+
+    def local_values(self, s: FloatArray, max_order: int) -> LocalBasis:
+        """The ``k + 1`` nonzero basis functions and their ``s``-derivatives up to
+        ``max_order`` at parameters ``s`` (N,) in ``[0, L]`` (validated by the caller):
+        first columns (N,) and values (max_order + 1, N, k + 1)
+        (:func:`skyquill.spline.local.uniform_local_basis`)."""
+        return uniform_local_basis(self.degree, self.n_spans, np.asarray(s, dtype=float), max_order)
+
+    def rows(self, first: NDArray[np.intp], values: FloatArray) -> sp.csr_array:
+        """Sparse rows (N, M) whose nonzeros are ``values`` (N, k + 1) from columns ``first``."""
+        n, width = values.shape
+        indices = (first[:, None] + np.arange(width)).ravel()
+        indptr = np.arange(0, n * width + 1, width)
+        return sp.csr_array((values.ravel(), indices, indptr), shape=(n, self.n_ctrl))
 
     def _derivative_basis(self, s: FloatArray, order: int) -> sp.csr_array:
         """Basis of the ``order``-th derivative spline (degree k - n, knots eq. 35) at ``s``."""
@@ -175,20 +189,21 @@ class ClampedUniformBasis:
         scipy.sparse.csr_array, shape (M - order, M)
         """
         self._check_order(order)
-        return self._derivative_maps[order]
-
-    @cached_property
-    def _derivative_maps(self) -> tuple[sp.csr_array, ...]:
-        maps = [sp.csr_array(sp.eye_array(self.n_ctrl, format="csr"))]
+        maps = self._derivative_maps
         knots = self.knots
-        for j in range(1, self.degree + 1):
+        # Built up to the order asked for (a problem needs those of its limits and cost).
+        for j in range(len(maps), order + 1):
             p = self.degree - j + 1  # degree before this differentiation
             m = self.n_ctrl - j + 1  # control points before it
             t = knots[j - 1 : len(knots) - j + 1]
             scale = p / (t[p + 1 : p + m] - t[1:m])  # eq. (34): k / (s_{i+k+1} - s_{i+1})
             step = sp.diags_array([-scale, scale], offsets=[0, 1], shape=(m - 1, m), format="csr")  # type: ignore[call-overload]  # scipy-stubs reject a list of float arrays
             maps.append(sp.csr_array(step @ maps[-1]))
-        return tuple(maps)
+        return maps[order]
+
+    @cached_property
+    def _derivative_maps(self) -> list[sp.csr_array]:
+        return [sp.csr_array(sp.eye_array(self.n_ctrl, format="csr"))]
 
     def end_rows(self, order: int) -> tuple[FloatArray, FloatArray]:
         """First and last rows of :meth:`derivative_map`, dense, each (M,): the
@@ -218,14 +233,14 @@ class ClampedUniformBasis:
         scipy.sparse.csr_array, shape (M, M), symmetric positive semi-definite.
         """
         self._check_order(order)
+        if order not in self._grams:  # built on first use: a problem needs one or two orders
+            D = self.derivative_map(order)
+            self._grams[order] = sp.csr_array(D.T @ self.reduced_gram(order) @ D)
         return self._grams[order]
 
     @cached_property
-    def _grams(self) -> tuple[sp.csr_array, ...]:
-        return tuple(
-            sp.csr_array(self.derivative_map(n).T @ self.reduced_gram(n) @ self.derivative_map(n))
-            for n in range(self.degree + 1)
-        )
+    def _grams(self) -> dict[int, sp.csr_array]:
+        return {}
 
     def reduced_gram(self, order: int) -> sp.csr_array:
         """Gram matrix ``W_n`` of the derivative spline's own basis, shape (M - n, M - n).
@@ -236,12 +251,7 @@ class ClampedUniformBasis:
         (large ``C`` nearly in the polynomial null space of ``V_n``).
         """
         self._check_order(order)
-        return self._reduced_grams[order]
-
-    @cached_property
-    def _reduced_grams(self) -> tuple[sp.csr_array, ...]:
-        grams = []
-        for order in range(self.degree + 1):
+        if order not in self._reduced_grams:
             n_nodes = self.degree - order + 1
             nodes, weights = np.polynomial.legendre.leggauss(n_nodes)
             u = 0.5 * (nodes + 1.0)  # on [0, 1]
@@ -249,8 +259,12 @@ class ClampedUniformBasis:
             s = (spans[:, None] + u[None, :]).ravel()
             w = np.tile(0.5 * weights, self.n_spans)
             B = self._derivative_basis(s, order)
-            grams.append(sp.csr_array(B.T @ sp.diags_array(w) @ B))
-        return tuple(grams)
+            self._reduced_grams[order] = sp.csr_array(B.T @ sp.diags_array(w) @ B)
+        return self._reduced_grams[order]
+
+    @cached_property
+    def _reduced_grams(self) -> dict[int, sp.csr_array]:
+        return {}
 
     def hull_map(
         self,

@@ -24,6 +24,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from skyquill.errors import InputError
+from skyquill.io.source import special_kind
 from skyquill.strokes.json_io import read_json
 from skyquill.strokes.model import Strokes
 from skyquill.validation import FloatArray, as_float
@@ -111,7 +112,15 @@ def _medians_in(entry: Any, char: str, where: str) -> Any:
 def _lookup_file(path: Path, char: str) -> Any | None:
     data = read_json(path, f"hanzi-writer data for {char!r}")
     if isinstance(data, dict) and "medians" in data:
-        return data["medians"]  # one character's file, as in hanzi-writer-data
+        # One character's file, as in hanzi-writer-data: its name says which character.
+        held = path.name.removesuffix(".json")
+        if len(held) != 1:
+            raise InputError(
+                f"{path}: got one character's hanzi-writer data in a file named {path.name!r}, "
+                f"expected it named after its character (such as 永.json) to write {char!r}, "
+                "or an object {character: medians}"
+            )
+        return data["medians"] if held == char else None
     if isinstance(data, dict):
         if char in data:
             return _medians_in(data[char], char, str(path))
@@ -134,7 +143,8 @@ def _lookup(place: Path, char: str) -> Any | None:
         return _lookup_dir(place, char)
     if place.is_file():
         return _lookup_file(place, char)
-    raise InputError(f"{place}: no such file or directory, expected hanzi data")
+    kind = special_kind(place) or "no such file or directory"
+    raise InputError(f"{place}: got {kind}, expected hanzi data (a JSON file or a folder)")
 
 
 def hanzi_strokes(char: str, source: str | Path | None = None) -> Strokes:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import io
 import logging
 import math
 import re
@@ -13,7 +14,9 @@ import svgelements as se
 from numpy.typing import NDArray
 
 from skyquill.errors import InputError
+from skyquill.io.source import read_bytes
 from skyquill.strokes.model import MAX_POINTS, MAX_STROKES, Strokes
+from skyquill.strokes.svg_checks import check_svg_markup
 
 logger = logging.getLogger(__name__)
 
@@ -165,20 +168,14 @@ def _read_parts(
     with something to draw: a layer's key is its index, a shape outside every
     layer has key -1 and name ``""``.
     """
-    if not p.is_file():
-        raise InputError(f"{p}: no such file, expected an SVG file")
-    size = p.stat().st_size
-    if size > MAX_BYTES:
-        raise InputError(f"{p}: got {size:,} bytes, expected an SVG file of at most {MAX_BYTES:,}")
+    raw = read_bytes(p, "an SVG file", max_bytes=MAX_BYTES)
     try:
-        svg = se.SVG.parse(str(p), ppi=PPI)
+        svg = se.SVG.parse(io.BytesIO(raw), ppi=PPI)
         grouped = _drawn_parts(svg)
     except Exception as exc:  # svgelements lets XML, value, recursion and I/O errors through
         raise InputError(f"{p}: cannot be parsed as SVG ({exc}), expected an SVG file") from None
+    check_svg_markup(p, raw)
     metres = _metres_per_px(p, svg) if true_size else 1.0
-    elements = [e for _, _, part in grouped for e in part]
-    for i, element in enumerate(elements):
-        _check_data(p, i, element)
     parts = [(key, name, _reified(part)) for key, name, part in grouped]
     shapes = [s for _, _, part in parts for s in part]
     if len(shapes) > MAX_STROKES:

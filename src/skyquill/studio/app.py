@@ -46,6 +46,7 @@ from fastapi.exceptions import RequestValidationError
 from fastapi.responses import HTMLResponse, JSONResponse, Response
 from fastapi.staticfiles import StaticFiles
 from starlette.datastructures import MutableHeaders
+from starlette.exceptions import HTTPException as StarletteHTTPException
 from starlette.middleware.trustedhost import TrustedHostMiddleware
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
@@ -286,6 +287,14 @@ def _job(manager: JobManager, job_id: str) -> Job:
     return job
 
 
+#: What FastAPI answers for a request body it cannot parse (JSON nested past Python's limit).
+_UNPARSED_BODY = "There was an error parsing the body"
+_NESTED_BODY = (
+    "body: got JSON that cannot be read (nested too deeply), expected a JSON object of the "
+    "fields listed at /docs"
+)
+
+
 class _UnplannableError(Exception):
     """A ``?wait=true`` plan that failed: its message goes back as a 422."""
 
@@ -315,6 +324,14 @@ def _add_error_handlers(app: FastAPI) -> None:
         person = "The studio is busy with other plans; press Plan again in a moment"
         return _detail(429, str(exc), user_message=person, headers={"Retry-After": "5"})
 
+    async def http_error(_: Request, exc: Exception) -> JSONResponse:
+        assert isinstance(exc, StarletteHTTPException)
+        if exc.status_code == 400 and exc.detail == _UNPARSED_BODY:
+            # FastAPI's own words for a body json.loads gave up on (nested too deeply).
+            return _detail(400, _NESTED_BODY, field="body")
+        return _detail(exc.status_code, str(exc.detail), headers=exc.headers)
+
+    app.add_exception_handler(StarletteHTTPException, http_error)
     app.add_exception_handler(RequestValidationError, validation)
     app.add_exception_handler(SkyquillError, user_error)
     app.add_exception_handler(_UnplannableError, user_error)

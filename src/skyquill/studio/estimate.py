@@ -2,24 +2,40 @@
 
 Milliseconds of arithmetic on the route (no solve), so the page can ask on every
 Plan press and warn before a person waits minutes for a 27-minute flight. The
-flight time is the timing the planner itself starts from
+flight time is a first timing of the route
 (:func:`~skyquill.calligraphy.mission.initial_flight_time`: the route at the
-speed limit, slowing to a stop at corners, the lifts within the jerk limit):
-the plan's duration when it needs no stretch, and what ``bench/studio_estimate.py``
-measures against the planned flights. Warnings are about the chosen vehicle only.
+speed limit, slowing to a stop at corners, the lifts within the jerk limit);
+``bench/studio_estimate.py`` measures it against the planned flights. Warnings
+are about the chosen vehicle only.
+
+At loose limits the writing is not slowed by the vehicle but by fidelity: the
+planner writes at the fastest pace that stays within the tolerance
+(``docs/calligraphy-timing.md``), whatever the vehicle allows beyond it. The
+estimate therefore times the route with the limits capped at
+:data:`TYPICAL_FAITHFUL_PACE`, the pace the bundled set writes at.
 """
 
 from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from skyquill.calligraphy.mission import WritingOptions, initial_flight_time, route_length
 from skyquill.calligraphy.show import layout
+from skyquill.calligraphy.timing import TimingBounds
 from skyquill.limits import VehicleLimits
 from skyquill.show.limits import ShowLimits
 from skyquill.studio.models import Estimate, PlanRequest
 from skyquill.studio.planner import CSV_RATE_HZ, SEPARATION_M, parts_of
 
+#: The pace (speed m/s; acceleration and jerk of the pace's shape, 2 p^2 and 10 p^3) the
+#: studio's requests are written at when the vehicle allows more, measured with
+#: ``bench/studio_estimate.py`` (12 bundled characters, a word, 4 drawings at 1x, 5x and
+#: 20x the default limits): capping the estimate's limits at 1.25 / 1.5 / 1.75 / 2.0 /
+#: 2.5 put planned / estimated in 0.73-1.00 / 0.86-1.02 / 0.99-1.18 / 1.00-1.34 /
+#: 1.00-1.64; 1.75 is the lowest that does not promise a faster flight than planned.
+TYPICAL_FAITHFUL_PACE = 1.75
 #: A flight longer than this is worth a second thought, s: paper 000's characters
 #: take well under a minute, and a Crazyflie's battery lasts about seven.
 WARN_FLIGHT_S = 300.0
@@ -43,11 +59,14 @@ def estimate(request: PlanRequest) -> Estimate:
         The request cannot be turned into strokes (as :func:`parts_of`).
     """
     parts = parts_of(request)
-    limits = VehicleLimits(request.vmax, request.amax, request.jmax)
+    paced = TimingBounds(request.vmax, request.amax, request.jmax).at_pace(TYPICAL_FAITHFUL_PACE)
+    limits = VehicleLimits(paced.vmax, paced.amax, paced.jmax)
     options = WritingOptions(size_m=request.size_m, limits=limits)
     places = layout(len(parts), request.size_m, SEPARATION_M, kind=request.board)
     lengths, times = [], []
-    for part, (board, home) in zip(parts, places, strict=True):
+    for part, (board, place) in zip(parts, places, strict=True):
+        home = np.array(place, dtype=float)  # raised to the minimum altitude, as planned
+        home[2] = max(home[2], request.min_altitude_m)
         tip_home = home - options.brush.length_m * board.normal  # the route is the tip's
         scaled = part.scaled(options.size_m)
         lengths.append(route_length(tuple(map(board.to_world, scaled.paths)), board, tip_home))

@@ -13,6 +13,8 @@ from typing import Annotated, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
+from skyquill.phases import MAX_MIN_ALTITUDE_M, MIN_ALTITUDE_M
+
 #: Strokes in one drawing.
 MAX_STROKES = 200
 #: Points in one stroke.
@@ -106,6 +108,15 @@ class PlanRequest(BaseModel):
         default="generic",
         description="The vehicle the flight is for: its files, estimates and warnings "
         "(``crazyflie``: planned to fit its uploads; ``skybrush``: a show file).",
+    )
+    min_altitude_m: float = Field(
+        default=MIN_ALTITUDE_M,
+        ge=0.0,
+        le=MAX_MIN_ALTITUDE_M,
+        strict=True,
+        description="Lowest altitude of the mission above the ground, m: each drone takes off "
+        "to a hover this high above its pad and nothing between take-off and landing is "
+        "planned below it.",
     )
 
     @model_validator(mode="after")
@@ -245,6 +256,20 @@ class DronePlan(BaseModel):
     )
 
 
+class Delivered(BaseModel):
+    """One download as its consumer plays it, against the plan's limits (``as_played``)."""
+
+    kind: str = Field(description="The download (``show``, ``crazyswarm``).")
+    verdict: Literal[
+        "every limit met", "within the delivery tolerance", "limits exceeded", "refused"
+    ] = Field(description="``refused``: the format cannot play the plan inside its limits.")
+    relative_excess: dict[str, float] = Field(
+        default_factory=dict,
+        description="Largest excess over the speed, acceleration and jerk limits, relative.",
+    )
+    allowed_relative_excess: dict[str, float] = Field(default_factory=dict)
+
+
 class DownloadFile(BaseModel):
     """A file the page offers for download."""
 
@@ -269,6 +294,11 @@ class PlanResult(BaseModel):
     min_separation_m: float | None
     drones: list[DronePlan]
     files: list[DownloadFile]
+    delivered: list[Delivered] = Field(
+        default_factory=list,
+        description="Each download as played (summary.json: exports.<kind>.as_played): "
+        "'every limit met' is said only when every one of them meets every limit.",
+    )
     notes: list[str]
 
 

@@ -33,15 +33,18 @@ from skyquill.calligraphy.mission import Mission, WritingOptions
 from skyquill.calligraphy.show import Show, plan_show
 from skyquill.errors import InfeasibleError, InputError, SolverError
 from skyquill.export import EXPORTERS, ExportOptions, ExportReport
+from skyquill.export.base import EXACT_TOLERANCE, ORDER_NAMES
 from skyquill.io.plan_dir import write_plan
 from skyquill.io.trajectory_json import PlannedTrajectory
 from skyquill.limits import VehicleLimits
+from skyquill.phases import flight_phases
 from skyquill.strokes import Strokes
 from skyquill.strokes.hanzi import bundled_hanzi, missing_hanzi
 from skyquill.strokes.hershey import missing_glyphs
 from skyquill.strokes.text import is_cjk
 from skyquill.studio.messages import StudioInputError, too_many_drones, unwritable_text
 from skyquill.studio.models import (
+    Delivered,
     DownloadFile,
     DronePlan,
     LimitReport,
@@ -111,7 +114,7 @@ class Progress(Protocol):
 PLAN_WEIGHT, FLY_WEIGHT = 3.0, 1.0
 #: The bar's span for :func:`plan_show` (the rest: reading the input, writing files).
 SHOW_START, SHOW_END = 0.05, 0.9
-#: Each solve of a drone's route (mission.py logs one per stretch or re-segmentation)
+#: Each solve of a drone's route (the planning logs one per timing tried or re-segmentation)
 #: moves the bar this fraction of the way to the end of the drone's share: how many
 #: solves a drone takes is not known in advance, so the bar slows, never stops or jumps back.
 SOLVE_STEP = 0.35
@@ -226,7 +229,9 @@ def run_plan(
     ]
     flown = [_flight_record(d, request) for d in drones if d.flight]
     record = {"plan_id": plan_id, "request": request_record(request), "simulated_flight": flown}
-    files, notes = _exports(show.missions, record, progress, STUDIO_FORMATS[request.target])
+    files, notes, delivered = _exports(
+        show.missions, record, progress, STUDIO_FORMATS[request.target], request.min_altitude_m
+    )
     named = {f"skyquill-{plan_id}-{kind}": (kind, f) for kind, f in files.items()}
     result = PlanResultModel(
         plan_id=plan_id,
@@ -249,6 +254,7 @@ def run_plan(
             )
             for name, (kind, f) in named.items()
         ],
+        delivered=delivered,
         notes=notes,
     )
     return PlanOutput(result, {name: f for name, (_, f) in named.items()})
@@ -330,6 +336,7 @@ def _plan_show(
                 board_kind=request.board,
                 fly=request.fly,
                 progress=report,
+                home_altitude_m=request.min_altitude_m,
             )
     except (SolverError, InfeasibleError) as exc:
         # SolverError: seen with tiny jerk limits, the QP backends hit their iteration
@@ -373,10 +380,14 @@ def _unplannable(request: PlanRequest, drone: int, exc: Exception) -> StudioInpu
 
 
 def _solve_stage(step: str, solves: int) -> str:
-    """One of mission.py's per-solve records in plain words, with the try's number."""
+    """One of the planning's per-solve records in plain words, with the try's number.
+
+    The time allocation tries its fastest timing first, then slower ones
+    (:mod:`~skyquill.calligraphy.allocation`); re-segmentation comes last.
+    """
     if step.startswith("re-segmenting"):
         what = "giving each part of the route the time it needs"
-    elif "(stretch 0)" in step:
+    elif solves == 1:
         what = "fitting the flight to the limits"
     else:
         what = "fitting again, slower"
@@ -384,7 +395,7 @@ def _solve_stage(step: str, solves: int) -> str:
 
 
 class _SolveHandler(logging.Handler):
-    """Passes each of mission.py's per-solve DEBUG records to a callback, as its message."""
+    """Passes each of the planning's per-solve DEBUG records to a callback, as its message."""
 
     def __init__(self, callback: Callable[[str], None]) -> None:
         super().__init__(logging.DEBUG)
@@ -523,19 +534,26 @@ def _exports(
     record: dict[str, Any],
     progress: Progress,
     formats: dict[str, str],
-) -> tuple[dict[str, StudioFile], list[str]]:
+    min_altitude_m: float,
+) -> tuple[dict[str, StudioFile], list[str], list[Delivered]]:
     """The plan's setpoint CSV(s) and summary, and the chosen vehicle's ``formats``.
 
     Everything is written through the same writer and exporters as the command
     line (a plan directory in a temporary folder, then
     :data:`~skyquill.export.EXPORTERS`), kept in memory, and checked as written.
-    ``record`` (the plan id, the request, the simulated flights) heads ``summary.json``.
-    Files are keyed by their kind (``setpoints.csv``).
+    ``record`` (the plan id, the request, the simulated flights) heads ``summary.json``,
+    which also gets each export's report under ``exports.<kind>`` (its ``as_played`` the
+    verdict the page words). Files are keyed by their kind (``setpoints.csv``).
     """
     planned = [
         (
             f"drone_{i}",
-            PlannedTrajectory(m.vehicle_trajectory(), tuple(m.pen_windows), m.limits),
+            PlannedTrajectory(
+                m.vehicle_trajectory(),
+                tuple(m.pen_windows),
+                m.limits,
+                phases=flight_phases(m.vehicle_trajectory(), min_altitude_m),
+            ),
         )
         for i, m in enumerate(missions, start=1)
     ]
@@ -549,6 +567,7 @@ def _exports(
             rate=CSV_RATE_HZ,
             guaranteed=True,
             summary=record | {"drones": [m.summary() for m in missions]},
+            min_altitude_m=min_altitude_m,
         )
         setpoints = [
             (f"setpoints_{i}.csv", (out / "plan" / d["csv"]).read_bytes())
@@ -562,6 +581,8 @@ def _exports(
             )
         ]
         notes = []
+        delivered: list[Delivered] = []
+        summary["exports"] = {}
         for k, (name, stem) in enumerate(formats.items(), start=2):
             progress(SHOW_END + 0.09 * (k - 1) / steps, f"writing the {stem} (file {k} of {steps})")
             exporter = EXPORTERS[name]
@@ -574,12 +595,30 @@ def _exports(
                 logger.warning("studio: %s export refused: %s", name, exc)
                 notes.append(f"The {stem} file could not be made for this flight ({exc})")
                 continue
+            except InfeasibleError as exc:
+                # A format that cannot play the plan inside its limits (a .skyc whose grid
+                # cannot): no download, and the verdict says so.
+                logger.warning("studio: %s export refused: %s", name, exc)
+                notes.append(
+                    f"The {stem} file was not made: as its player would fly it, it would go "
+                    f"over the limits ({exc})"
+                )
+                summary["exports"][stem] = {"format": name, "refused": str(exc)}
+                delivered.append(Delivered(kind=stem, verdict="refused"))
+                continue
+            played = report.as_played.as_dict()
+            summary["exports"][stem] = {
+                "format": name,
+                "message": report.message.replace(str(out) + "/", ""),
+                "as_played": played,
+            }
+            delivered.append(Delivered.model_validate({"kind": stem} | played))
             notes.append(_export_note(name, stem, report))
             parts = [(f.name, f.read_bytes()) for f in report.files]
             files.append(_bundle(parts, stem, DESCRIPTIONS.get(name, exporter.help)))
         data = json.dumps(summary, indent=2, allow_nan=False).encode()
     files.append(StudioFile("summary.json", data, "application/json", DESCRIPTIONS["summary"]))
-    return {f.name: f for f in files}, notes
+    return {f.name: f for f in files}, notes, delivered
 
 
 def _export_note(name: str, stem: str, report: ExportReport) -> str:
@@ -591,9 +630,19 @@ def _export_note(name: str, stem: str, report: ExportReport) -> str:
     if uploads:
         counts = [len(d.get("uploads", ())) for d in uploads]
         extra = f"; {max(counts)} upload{'' if max(counts) == 1 else 's'} per drone at most"
+    played = report.as_played
+    if played.exact:
+        limits = "and within every limit"
+    else:
+        over = ", ".join(
+            f"{ORDER_NAMES[n]} {100 * e:.2f} %"
+            for n, e in enumerate(played.excess, start=1)
+            if e > EXACT_TOLERANCE
+        )
+        limits = f"but over the limits by {over} (summary.json: exports.{stem}.as_played)"
     return (
         f"The {stem} file, read back as {CONSUMERS.get(name, 'its player reads it')}, stays "
-        f"within {within} of the planned flight{extra}"
+        f"within {within} of the planned flight{extra}, {limits}"
     )
 
 

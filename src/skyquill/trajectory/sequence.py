@@ -18,10 +18,9 @@ from skyquill.errors import InputError
 from skyquill.trajectory.base import Samples, Trajectory, evaluation_times, sample
 from skyquill.validation import FloatArray, as_int
 
-#: Largest position gap between consecutive pieces, m.
+#: Largest position gap between consecutive pieces (m), and speed (m/s) and acceleration
+#: (m/s^2) at a join that still count as rest.
 JOIN_TOLERANCE_M = 1e-6
-#: Largest speed (m/s) and acceleration (m/s^2) at a join that still counts as rest.
-REST_TOLERANCE = 1e-6
 
 
 @dataclass(frozen=True)
@@ -33,9 +32,14 @@ class RestToRestSequence:
     pieces
         At least one trajectory, all with the same number of axes; each next
         one starts where the previous one ends, and both are at rest there.
+    tolerance
+        Largest gap (m), speed (m/s) and acceleration (m/s^2) at a join that still
+        counts as meeting at rest; float32 pieces (a Crazyflie's own polynomials) end
+        within a float32 rounding of their targets and need more than the default.
     """
 
     pieces: tuple[Trajectory, ...]
+    tolerance: float = JOIN_TOLERANCE_M
 
     def __post_init__(self) -> None:
         pieces = tuple(self.pieces)
@@ -45,7 +49,7 @@ class RestToRestSequence:
         if len(dims) > 1:
             raise InputError(f"pieces: got axes {sorted(dims)}, expected one number of axes")
         for i in range(1, len(pieces)):
-            _check_join(i, pieces[i - 1], pieces[i])
+            _check_join(i, pieces[i - 1], pieces[i], self.tolerance)
         object.__setattr__(self, "pieces", pieces)
 
     @property
@@ -102,21 +106,21 @@ def concatenate(pieces: Sequence[Trajectory]) -> Trajectory:
     return pieces[0] if len(pieces) == 1 else RestToRestSequence(tuple(pieces))
 
 
-def _check_join(i: int, before: Trajectory, after: Trajectory) -> None:
+def _check_join(i: int, before: Trajectory, after: Trajectory, tolerance: float) -> None:
     end = np.array([before.duration])
     start = np.array([0.0])
     gap = float(np.linalg.norm(before.evaluate(end)[0] - after.evaluate(start)[0]))
-    if gap > JOIN_TOLERANCE_M:
+    if gap > tolerance:
         raise InputError(
             f"pieces[{i}]: got a start {gap:.3g} m from where pieces[{i - 1}] ends, "
-            f"expected at most {JOIN_TOLERANCE_M:g} m"
+            f"expected at most {tolerance:g} m"
         )
     for order, name in ((1, "speed"), (2, "acceleration")):
         for which, traj, at in ((i - 1, before, end), (i, after, start)):
             value = float(np.linalg.norm(traj.evaluate(at, order)[0]))
-            if value > REST_TOLERANCE:
+            if value > tolerance:
                 raise InputError(
                     f"pieces[{which}]: got {name} {value:.3g} at the join with the "
                     f"{'next' if which == i - 1 else 'previous'} piece, expected rest "
-                    f"(at most {REST_TOLERANCE:g})"
+                    f"(at most {tolerance:g})"
                 )

@@ -45,8 +45,12 @@ def plot_coverage(plan: CoveragePlan, path: str | Path) -> None:
     """
     opts = plan.options
     sp = plan.samples()
-    fig = plt.figure(figsize=(13, 6.5), layout="constrained")
-    grid = fig.add_gridspec(3, 2, width_ratios=(1.1, 1.0))
+    # A fixed layout: constrained layout draws the figure twice to measure it.
+    fig = plt.figure(figsize=(13, 6.5))
+    grid = fig.add_gridspec(
+        3, 2, width_ratios=(1.1, 1.0), left=0.06, right=0.98, bottom=0.08, top=0.9,
+        hspace=0.45, wspace=0.18,
+    )  # fmt: skip
     top = fig.add_subplot(grid[:, 0])
     sprayed = None if plan.mission is None else plan.mission.swept  # spray off on transits
     # The planner's own simplified sweep: the raw buffer of a 20 km path's 1 M

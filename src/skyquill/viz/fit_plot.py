@@ -31,12 +31,14 @@ def plot_fit(fit: PointFit, path: str | Path, title: str = "") -> None:
     """
     traj = fit.trajectory
     t = np.linspace(0.0, traj.duration, 2000)
-    fig, ax = plt.subplots(2, 2, figsize=(11, 8), layout="constrained")
+    # A fixed layout: constrained layout draws the figure twice to measure it (half the time).
+    fig, ax = plt.subplots(2, 2, figsize=(11, 8))
+    fig.subplots_adjust(left=0.07, right=0.98, bottom=0.07, top=0.92, hspace=0.28, wspace=0.22)
     p = traj.evaluate(t)
     ax[0, 0].plot(fit.points[:, 0], fit.points[:, 1], ".", ms=2, color="0.6", label="input")
     ax[0, 0].plot(p[:, 0], p[:, 1], "-", lw=1.2, color="C0", label="trajectory")
     ax[0, 0].set(xlabel="x [m]", ylabel="y [m]", aspect="equal", title="path (top view)")
-    ax[0, 0].legend(loc="best", fontsize=8)
+    ax[0, 0].legend(loc="upper right", fontsize=8)  # "best" tests every point of the path
     for panel, order, unit in ((ax[0, 1], 1, "m/s"), (ax[1, 0], 2, "m/s²"), (ax[1, 1], 3, "m/s³")):
         values = traj.evaluate(t, order)
         for i in range(values.shape[1]):

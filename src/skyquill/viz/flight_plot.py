@@ -31,8 +31,12 @@ def plot_flight(flight: Flight, path: str | Path, title: str = "") -> None:
     title
         Figure title (the controller, simulator and errors are appended).
     """
-    fig = plt.figure(figsize=(13, 8), layout="constrained")
-    grid = fig.add_gridspec(2, 3, height_ratios=(1.0, 1.4))
+    # A fixed layout: constrained layout draws the figure twice to measure it.
+    fig = plt.figure(figsize=(13, 8))
+    grid = fig.add_gridspec(
+        2, 3, height_ratios=(1.0, 1.4), left=0.06, right=0.98, bottom=0.07, top=0.91,
+        hspace=0.3, wspace=0.25,
+    )  # fmt: skip
     t = flight.t
     for i, axis in enumerate(AXES):
         panel = fig.add_subplot(grid[0, i])
@@ -40,7 +44,7 @@ def plot_flight(flight: Flight, path: str | Path, title: str = "") -> None:
         panel.plot(t, flight.p[:, i], "-", lw=1.0, color="C0", label="flown")
         panel.set(xlabel="t [s]", ylabel=f"{axis} [m]", title=f"{axis} against time")
         if i == 0:
-            panel.legend(loc="best", fontsize=8)
+            panel.legend(loc="upper right", fontsize=8)  # "best" tests every point
 
     top = fig.add_subplot(grid[1, 0])
     top.plot(flight.p_ref[:, 0], flight.p_ref[:, 1], "--", lw=1.2, color="0.45", label="reference")
@@ -50,7 +54,7 @@ def plot_flight(flight: Flight, path: str | Path, title: str = "") -> None:
             stroke[:, 0], stroke[:, 1], "-", lw=2.5, color="k", label="ink" if k == 0 else None
         )
     top.set(xlabel="x [m]", ylabel="y [m]", aspect="equal", title="top view")
-    top.legend(loc="best", fontsize=8)
+    top.legend(loc="upper right", fontsize=8)
 
     err = fig.add_subplot(grid[1, 1:])
     error_mm = 1e3 * flight.position_error

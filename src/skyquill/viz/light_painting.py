@@ -26,10 +26,11 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
-from matplotlib.animation import FuncAnimation, PillowWriter
 from matplotlib.axes import Axes
 from matplotlib.collections import LineCollection
 from matplotlib.figure import Figure
+from numpy.typing import NDArray
+from PIL import Image, ImageDraw
 
 from skyquill.colors import RGB
 from skyquill.errors import InputError
@@ -50,6 +51,12 @@ PREVIEW_FPS = 12
 TRAIL_RATE_HZ = 25.0
 #: Colour of a drone whose light is off (RGB 0..1).
 DARK = (0.35, 0.35, 0.35)
+#: Colour of the preview's clock (RGB 0..255).
+STAMP = (204, 204, 204)
+#: The photograph keeps a sample where the light has moved on by this much, px.
+THIN_PX = 0.5
+#: Longest trail segment rasterised, px (a segment across the whole preview).
+MAX_SEGMENT_PX = 2000
 DPI = 100
 
 
@@ -95,9 +102,11 @@ class Exposure:
     drones: int
 
 
-def _lit_polylines(
-    drones: Sequence[PlannedTrajectory], default: RGB
-) -> list[tuple[FloatArray, tuple[float, float, float]]]:
+#: A lit stretch of one drone: positions (K, 3), m, and its colour (0..1).
+Polyline = tuple[FloatArray, tuple[float, float, float]]
+
+
+def lit_polylines(drones: Sequence[PlannedTrajectory], default: RGB) -> list[Polyline]:
     """Each lit window of each drone as (positions (K, 3), colour 0..1)."""
     total = sum(b - a for d in drones for a, b in d.pen_windows_s) * EXPOSURE_RATE_HZ
     rate = EXPOSURE_RATE_HZ * min(1.0, MAX_EXPOSURE_SAMPLES / max(total, 1.0))
@@ -110,18 +119,33 @@ def _lit_polylines(
     return out
 
 
-def _segments(camera: Camera, points: FloatArray) -> FloatArray:
-    """Image segments (M, 2, 2) of a polyline, the parts behind the camera left out."""
+def _image_runs(camera: Camera, points: FloatArray) -> list[FloatArray]:
+    """The visible runs (K, 2) of a polyline in the image, thinned to :data:`THIN_PX`.
+
+    The parts behind the camera are left out. A sample is kept where the path has
+    moved on by another :data:`THIN_PX` along the image, and at both ends: the
+    photograph cannot show the samples in between (a formation's drones hold still
+    for seconds at 100 samples a second).
+    """
     uv, front = camera.project(points)
-    keep = front[:-1] & front[1:]
-    return np.stack([uv[:-1], uv[1:]], axis=1)[keep]
+    runs = []
+    cuts = np.flatnonzero(np.diff(front.astype(np.int8))) + 1
+    for run, seen in zip(np.split(uv, cuts), np.split(front, cuts), strict=True):
+        if not seen[0]:
+            continue
+        arc = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(run, axis=0).T))])
+        step = np.floor(arc / THIN_PX)
+        keep = np.concatenate([[True], step[1:] != step[:-1]])
+        keep[-1] = True
+        runs.append(run[keep])
+    return runs
 
 
-def _extent_px(segs: FloatArray) -> float:
-    """Largest side of the image box of ``segs`` (M, 2, 2), px; inf when none is visible."""
-    if segs.size == 0:
+def _extent_px(runs: Sequence[FloatArray]) -> float:
+    """Largest side of the image box of ``runs``, px; inf when none is visible."""
+    if not runs:
         return math.inf
-    points = segs.reshape(-1, 2)
+    points = np.concatenate(runs)
     return float(np.max(points.max(axis=0) - points.min(axis=0)))
 
 
@@ -141,6 +165,8 @@ def long_exposure(
     camera: Camera,
     path: str | Path,
     default_rgb: RGB = (255, 255, 255),
+    *,
+    lines: Sequence[Polyline] | None = None,
 ) -> Exposure:
     """Write the long-exposure photograph of the show's lights as a PNG.
 
@@ -154,6 +180,8 @@ def long_exposure(
         PNG file to write.
     default_rgb
         The colour of windows whose drone has no colours of its own.
+    lines
+        The lit polylines (:func:`lit_polylines`) when the caller has them already.
 
     Raises
     ------
@@ -162,19 +190,30 @@ def long_exposure(
     """
     if not drones:
         raise InputError("drones: got none, expected at least one to photograph")
+    lines = lit_polylines(drones, default_rgb) if lines is None else lines
     fig, ax = _black_figure(camera)
-    lines = _lit_polylines(drones, default_rgb)
-    segments = [(_segments(camera, points), rgb) for points, rgb in lines]
+    runs = [_image_runs(camera, points) for points, _ in lines]
+    rgb = np.array([c for _, c in lines]).reshape(-1, 3)
+    extent = np.array([_extent_px(r) for r in runs])
+    counts = np.array([len(r) for r in runs], dtype=np.intp)
+    every = [run for window in runs for run in window]
+    centres = np.array(
+        [np.concatenate(r).mean(axis=0) if r else (np.nan, np.nan) for r in runs]
+    ).reshape(-1, 2)
+    # One collection per glow pass, one path per lit window (not one artist per window,
+    # nor one path per sample: a thousand drones were a million segments); the core of
+    # a light trace is whiter than its halo.
     for width, alpha in GLOW:
-        for segs, rgb in segments:
-            # the core of a light trace is whiter than its halo, as on a sensor
-            core = tuple(0.6 * c + 0.4 for c in rgb) if alpha == 1.0 else rgb
-            ax.add_collection(
-                LineCollection(list(segs), colors=[core], linewidths=width, alpha=alpha)
+        colour = 0.6 * rgb + 0.4 if alpha == 1.0 else rgb
+        ax.add_collection(
+            LineCollection(
+                every, colors=np.repeat(colour, counts, axis=0), linewidths=width, alpha=alpha
             )
-            if _extent_px(segs) < width:  # a light held still (a formation): a dot
-                u, v = segs.reshape(-1, 2).mean(axis=0)
-                ax.scatter(u, v, s=(1.6 * width) ** 2, color=[core], alpha=alpha, lw=0)
+        )
+        still = extent < width  # a light held still (a formation place): a dot
+        if still.any():
+            u, v = centres[still].T
+            ax.scatter(u, v, s=(1.6 * width) ** 2, c=colour[still], alpha=alpha, lw=0)
     fig.savefig(path, dpi=DPI, facecolor="black")
     plt.close(fig)
     length = sum(float(np.linalg.norm(np.diff(p, axis=0), axis=1).sum()) for p, _ in lines)
@@ -191,6 +230,11 @@ def animate_show(
     max_frames: int = MAX_FRAMES,
 ) -> int:
     """Write an animated GIF of the show through ``camera``; returns the number of frames.
+
+    Frames are drawn straight into pixel arrays (numpy) and written by Pillow: every
+    lit stretch of every drone is rasterised once, as the pixels of its segments with
+    the time each is reached, and a frame shows those inside its trail window; the
+    drones are 3 px squares, lit in their colour or dark grey.
 
     Parameters
     ----------
@@ -212,34 +256,116 @@ def animate_show(
     trail = horizon if trail_s == math.inf else as_float("trail_s", trail_s, nonneg=True)
     clock = np.linspace(0.0, horizon, max(2, int(horizon * TRAIL_RATE_HZ)) + 1)
     uv, lit, colors = _tracks(drones, camera, clock, default_rgb)
-    fig, ax = _black_figure(camera)
-    dots = ax.scatter(uv[:, 0, 0], uv[:, 0, 1], s=14, c=[DARK] * len(drones))
-    trails = LineCollection([], linewidths=2.0)
-    ax.add_collection(trails)
-    stamp = ax.text(10, 24, "", color="0.8", fontsize=11)
+    pixels = _trail_pixels(uv, lit, colors, clock, camera)
     times = np.linspace(0.0, horizon, min(frames, max(2, int(horizon * PREVIEW_FPS))))
-
-    def draw(t: float) -> None:
-        k = int(np.searchsorted(clock, t))
-        k = min(k, clock.size - 1)
-        dots.set_offsets(uv[:, k])
-        dots.set_facecolor([tuple(c) for c in np.where(lit[:, k, None], colors[:, k], DARK)])
-        first = max(0, int(np.searchsorted(clock, t - trail)))
-        segs, cols = _trail_segments(uv[:, first : k + 1], lit[:, first : k + 1], colors[:, first:])
-        trails.set_segments(list(segs))
-        trails.set_color([tuple(c) for c in cols])
-        stamp.set_text(f"t = {t:5.1f} s")
-
-    FuncAnimation(fig, draw, frames=times, blit=False).save(
-        str(path), writer=PillowWriter(fps=PREVIEW_FPS), dpi=DPI
+    size = (camera.height_px, camera.width_px, 3)
+    built = np.zeros(size, dtype=np.uint8)  # trails that never fade (trail >= the show)
+    shown = 0
+    images = []
+    for t in times:
+        k = min(int(np.searchsorted(clock, t)), clock.size - 1)
+        end = int(np.searchsorted(pixels.t, t, side="right"))
+        if trail >= horizon:
+            pixels.paint(built, shown, end)
+            shown = end
+            frame = built.copy()
+        else:
+            frame = np.zeros(size, dtype=np.uint8)
+            pixels.paint(frame, int(np.searchsorted(pixels.t, t - trail)), end)
+        _paint_dots(frame, uv[:, k], np.where(lit[:, k, None], colors[:, k], DARK))
+        image = Image.fromarray(frame)
+        draw = ImageDraw.Draw(image)
+        draw.fontmode = "1"  # no antialiasing: the frame keeps the palette's colours
+        draw.text((10, 10), f"t = {t:5.1f} s", fill=STAMP)
+        images.append(image)
+    # One palette for every frame (the lights' colours, dark, the stamp), instead of
+    # Pillow's median cut per frame: the frames hold only these colours.
+    palette = _palette(colors)
+    images = [im.quantize(palette=palette, dither=Image.Dither.NONE) for im in images]
+    images[0].save(
+        str(path),
+        format="GIF",
+        save_all=True,
+        append_images=images[1:],
+        duration=round(1000 / PREVIEW_FPS),
+        loop=0,
     )
-    plt.close(fig)
     return int(times.size)
+
+
+@dataclass(frozen=True)
+class _Pixels:
+    """Pixels of every lit trail segment, by the time each is reached (sorted)."""
+
+    t: FloatArray
+    u: NDArray[np.intp]
+    v: NDArray[np.intp]
+    rgb: NDArray[np.uint8]
+
+    def paint(self, frame: NDArray[np.uint8], start: int, end: int) -> None:
+        """Set the pixels ``[start, end)`` (2 px wide: each with its right and lower neighbours)."""
+        u, v, rgb = self.u[start:end], self.v[start:end], self.rgb[start:end]
+        height, width = frame.shape[:2]
+        for du, dv in ((0, 0), (1, 0), (0, 1), (1, 1)):
+            frame[np.minimum(v + dv, height - 1), np.minimum(u + du, width - 1)] = rgb
+
+
+def _trail_pixels(
+    uv: FloatArray, lit: NDArray[np.bool_], colors: FloatArray, clock: FloatArray, camera: Camera
+) -> _Pixels:
+    """Rasterise the segments between consecutive lit samples (one pixel step along each)."""
+    both = lit[:, :-1] & lit[:, 1:]
+    drone, k = np.nonzero(both)
+    a, b = uv[drone, k], uv[drone, k + 1]
+    box = np.array([camera.width_px, camera.height_px], dtype=float)
+    inside = np.all((a > -box) & (a < 2 * box) & (b > -box) & (b < 2 * box), axis=1)
+    a, b, drone, k = a[inside], b[inside], drone[inside], k[inside]
+    steps = np.minimum(np.ceil(np.abs(b - a).max(axis=1)).astype(np.intp), MAX_SEGMENT_PX) + 1
+    seg = np.repeat(np.arange(steps.size), steps)
+    frac = (np.arange(steps.sum()) - np.repeat(np.cumsum(steps) - steps, steps)) / np.repeat(
+        steps, steps
+    )
+    points = a[seg] + frac[:, None] * (b[seg] - a[seg])
+    when = clock[k[seg]] + frac * (clock[k[seg] + 1] - clock[k[seg]])
+    keep = np.all((points >= 0) & (points < box), axis=1)
+    order = np.argsort(when[keep], kind="stable")
+    rgb = np.clip(np.round(255 * colors[drone[seg], k[seg]]), 0, 255).astype(np.uint8)
+    return _Pixels(
+        when[keep][order],
+        points[keep, 0].astype(np.intp)[order],
+        points[keep, 1].astype(np.intp)[order],
+        rgb[keep][order],
+    )
+
+
+def _palette(colors: FloatArray) -> Image.Image:
+    """A P-mode image whose palette holds black, dark, the stamp and every light colour."""
+    lights = np.unique(np.clip(np.round(255 * colors.reshape(-1, 3)), 0, 255), axis=0)
+    fixed = np.array([(0, 0, 0), [round(255 * c) for c in DARK], STAMP], dtype=float)
+    every = np.unique(np.concatenate([fixed, lights]), axis=0)[:256].astype(np.uint8)
+    flat = np.zeros(768, dtype=np.uint8)
+    flat[: every.size] = every.ravel()
+    image = Image.new("P", (1, 1))
+    image.putpalette(flat.tolist())
+    return image
+
+
+def _paint_dots(frame: NDArray[np.uint8], uv: FloatArray, rgb: FloatArray) -> None:
+    """Each drone as a 3 px square at ``uv`` (D, 2) in its colour (D, 3) 0..1 (none if hidden)."""
+    height, width = frame.shape[:2]
+    seen = np.all(np.isfinite(uv), axis=1)
+    centre = np.round(uv[seen]).astype(np.intp)
+    colour = np.clip(np.round(255 * rgb[seen]), 0, 255).astype(np.uint8)
+    for du in (-1, 0, 1):
+        for dv in (-1, 0, 1):
+            u, v = centre[:, 0] + du, centre[:, 1] + dv
+            on = (u >= 0) & (u < width) & (v >= 0) & (v < height)
+            frame[v[on], u[on]] = colour[on]
 
 
 def _tracks(
     drones: Sequence[PlannedTrajectory], camera: Camera, clock: FloatArray, default: RGB
-) -> tuple[FloatArray, np.ndarray, FloatArray]:
+) -> tuple[FloatArray, NDArray[np.bool_], FloatArray]:
     """Image positions (D, T, 2), lit (D, T) and colours 0..1 (D, T, 3) on ``clock``."""
     uv = np.empty((len(drones), clock.size, 2))
     lit = np.zeros((len(drones), clock.size), dtype=bool)
@@ -252,15 +378,6 @@ def _tracks(
         lit[i] = light.any(axis=1) & front
         colors[i] = light / 255.0
     return uv, lit, colors
-
-
-def _trail_segments(
-    uv: FloatArray, lit: np.ndarray, colors: FloatArray
-) -> tuple[FloatArray, FloatArray]:
-    """Segments (M, 2, 2) between consecutive lit samples, and their colours (M, 3)."""
-    both = lit[:, :-1] & lit[:, 1:]
-    segs = np.stack([uv[:, :-1], uv[:, 1:]], axis=2)[both]
-    return segs, colors[:, : uv.shape[1] - 1][both]
 
 
 #: Size of the photograph and of the preview, pixels (width, height).
@@ -279,10 +396,12 @@ def write_pictures(
     """Write ``long_exposure.png`` and ``preview.gif`` into ``folder``; their summary entry.
 
     The photograph frames the lit path (what the camera records); the preview frames
-    the whole flight (take-off and landing included).
+    the whole flight (take-off and landing included). The lit path is sampled once for
+    both the framing and the photograph.
     """
-    everything = _positions(drones, lit_only=False)
-    lit = _positions(drones, lit_only=True)
+    lines = lit_polylines(drones, default_rgb)
+    everything = _positions(drones)
+    lit = np.concatenate([p for p, _ in lines]) if lines else np.empty((0, 3))
     photo_camera = Camera.framing(
         lit if lit.size else everything,
         view.azimuth_deg,
@@ -291,7 +410,9 @@ def write_pictures(
         width_px=PHOTO_PX[0],
         height_px=PHOTO_PX[1],
     )
-    photo = long_exposure(drones, photo_camera, folder / "long_exposure.png", default_rgb)
+    photo = long_exposure(
+        drones, photo_camera, folder / "long_exposure.png", default_rgb, lines=lines
+    )
     preview_camera = Camera.framing(
         everything,
         view.azimuth_deg,
@@ -317,11 +438,8 @@ def write_pictures(
     }
 
 
-def _positions(drones: Sequence[PlannedTrajectory], *, lit_only: bool) -> FloatArray:
-    """Sampled positions of every drone (M, 3): the lit ones, or the whole flights."""
-    if lit_only:
-        lines = _lit_polylines(drones, (255, 255, 255))
-        return np.concatenate([p for p, _ in lines]) if lines else np.empty((0, 3))
+def _positions(drones: Sequence[PlannedTrajectory]) -> FloatArray:
+    """Positions of every drone's whole flight, 400 samples each (M, 3)."""
     return np.concatenate(
         [d.trajectory.evaluate(np.linspace(0.0, d.trajectory.duration, 400)) for d in drones]
     )

@@ -38,7 +38,8 @@ def plot_mission(result: MissionResult, path: str | Path, title: str = "") -> No
         f"RMSE {100 * result.rmse_m:.2f} cm, max {100 * result.max_error_m:.2f} cm, "
         f"{result.flight_time_s / 60:.1f} min, {result.landings} landing(s)"
     )
-    fig.tight_layout()
+    # A fixed layout: tight_layout draws the figure once more to measure it.
+    fig.subplots_adjust(left=0.05, right=0.98, bottom=0.07, top=0.92, hspace=0.3, wspace=0.25)
     fig.savefig(path, dpi=90)
     plt.close(fig)
 

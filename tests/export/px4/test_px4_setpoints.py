@@ -143,14 +143,45 @@ def test_send_with_grpc_mavsdk_is_input_error(monkeypatch: pytest.MonkeyPatch) -
 
 
 class FakeSystem:
-    """A PX4 stand-in with the async methods send_mavsdk calls; records every call."""
+    """A PX4 stand-in with the async methods send_mavsdk calls; records every call.
 
-    def __init__(self, connects: bool = True, start_ok: bool = True) -> None:
+    Its take-off climbs to the asked height in three polls (never, with ``climbs=False``);
+    its landing reaches the ground in two.
+    """
+
+    def __init__(self, connects: bool = True, climbs: bool = True) -> None:
         self.connects = connects
+        self.climbs = climbs
         self.calls: list[str] = []
         self.sent: list[tuple[float, tuple[float, ...]]] = []  # (loop time, setpoint row)
         self.offboard_active = False
         self.closed = False
+        self.target = 0.0
+        self.z = 0.0
+        self.polls = 0
+
+    async def set_parameter(self, name: str, value: float) -> None:
+        self.calls.append(f"{name} {value:g}")
+
+    async def arm(self) -> None:
+        self.calls.append("arm")
+
+    async def takeoff(self, altitude_m: float) -> None:
+        self.calls.append(f"takeoff {altitude_m:g}")
+        self.target = altitude_m
+
+    async def height(self) -> tuple[bool, float]:
+        self.polls += 1
+        if self.climbs:
+            self.z = min(self.target, self.z + self.target / 3)
+        return self.z > 0.0, self.z
+
+    async def land(self) -> None:
+        self.calls.append("land")
+
+    async def landed(self) -> bool:
+        self.z = max(0.0, self.z - self.target / 2)
+        return self.z == 0.0
 
     async def connect(self, system_address: str) -> None:
         self.calls.append(f"connect {system_address}")
@@ -189,10 +220,12 @@ def test_fake_system_sees_the_offboard_sequence() -> None:
     n = send_mavsdk(sp, "udpin://0.0.0.0:14540", dry_run=False, system_factory=lambda: fake)
     assert n == len(sp) == 21
     assert fake.calls == (
-        ["connect udpin://0.0.0.0:14540", "wait_connected", "setpoint", "start"]
+        ["connect udpin://0.0.0.0:14540", "wait_connected", "arm", "takeoff 3"]
+        + ["setpoint", "start"]
         + ["setpoint"] * len(sp)
-        + ["stop"]
+        + ["stop", "land"]
     )
+    assert fake.z == 0.0  # landed: waited for
     assert fake.closed and not fake.offboard_active
     # every row arrives, in order, as the NED setpoint (yaw 0 = north)
     rows = np.array([row for _, row in fake.sent[1:]])
@@ -221,6 +254,22 @@ def test_stop_runs_after_a_failed_send() -> None:
     ):
         send_mavsdk(sp, dry_run=False, send_timeout_s=0.05, system_factory=lambda: fake)
     assert fake.calls[-1] == "stop" and fake.closed
+
+
+def test_a_take_off_that_does_not_climb_hits_the_step_timeout() -> None:
+    sp = px4_setpoints(line((1.0, 0.0, 0.0)), rate_hz=25.0)
+    fake = FakeSystem(climbs=False)
+    with pytest.raises(SolverError, match=r"step_timeout_s: got 0.3 s, which passed before it "
+                       r"took off to 3.00 m"):  # fmt: skip
+        send_mavsdk(sp, dry_run=False, step_timeout_s=0.3, system_factory=lambda: fake)
+    assert "setpoint" not in fake.calls and fake.closed  # never in offboard
+
+
+def test_a_first_setpoint_on_the_ground_is_refused() -> None:
+    ground = SplineTrajectory(np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]]), 1, 2.0)
+    sp = px4_setpoints(ground, rate_hz=25.0)
+    with pytest.raises(InputError, match=r"setpoints: got a first setpoint 0.000 m above home"):
+        send_mavsdk(sp, dry_run=False, system_factory=FakeSystem)
 
 
 def test_never_connecting_hits_the_connect_timeout() -> None:
@@ -296,3 +345,22 @@ def test_setpoints_is_frozen() -> None:
     assert isinstance(sp, Px4Setpoints)
     with pytest.raises(AttributeError):
         sp.rate_hz = 5.0  # type: ignore[misc]
+
+
+def test_px4_parameters_keep_its_take_off_and_landing_inside_the_plan() -> None:
+    """Each parameter is PX4's default or the plan's bound for its order, whichever is
+    smaller; they are set before arming."""
+    from skyquill.export.px4.flight_parameters import PX4_DEFAULTS, px4_flight_parameters
+    from skyquill.limits import VehicleLimits
+
+    slow = px4_flight_parameters(VehicleLimits(0.5, 1.0, 2.0).derivative_limits(3))
+    assert slow["MPC_TKO_SPEED"] == slow["MPC_LAND_SPEED"] == 0.5
+    assert slow["MPC_ACC_UP_MAX"] == slow["MPC_ACC_DOWN_MAX"] == 1.0
+    assert slow["MPC_JERK_AUTO"] == 2.0
+    fast = px4_flight_parameters(VehicleLimits(10.0, 20.0, 100.0).derivative_limits(3))
+    assert fast == {name: value for name, (_, value) in PX4_DEFAULTS.items()}
+    system = FakeSystem()
+    sp = px4_setpoints(line((1.0, 0.0, 0.0), duration=0.4), rate_hz=50.0)
+    send_mavsdk(sp, dry_run=False, system_factory=lambda: system, parameters=slow,
+                step_timeout_s=5.0)  # fmt: skip
+    assert system.calls[2 : len(slow) + 3] == [f"{k} {v:g}" for k, v in slow.items()] + ["arm"]

@@ -2,20 +2,27 @@
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from skyquill.colors import check_rgb
 from skyquill.errors import InputError
 from skyquill.export.skybrush import lights
 from skyquill.export.skybrush.lights import (
+    LightSlice,
     colored_frames,
     encode_light_program,
     light_colors,
     light_slices,
     lights_json,
+    longest_mismatch_ms,
     program_bytes,
 )
+from skyquill.io.trajectory_json import light_at
 
 
 def frame_windows(windows: list[tuple[float, float]]) -> list[tuple[int, int]]:
@@ -124,3 +131,50 @@ def test_touching_windows_of_two_colours_switch_on_the_frame() -> None:
 def test_bad_colours_per_window_are_named(colors: object, message: str) -> None:
     with pytest.raises(InputError, match=message):
         encode_light_program([(0.0, 1.0), (2.0, 3.0)], colors, 4.0)  # type: ignore[arg-type]
+
+
+def _every_millisecond(
+    slices: list[LightSlice],
+    windows: list[tuple[float, float]],
+    colors: list[tuple[int, int, int]],
+    end_ms: int,
+) -> int:
+    """The longest run of wrong milliseconds, comparing every one of them."""
+    t = np.arange(0.0, end_ms + 1)
+    wrong = np.any(light_colors(slices, t) != light_at(t / 1000, windows, colors), axis=1)
+    runs = np.diff(np.flatnonzero(np.diff(np.concatenate([[0], wrong.astype(int), [0]]))))[::2]
+    return int(runs.max()) if runs.size else 0
+
+
+@settings(max_examples=80, deadline=None)
+@given(seed=st.integers(0, 10**6), fades=st.booleans())
+def test_the_longest_mismatch_is_what_every_millisecond_compared_finds(
+    seed: int, fades: bool
+) -> None:
+    rng = np.random.default_rng(seed)
+    palette = [(255, 0, 0), (0, 255, 0), (255, 255, 255)]
+    cuts = np.sort(rng.uniform(0.0, 4000.0, int(rng.integers(1, 8))))
+    slices = [LightSlice(0.0, 0.0, (0.0, 0.0, 0.0), None)]
+    for a, b in itertools.pairwise([*cuts.tolist(), 4000.0]):
+        rgb = tuple(float(c) for c in palette[int(rng.integers(0, 3))])
+        end = tuple(float(c) for c in palette[int(rng.integers(0, 3))]) if fades else None
+        slices.append(LightSlice(a, b, rgb, end))  # type: ignore[arg-type]
+    slices.append(LightSlice(4000.0, np.inf, (0.0, 0.0, 0.0), None))
+    # windows near the slices' edges (off by whole and fractional milliseconds)
+    edges = np.sort(rng.choice(cuts, 2 * int(rng.integers(0, 4))) / 1000)
+    edges = edges + rng.choice([0.0, 0.001, -0.001, 0.0004, 1e-12], edges.size)
+    windows = [(float(a), float(b)) for a, b in edges.reshape(-1, 2) if b >= a]
+    colors = [palette[int(rng.integers(0, 3))] for _ in windows]
+    end_ms = int(rng.integers(1, 4500))
+    assert longest_mismatch_ms(slices, windows, colors, end_ms) == _every_millisecond(
+        slices, windows, colors, end_ms
+    )
+
+
+def test_a_program_written_for_the_pen_switches_within_a_frame() -> None:
+    windows = [(0.5, 1.2), (1.25, 2.0)]
+    colors: list[tuple[int, int, int]] = [(255, 0, 0), (0, 0, 255)]
+    slices = light_slices("t", encode_light_program(windows, colors, 3.0), 3000.0)
+    offset = longest_mismatch_ms(slices, windows, colors, 3000)
+    assert offset == _every_millisecond(slices, windows, colors, 3000)
+    assert 0 < offset <= 20

@@ -11,6 +11,8 @@ from typing import Any
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from skyquill.errors import InputError
 from skyquill.export.skybrush.playback import played_trajectory, quantize, scaling_factor
@@ -120,3 +122,52 @@ def test_a_show_beyond_32_m_is_stored_in_coarser_units() -> None:
 def test_what_skybrush_cannot_play_is_named(points: list[Any], match: str) -> None:
     with pytest.raises(InputError, match=match):
         played_trajectory("t", {"points": points})
+
+
+_FACTS = (1, 1, 2, 6, 24, 120, 720, 5040)
+
+
+def reference_bezier(points: np.ndarray) -> np.ndarray:
+    """libskybrush's ``sb_poly_make_bezier`` on one axis of one segment, float32, as poly.c."""
+    n = points.size - 1
+    out = np.zeros(4, dtype=np.float32)
+    if n == 0:
+        out[0] = points[0]
+        return out
+    if n == 1:
+        out[0], out[1] = points[0], points[1] - points[0]
+        return out
+    for j in range(n + 1):
+        coeff = np.float32(0.0)
+        sign = -1 if j % 2 else 1
+        for i in range(j + 1):
+            term = np.float32(sign) * points[i]
+            coeff = coeff + term / np.float32(_FACTS[i]) / np.float32(_FACTS[j - i])
+            sign = -sign
+        out[j] = coeff * np.float32(_FACTS[n]) / np.float32(_FACTS[n - j])
+    return out
+
+
+@settings(max_examples=60, deadline=None)
+@given(seed=st.integers(0, 10**6), count=st.integers(2, 30), takeoff=st.sampled_from([0.0, 1.5]))
+def test_every_segment_at_once_is_bit_for_bit_the_firmwares_one_at_a_time(
+    seed: int, count: int, takeoff: float
+) -> None:
+    rng = np.random.default_rng(seed)
+    times = np.round(np.cumsum(rng.uniform(0.001, 3.0, count)), 3)
+    still = rng.random((count, 3)) < 0.3  # axes that do not move
+    positions = rng.uniform(-60, 60, (count, 3))
+    positions[1:] = np.where(still[1:], positions[:-1], positions[1:])
+    points = []
+    for k in range(count):
+        controls = [] if k == 0 else rng.uniform(-60, 60, (int(rng.integers(0, 3)), 3)).tolist()
+        points.append([float(times[k]), positions[k].tolist(), controls])
+    traj = {"version": 1, "points": points, "takeoffTime": takeoff}
+    played = played_trajectory("t", traj)
+    durations, stored = reference_segments(traj)
+    assert played.durations_ms.tolist() == durations
+    for k, per_axis in enumerate(stored):
+        for axis, series in enumerate(per_axis):
+            ints = np.array(series, dtype=np.int64) * played.scale
+            expected = reference_bezier(ints.astype(np.float32))
+            np.testing.assert_array_equal(played.coeffs_mm[k, :, axis], expected)

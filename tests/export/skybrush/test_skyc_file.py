@@ -256,5 +256,54 @@ def test_a_truncated_or_nan_show_is_an_input_error(tmp_path: Path) -> None:
         read_show_json(path)
     show["swarm"]["drones"][0]["settings"]["trajectory"]["points"][1][1][0] = math.nan
     nan = _archive(tmp_path / "nan.skyc", json.dumps(show).encode())  # json writes NaN
-    with pytest.raises(InputError, match=r"points\[1\]\[1\]: got \[nan"):
+    with pytest.raises(InputError, match=r"show.json: got NaN, expected a Skybrush show object"):
         read_show_json(nan)
+
+
+_MUTATIONS = (
+    lambda p: p,
+    lambda p: [p[0], p[1]],  # a point of two fields
+    lambda p: [True, p[1], p[2]],  # a boolean time
+    lambda p: [p[0], [*p[1][:2], "1"], p[2]],  # a string coordinate
+    lambda p: [p[0], [*p[1][:2], float("nan")], p[2]],
+    lambda p: [p[0], p[1][:2], p[2]],  # two coordinates
+    lambda p: [p[0], p[1], [[0.0, 0.0, 0.0]] * 3],  # three control points
+    lambda p: [p[0], p[1], [[0.0, 0.0]]],  # a short control point
+    lambda p: [p[0], p[1], {}],  # controls not a list
+    lambda p: [p[0] + 70.0, p[1], p[2]],  # a 70 s step
+    lambda p: [p[0] - 5.0, p[1], p[2]],  # back in time
+    lambda p: [int(p[0]), [int(c) for c in p[1]], p[2]],  # integers are numbers too
+)
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    seed=st.integers(0, 10**6),
+    count=st.integers(1, 12),
+    mutation=st.integers(0, len(_MUTATIONS) - 1),
+    where=st.integers(0, 11),
+)
+def test_the_bulk_check_accepts_exactly_what_the_field_by_field_one_accepts(
+    seed: int, count: int, mutation: int, where: int
+) -> None:
+    rng = np.random.default_rng(seed)
+    times = np.cumsum(rng.uniform(0.001, 3.0, count)).round(3).tolist()
+    points = [
+        [
+            t,
+            rng.uniform(-5, 5, 3).tolist(),
+            [] if k == 0 else rng.uniform(-5, 5, (int(rng.integers(0, 3)), 3)).tolist(),
+        ]
+        for k, t in enumerate(times)
+    ]
+    k = where % count
+    points[k] = _MUTATIONS[mutation](points[k])
+    bulk = skyc._well_formed(points)
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(skyc, "_well_formed", lambda _: False)
+        try:
+            skyc._check_trajectory("t", {"version": 1, "points": points})
+            one_by_one = True
+        except InputError:
+            one_by_one = False
+    assert bulk == one_by_one

@@ -164,3 +164,20 @@ def test_interior_descent_never_solves_a_conic_program(monkeypatch: pytest.Monke
     assert out.result.method == "closed_form"
     assert out.cost <= first.cost
     assert out.result.verification.max_excess <= 1e-9
+
+
+def test_frozen_segments_keep_their_durations_and_the_rest_descends() -> None:
+    """A descent with some segments frozen moves time among the others only, keeps the
+    total, and still lowers the cost; every segment frozen: nothing moves."""
+    rng = np.random.default_rng(4)
+    points = np.cumsum(rng.normal(0.0, 0.3, (12, 2)), axis=0)
+    times = np.concatenate([[0.0], np.cumsum(rng.uniform(0.5, 1.5, 11))])
+    make = point_fit_factory(points, 20)
+    frozen = np.zeros(11, dtype=bool)
+    frozen[:3] = frozen[-2:] = True
+    out = resegment(points, times, make, mode="fixed", max_iter=6, frozen=frozen)
+    np.testing.assert_allclose(np.diff(out.times)[frozen], np.diff(times)[frozen], rtol=1e-9)
+    assert out.times[-1] == times[-1]
+    assert out.history[-1] < out.history[0]
+    still = resegment(points, times, make, mode="fixed", frozen=np.ones(11, dtype=bool))
+    np.testing.assert_allclose(still.times, times, rtol=0, atol=1e-12)

@@ -36,9 +36,10 @@ def plan_jerk(
     )  # fmt: skip
     if found is None:
         raise InfeasibleError(
-            f"pattern 'zigzag-jerk': got a region none of {len(shapes)} lane layout(s) fits "
+            f"pattern: got 'zigzag-jerk' for a region none of {len(shapes)} lane layout(s) fits "
             + ("" if goal is None else f"with {goal:g} coverage ")
-            + "(lanes too short to turn at speed?), expected room for two lanes and their turns",
+            + "(lanes too short to turn at speed?), expected room for two lanes and their turns "
+            "(or another pattern)",
             ("coverage",),
         )
     flight, path = found

@@ -1,33 +1,42 @@
 """Crazyswarm2 / cflib polynomial CSV, one file per upload, checked as the Crazyflie flies it.
 
-A plan is cut into uploads by :func:`skyquill.targets.plan_uploads` (the one
-place that decides them); a plan that does not fit a Crazyflie is refused with
-its message, never split mid-motion. Each upload is written exactly (one row
+A Crazyflie flies a plan's mission (:mod:`skyquill.phases`): it takes off and lands with
+its firmware's own commands (the fly script, :mod:`.fly_script`, with durations that keep
+the plan's limits: :mod:`.manoeuvres`), so the plan's own take-off and landing, if it has
+them, are not uploaded. The mission is cut into uploads by
+:func:`skyquill.targets.plan_uploads` (the one place that decides them); a plan that does
+not fit a Crazyflie is refused with its message, never split mid-motion, and so is one
+with landings inside its mission (one flight per export). Each upload is written exactly (one row
 per knot span or polynomial piece), then read back the way it will fly: the
 CSV parsed, packed with cflib's ``Poly4D`` arithmetic, at most 4096 B per
 upload, and evaluated in float32 as the firmware's ``pptraj.c`` does
 (:mod:`skyquill.export.crazyflie.memory`). That read-back, flown on the plan's
-clock with the hovers between uploads, is what the dense limit check and the
-distance check of :func:`~skyquill.export.base.check_delivered` see.
+clock with the hovers between uploads, is what the distance check of
+:func:`~skyquill.export.base.check_delivered` sees; the dense limit check sees the whole
+flight, from the firmware's take-off through the uploads to the end of its landing
+(:mod:`.whole_flight`), each manoeuvre as the firmware plans it.
 """
 
 from __future__ import annotations
 
 import json
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from skyquill.errors import InputError
+from skyquill.errors import InfeasibleError, InputError
 from skyquill.export.base import (
+    ALLOWED_EXCESS,
+    ORDER_NAMES,
     DeliveredCheck,
     ExportOptions,
     ExportReport,
     NamedPlan,
     check_delivered,
+    mission_plan,
     target,
 )
 from skyquill.export.crazyflie import fly_script
@@ -36,6 +45,7 @@ from skyquill.export.crazyflie.csv_file import (
     upload_pieces,
     write_crazyswarm,
 )
+from skyquill.export.crazyflie.manoeuvres import APPROACH_OFFSET_M, manoeuvre_s
 from skyquill.export.crazyflie.memory import (
     MEMORY_BYTES,
     PIECE_BYTES,
@@ -44,10 +54,14 @@ from skyquill.export.crazyflie.memory import (
     flown_uploads,
     pack_pieces,
 )
+from skyquill.export.crazyflie.whole_flight import whole_flight
+from skyquill.io.json_read import read_json_file
 from skyquill.io.trajectory_json import PlannedTrajectory
+from skyquill.phases import FlightPhases
 from skyquill.targets import CRAZYFLIE, Upload, plan_uploads
 from skyquill.trajectory import Trajectory
 from skyquill.validation import FloatArray
+from skyquill.verify import verify
 
 #: Relative limit excess of the delivered float32 polynomials that is float32 rounding, not a
 #: broken limit: a limit the plan meets exactly shows ~1.2e-7 (one float32 ulp) on the
@@ -112,12 +126,13 @@ class UploadFile:
 
 @dataclass(frozen=True)
 class DroneExport:
-    """One drone's uploads, what the Crazyflie flies from them, and its check."""
+    """One drone's uploads, what the Crazyflie flies from them, its check and its flight."""
 
     drone: str
     uploads: tuple[UploadFile, ...]
     flown: FlownUploads
     delivered: DeliveredCheck
+    flight: dict[str, Any]
 
     @property
     def within_limits(self) -> bool:
@@ -130,6 +145,7 @@ class DroneExport:
             "drone": self.drone,
             "duration_s": self.flown.duration,
             "axes": self.flown.dim,
+            "flight": self.flight,
             "uploads": [u.as_dict() for u in self.uploads],
             "delivered_within_limits": self.within_limits,
             "delivered": self.delivered.as_dict(),
@@ -177,14 +193,15 @@ class CrazyswarmExporter:
 
 
 def export_drone(name: str, planned: PlannedTrajectory, path: Path) -> DroneExport:
-    """Write ``planned`` as the uploads a Crazyflie flies and check them as flown.
+    """Write ``planned``'s mission as the uploads a Crazyflie flies and check them as flown.
 
     Parameters
     ----------
     name
         The drone's name.
     planned
-        Its plan (z-up world frame, m, s).
+        Its plan (z-up world frame, m, s); its phases (recorded, else found at the default
+        minimum altitude) say which part is the mission.
     path
         ``<stem>.csv`` for one upload; several are written as
         ``<stem>_part1.csv``, ``<stem>_part2.csv``, ... in flight order.
@@ -192,17 +209,34 @@ def export_drone(name: str, planned: PlannedTrajectory, path: Path) -> DroneExpo
     Raises
     ------
     InputError
-        A plan that does not fit a Crazyflie (:func:`~skyquill.targets.plan_uploads`)
-        or that is not at rest where an upload starts or ends.
+        A plan that is not 3-D, has landings inside its mission, does not fit a Crazyflie
+        (:func:`~skyquill.targets.plan_uploads`) or is not at rest where an upload starts
+        or ends.
     """
-    uploads = plan_uploads(planned.trajectory, CRAZYFLIE)
+    if planned.trajectory.dim != 3:
+        raise InputError(
+            f"trajectory: got a {planned.trajectory.dim}-D plan, expected 3-D (x, y, z): plan "
+            "2-D input with --altitude"
+        )
+    # What the plan is made of first (a Crazyflie flies polynomials, from rest to rest), then
+    # where its mission is: a plan that fails both hears about the first.
+    _check_rest(plan_uploads(planned.trajectory, CRAZYFLIE))
+    phases = planned.flight()
+    if phases.ground_stops_s:
+        a, b = phases.ground_stops_s[0]
+        raise InputError(
+            f"plan: got drone {name} landing inside its mission ({a:.2f} to {b:.2f} s), "
+            "expected one take-off and one landing per Crazyflie flight"
+        )
+    mission = mission_plan(planned)
+    uploads = plan_uploads(mission.trajectory, CRAZYFLIE)
     _check_rest(uploads)
     paths = part_paths(path, len(uploads))
     for upload, file in zip(uploads, paths, strict=True):
         write_crazyswarm(upload_pieces(upload.parts), file)
     packed = [read_upload(file) for file in paths]
     flown = flown_uploads(
-        [u.start_s for u in uploads], packed, planned.trajectory.duration, planned.trajectory.dim
+        [u.start_s for u in uploads], packed, mission.trajectory.duration, mission.trajectory.dim
     )
     files = []
     for upload, file, data, firmware in zip(uploads, paths, packed, flown.uploads, strict=True):
@@ -219,7 +253,85 @@ def export_drone(name: str, planned: PlannedTrajectory, path: Path) -> DroneExpo
                 end,
             )
         )
-    return DroneExport(name, tuple(files), flown, check_delivered(name, planned, flown))
+    flight = _flight(phases, planned)
+    delivered = _whole_flight_checked(name, check_delivered(name, mission, flown), flight, flown,
+                                      planned)  # fmt: skip
+    return DroneExport(name, tuple(files), flown, delivered, flight)
+
+
+def _whole_flight_checked(
+    name: str,
+    mission: DeliveredCheck,
+    flight: dict[str, Any],
+    flown: FlownUploads,
+    planned: PlannedTrajectory,
+) -> DeliveredCheck:
+    """``mission``'s check with the limits checked from motors start to stop.
+
+    The firmware's take-off, approach and landing around the uploads
+    (:func:`~.whole_flight.whole_flight`) are checked densely at the plan's limits; the
+    check's excess is the worse of the mission's and the whole flight's, and
+    ``flight["as_played"]`` records the whole flight's numbers.
+
+    Raises
+    ------
+    InfeasibleError
+        The whole flight is over a limit by more than
+        :data:`~skyquill.export.base.ALLOWED_EXCESS` (the manoeuvres' durations keep the
+        limits, so this is the float32 polynomials' doing).
+    """
+    whole = whole_flight(flight, flown)
+    check = verify(whole, planned.limits, guaranteed=False)
+    excess = tuple(max(e, check.excess(n)) for n, e in enumerate(mission.excess_by_order, start=1))
+    flight["as_played"] = {
+        "from": "motors start (take-off) to motors stop (landing ended)",
+        "duration_s": whole.duration,
+        "relative_excess": {ORDER_NAMES[n]: check.excess(n) for n in ORDER_NAMES},
+        "lowest_after_takeoff_m": float(
+            whole.evaluate(np.linspace(whole.starts[1], whole.starts[3], 2001))[:, 2].min()
+        ),
+    }
+    for order, value in enumerate(excess, start=1):
+        if value > ALLOWED_EXCESS[order]:
+            raise InfeasibleError(
+                f"plan: got drone {name}'s {ORDER_NAMES[order]} {100 * value:.2f} % over its "
+                f"limit as the Crazyflie flies it from take-off to landing, expected at most "
+                f"{100 * ALLOWED_EXCESS[order]:g} % over; plan it with a lower "
+                f"{ORDER_NAMES[order]} limit",
+                ("limits",),
+            )
+    return replace(
+        mission,
+        limit_excess=max(mission.limit_excess, check.max_excess),
+        limits=tuple(check.limits_report()),
+        excess_by_order=(excess[0], excess[1], excess[2]),
+    )
+
+
+def _flight(phases: FlightPhases, planned: PlannedTrajectory) -> dict[str, Any]:
+    """The firmware's take-off, approach and landing around the mission (:mod:`.manoeuvres`)."""
+    first, last = np.array(phases.first_point_m), np.array(phases.last_point_m)
+    climb = first[2] - phases.ground_m
+    return {
+        "takeoff": {
+            "height_m": float(first[2]),
+            "duration_s": manoeuvre_s(climb, planned.limits),
+        },
+        "approach": {
+            "point_m": first.tolist(),
+            "duration_s": manoeuvre_s(APPROACH_OFFSET_M, planned.limits),
+            "from_within_m": APPROACH_OFFSET_M,
+        },
+        "landing": {
+            "height_m": phases.ground_m,
+            "from_m": last.tolist(),
+            "duration_s": manoeuvre_s(last[2] - phases.ground_m, planned.limits),
+        },
+        "min_altitude_m": phases.min_altitude_m,
+        "ground_m": phases.ground_m,
+        "mission_s": list(phases.mission_s),
+        "mission_lowest_m": phases.lowest_m,
+    }
 
 
 def part_paths(path: Path, n: int) -> list[Path]:
@@ -282,7 +394,7 @@ _Schedule = list[tuple[str, float, int, list[tuple[str, int, int, float]]]]
 def _schedule(summary: Path) -> _Schedule:
     """The drones' uploads as ``summary`` lists them (:data:`_Schedule`)."""
     try:
-        data = json.loads(Path(summary).read_text(encoding="utf-8"))
+        data = read_json_file(summary, "a Crazyswarm export summary")  # a regular file, strictly
         return [
             (
                 str(d["drone"]),
@@ -302,27 +414,30 @@ def _schedule(summary: Path) -> _Schedule:
 
 
 def write_fly_script(path: Path, drones: Sequence[DroneExport], several: bool) -> Path:
-    """``path``: :mod:`skyquill.export.crazyflie.fly_script` with the drones' upload schedule."""
+    """``path``: :mod:`skyquill.export.crazyflie.fly_script` with the drones' flights."""
     schedule = {
-        (d.drone if several else SINGLE): [
-            {
-                "file": u.file.name,
-                "start_s": u.start_s,
-                "end_s": u.end_s,
-                "start": u.start[0].tolist(),
-                "end": u.end[0].tolist(),
-            }
-            for u in d.uploads
-        ]
+        (d.drone if several else SINGLE): d.flight
+        | {
+            "uploads": [
+                {
+                    "file": u.file.name,
+                    "start_s": u.start_s,
+                    "end_s": u.end_s,
+                    "start": u.start[0].tolist(),
+                    "end": u.end[0].tolist(),
+                }
+                for u in d.uploads
+            ]
+        }
         for d in drones
     }
     source = Path(fly_script.__file__).read_text(encoding="utf-8")
-    marker = "SCHEDULE: dict[str, list[dict[str, Any]]] = {}\n"
+    marker = "SCHEDULE: dict[str, dict[str, Any]] = {}\n"
     if marker not in source:  # pragma: no cover - the template and this line go together
         raise RuntimeError("fly_script.py: the SCHEDULE line is missing")
     literal = json.dumps(schedule, indent=4)  # strings, numbers, lists: also a Python literal
     path.write_text(
-        source.replace(marker, f"SCHEDULE: dict[str, list[dict[str, Any]]] = {literal}\n"),
+        source.replace(marker, f"SCHEDULE: dict[str, dict[str, Any]] = {literal}\n"),
         encoding="utf-8",
     )
     return path
@@ -366,11 +481,6 @@ def _message(drones: Sequence[DroneExport], script: Path, plans: Sequence[NamedP
         text += (
             f" -- WARNING: above the float32 rounding tolerance {FLOAT32_LIMIT_TOLERANCE:g}; "
             "plan with a margin below the vehicle's limits"
-        )
-    if any(p.trajectory.dim == 2 for _, p in plans):
-        text += (
-            ". The trajectory is 2-D and was written with z = 0 m: fly it relative to a "
-            "hover point (start_trajectory(relative_position=True)) or lift it first"
         )
     return text
 

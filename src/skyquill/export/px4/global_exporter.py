@@ -27,6 +27,7 @@ import numpy as np
 from skyquill.coverage.geo import GeoFrame
 from skyquill.errors import InputError
 from skyquill.export.base import ExportOptions, ExportReport, NamedPlan
+from skyquill.export.px4.flight_parameters import px4_flight_parameters
 from skyquill.export.px4.setpoints import (
     PX4_COLUMNS,
     check_stream_rate,
@@ -109,7 +110,15 @@ class Px4GlobalExporter:
             return read_px4_global(path, origin)
 
         # The sampled formats' loop: one file a drone, read back, checked against the plan.
-        report = SampledExporter(self.name, self.suffix, self.help, write)(plans, out, options)
+        report = SampledExporter(
+            self.name,
+            self.suffix,
+            self.help,
+            write,
+            mission_only=True,
+            drone_details=lambda planned: px4_flight_parameters(planned.limits),
+            details_key="px4_parameters",
+        )(plans, out, options)
         return replace(
             report,
             message=f"wrote {len(report.files)} PX4 global setpoint file(s) at "

@@ -12,9 +12,14 @@ and ``yaw_ned_deg = 90 - degrees(yaw_enu_rad)`` wrapped to ``(-180, 180]``.
 The world origin maps to PX4's local origin (the EKF origin, usually where the
 vehicle was armed): place the trajectory relative to it before streaming.
 
-:func:`px4_setpoints` is pure; :func:`send_mavsdk` optionally streams the result
-through MAVSDK 4.x (``mavsdk>=4.1,<5``, the optional ``px4`` extra, imported only
-when really sending; tested with 4.1.0) or through any :class:`OffboardSystem`.
+:func:`px4_setpoints` is pure; :func:`send_mavsdk` optionally flies the result through
+MAVSDK 4.x (``mavsdk>=4.1,<5``, the optional ``px4`` extra, imported only when really
+sending; tested with 4.1.0) or through any :class:`OffboardSystem`: arm, take off with
+PX4's own take-off to the first setpoint's height, enter offboard at the first setpoint,
+stream, leave offboard, land with PX4's own landing, each step within a time limit
+(MAVSDK-Python ``action.arm``, ``set_takeoff_altitude``, ``takeoff``, ``land``;
+``telemetry.in_air``, ``position_velocity_ned``, ``landed_state``; ``offboard.start``,
+``stop``).
 """
 
 from __future__ import annotations
@@ -42,6 +47,10 @@ MAX_RATE_HZ = 1000.0
 MAVSDK_REQUIREMENT = "mavsdk>=4.1,<5"
 #: PX4 SITL's offboard port, in MAVSDK >= 2 URL syntax (listen for UDP).
 DEFAULT_ADDRESS = "udpin://0.0.0.0:14540"
+#: How often the vehicle's state is polled while waiting for a take-off or a landing, s.
+POLL_S = 0.1
+#: How close to the take-off height counts as there, m.
+TAKEOFF_TOLERANCE_M = 0.15
 #: Header of :meth:`Px4Setpoints.to_csv`.
 PX4_COLUMNS = (
     "t",
@@ -180,6 +189,24 @@ class OffboardSystem(Protocol):
     async def stop_offboard(self) -> None:
         """Leave offboard mode (PX4 goes to Hold)."""
 
+    async def set_parameter(self, name: str, value: float) -> None:
+        """Set one of PX4's float parameters (``MPC_TKO_SPEED``...)."""
+
+    async def arm(self) -> None:
+        """Arm the vehicle (motors at idle)."""
+
+    async def takeoff(self, altitude_m: float) -> None:
+        """PX4's own take-off to ``altitude_m`` above home (returns once commanded)."""
+
+    async def height(self) -> tuple[bool, float]:
+        """Whether it is in the air, and its height above home, m (polled)."""
+
+    async def land(self) -> None:
+        """PX4's own landing where it is (returns once commanded)."""
+
+    async def landed(self) -> bool:
+        """Whether it is on the ground (polled)."""
+
     def close(self) -> None:
         """Release the link; called once, also after errors."""
 
@@ -225,6 +252,9 @@ class MavsdkSystem:
         )
         self._mavsdk = self._aio.Mavsdk(config)
         self._offboard: Any = None
+        self._action: Any = None
+        self._telemetry: Any = None
+        self._param: Any = None
 
     async def connect(self, system_address: str) -> None:
         """Add the connection URL (e.g. ``udpin://0.0.0.0:14540``)."""
@@ -243,6 +273,13 @@ class MavsdkSystem:
         if system is None:  # only when the instance was destroyed meanwhile
             raise SolverError("address: got no autopilot, expected one (MAVSDK was closed)")
         self._offboard = self._off.OffboardAsync(system)
+        action = importlib.import_module("mavsdk.asyncio.plugins.action")
+        telemetry = importlib.import_module("mavsdk.asyncio.plugins.telemetry")
+        self._action = action.ActionAsync(system)
+        self._param = importlib.import_module("mavsdk.asyncio.plugins.param").ParamAsync(system)
+        self._telemetry = telemetry.TelemetryAsync(system)
+        self._errors = (action.ActionError, telemetry.TelemetryError)
+        self._on_ground = telemetry.LandedState.ON_GROUND
 
     def setpoint(
         self, position_ned: FloatArray, velocity_ned: FloatArray, accel_ned: FloatArray, yaw: float
@@ -275,10 +312,54 @@ class MavsdkSystem:
         """Stop offboard (PX4 holds position)."""
         await self._offboard.stop()
 
+    async def set_parameter(self, name: str, value: float) -> None:
+        """``param.set_param_float``; a SolverError carries PX4's reason when it refuses."""
+        param = importlib.import_module("mavsdk.asyncio.plugins.param")
+        try:
+            await self._param.set_param_float(name, float(value))
+        except param.ParamError as exc:
+            raise SolverError(
+                f"parameters: got {exc} from PX4 for {name} = {value:g}, expected PX4 to accept "
+                "it (a parameter of this PX4 version, within its range)"
+            ) from None
+
+    async def arm(self) -> None:
+        """``action.arm``; a SolverError carries PX4's reason when it refuses."""
+        await self._act("arm", self._action.arm())
+
+    async def takeoff(self, altitude_m: float) -> None:
+        """``action.set_takeoff_altitude`` then ``action.takeoff``."""
+        await self._act("takeoff", self._action.set_takeoff_altitude(float(altitude_m)))
+        await self._act("takeoff", self._action.takeoff())
+
+    async def height(self) -> tuple[bool, float]:
+        """``telemetry.in_air`` and ``position_velocity_ned`` (height = -down)."""
+        in_air = await self._telemetry.in_air()
+        state = await self._telemetry.position_velocity_ned()
+        return bool(in_air), -float(state.position.down_m)
+
+    async def land(self) -> None:
+        """``action.land``."""
+        await self._act("land", self._action.land())
+
+    async def landed(self) -> bool:
+        """``telemetry.landed_state`` is ``ON_GROUND``."""
+        return bool(await self._telemetry.landed_state() == self._on_ground)
+
+    async def _act(self, step: str, call: Awaitable[Any]) -> None:
+        try:
+            await call
+        except self._errors as exc:
+            raise SolverError(
+                f"{step}: got {exc} from PX4, expected it to {step} (armable, a position "
+                "estimate, pre-flight checks passed)"
+            ) from None
+
     def close(self) -> None:
         """Destroy the MAVSDK instance (this also ends a pending discovery)."""
-        if self._offboard is not None:
-            self._offboard.destroy()
+        for plugin in (self._offboard, self._action, self._telemetry, self._param):
+            if plugin is not None:
+                plugin.destroy()
         self._mavsdk.destroy()
 
 
@@ -304,14 +385,22 @@ def send_mavsdk(
     *,
     connect_timeout_s: float = 10.0,
     send_timeout_s: float = 1.0,
+    step_timeout_s: float = 30.0,
     system_factory: Callable[[], OffboardSystem] | None = None,
+    parameters: dict[str, float] | None = None,
 ) -> int:
-    """Stream ``setpoints`` to a PX4 vehicle in offboard mode through MAVSDK.
+    """Fly ``setpoints`` on a PX4 vehicle: take off, offboard, land, through MAVSDK.
 
-    The vehicle must already be armed and airborne at (or near) the first
-    setpoint. The sequence is: connect, wait for an autopilot, send the first
-    setpoint (PX4 refuses offboard without one), start offboard, stream every
-    setpoint at ``setpoints.rate_hz``, stop offboard (also after an error).
+    The vehicle stands on the ground below the first setpoint (PX4's local origin, the
+    EKF origin, is where it was armed). The sequence: connect and wait for an autopilot;
+    set ``parameters`` (the export summary's ``px4_parameters``, which keep PX4's own
+    take-off and landing inside the plan's limits:
+    :mod:`skyquill.export.px4.flight_parameters`); arm; PX4's own take-off to the first
+    setpoint's height and wait until it is there;
+    send the first setpoint (PX4 refuses offboard without one), start offboard (at the
+    first airborne setpoint), stream every setpoint at ``setpoints.rate_hz``, stop
+    offboard (also after an error); PX4's own landing and wait until it is on the ground.
+    Arming, the take-off and the landing each have ``step_timeout_s``.
 
     Works with ``mavsdk`` 4.x (the native binding, tested with 4.1.0; install
     with ``pip install 'skyquill[px4]'``); the gRPC ``mavsdk < 4`` is refused.
@@ -329,9 +418,13 @@ def send_mavsdk(
         Longest wait, s, for the connection and the vehicle's discovery.
     send_timeout_s
         Longest wait, s, for each send, offboard start and offboard stop.
+    step_timeout_s
+        Longest wait, s, to arm, to reach the take-off height, to land.
     system_factory
         Makes the :class:`OffboardSystem` to talk to; default
         :class:`MavsdkSystem` (tests pass a fake vehicle here).
+    parameters
+        PX4 float parameters set before arming, each within ``step_timeout_s``.
 
     Returns
     -------
@@ -354,15 +447,24 @@ def send_mavsdk(
             f"setpoints: got {type(setpoints).__name__}, expected Px4Setpoints (from px4_setpoints)"
         )
     check_stream_rate(setpoints.rate_hz)
+    parameters = dict(parameters or {})
+    for key, value in parameters.items():
+        as_float(f"parameters[{key!r}]", value, positive=True)
     limits = _Timeouts(
         as_float("connect_timeout_s", connect_timeout_s, positive=True),
         as_float("send_timeout_s", send_timeout_s, positive=True),
+        as_float("step_timeout_s", step_timeout_s, positive=True),
     )
+    if -float(setpoints.position_ned[0, 2]) <= 0.0:
+        raise InputError(
+            f"setpoints: got a first setpoint {-float(setpoints.position_ned[0, 2]):.3f} m above "
+            "home, expected the mission's first airborne point (PX4 takes off to its height)"
+        )
     if dry_run:
         return len(setpoints)
     system = (system_factory or MavsdkSystem)()
     try:
-        return asyncio.run(_stream(system, setpoints, address, limits))
+        return asyncio.run(_stream(system, setpoints, address, limits, parameters))
     finally:
         system.close()
 
@@ -373,6 +475,7 @@ class _Timeouts:
 
     connect: float
     send: float
+    step: float
 
 
 async def _bounded(step: Awaitable[T], limit: float, what: str, name: str) -> T:
@@ -387,8 +490,14 @@ async def _bounded(step: Awaitable[T], limit: float, what: str, name: str) -> T:
         ) from None
 
 
-async def _stream(system: OffboardSystem, sp: Px4Setpoints, address: str, lim: _Timeouts) -> int:
-    """Connect, send the first setpoint, start offboard, stream at the rate, stop."""
+async def _stream(
+    system: OffboardSystem,
+    sp: Px4Setpoints,
+    address: str,
+    lim: _Timeouts,
+    parameters: dict[str, float],
+) -> int:
+    """Connect, set the parameters, arm, take off, offboard at the rate, land."""
 
     async def connect() -> None:
         await system.connect(system_address=address)
@@ -397,6 +506,37 @@ async def _stream(system: OffboardSystem, sp: Px4Setpoints, address: str, lim: _
     await _bounded(
         connect(), lim.connect, f"a vehicle was discovered at {address!r}", "connect_timeout_s"
     )
+    for name, value in parameters.items():
+        await _bounded(system.set_parameter(name, value), lim.step, f"PX4 set {name}",
+                       "step_timeout_s")  # fmt: skip
+    await _bounded(system.arm(), lim.step, "the vehicle armed", "step_timeout_s")
+    height = -float(sp.position_ned[0, 2])
+    await _bounded(_take_off(system, height), lim.step, f"it took off to {height:.2f} m",
+                   "step_timeout_s")  # fmt: skip
+    sent = await _offboard(system, sp, lim)
+    await _bounded(_land(system), lim.step, "it landed", "step_timeout_s")
+    return sent
+
+
+async def _take_off(system: OffboardSystem, height: float) -> None:
+    """PX4's take-off, then wait until it is in the air at ``height`` (polled)."""
+    await system.takeoff(height)
+    while True:
+        in_air, now = await system.height()
+        if in_air and abs(now - height) <= TAKEOFF_TOLERANCE_M:
+            return
+        await asyncio.sleep(POLL_S)
+
+
+async def _land(system: OffboardSystem) -> None:
+    """PX4's landing, then wait until it is on the ground (polled)."""
+    await system.land()
+    while not await system.landed():
+        await asyncio.sleep(POLL_S)
+
+
+async def _offboard(system: OffboardSystem, sp: Px4Setpoints, lim: _Timeouts) -> int:
+    """The first setpoint, offboard, every setpoint at the rate, offboard stopped."""
 
     def send(i: int) -> Awaitable[None]:
         msg = system.setpoint(

@@ -5,7 +5,8 @@ of every pen-window end (rounded to the ms), so the light switches on the millis
 pen does even though Studio fades colours linearly between rows. Read back as Studio reads
 it (:mod:`skyquill.export.skybrush.csv_file`: positions interpolated linearly), then checked: the
 distance from the plan, the speed limit (a linear interpolation has no acceleration between
-rows and an impulse at each, so only the speed check means something), the lights.
+rows and an impulse at each, so only the speed check means something), the lights. Each
+drone starts and ends on its pad (:mod:`.pads`).
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ from numpy.typing import NDArray
 from skyquill.colors import RGB
 from skyquill.export.base import ExportOptions, ExportReport, NamedPlan, check_delivered
 from skyquill.export.skybrush.csv_file import CsvDrone, read_csv_zip, write_csv_zip
+from skyquill.export.skybrush.pads import on_pads
 from skyquill.io.trajectory_json import PlannedTrajectory, light_at
 
 
@@ -66,11 +68,13 @@ class SkybrushCsvExporter:
     ) -> ExportReport:
         """Write the rows, read the archive back as Studio does, check each drone."""
         rgb = options.light_rgb
+        plans = [(name, on_pads(plan)) for name, plan in plans]  # as Skybrush expects
         rows = [csv_drone(name, plan, options.rate_hz, rgb) for name, plan in plans]
         path = write_csv_zip(rows, out.with_suffix(self.suffix))
         back = {d.name: d for d in read_csv_zip(path)}
-        delivered = tuple(
-            check_delivered(name, plan, back[name].trajectory()) for name, plan in plans
+        delivered = tuple(  # linear between rows: only the speed means something
+            check_delivered(name, plan, back[name].trajectory(), orders=(1,))
+            for name, plan in plans
         )
         details: dict[str, Any] = {
             "rows": sum(d.t_ms.size for d in rows),

@@ -1,66 +1,66 @@
-"""A trajectory as Skybrush keyframes: cubic Bézier segments on Skybrush's ms and mm grid.
+"""A trajectory as Skybrush keyframes: C2 cubic Bézier segments on Skybrush's ms and mm grid.
 
 Skybrush's server stores segment durations in whole milliseconds and coordinates in units
-of ``scale`` mm (:mod:`skyquill.export.skybrush.playback`). Keyframes off that grid drift: the
-old 0.0999 s spacing played 28 mm and 30 ms off on 永. Here every segment boundary is an
+of ``scale`` mm (:mod:`skyquill.export.skybrush.playback`). Every segment boundary here is an
 integer millisecond and every Bézier point is written as a number that the server's
 truncation maps to the intended integer, so what the drone plays is exactly what is built
-here, and the export measures its distance from the plan on that.
+here, and the export checks it as played.
 
-Construction:
+Construction (each step its own module):
 
-1. segments of :data:`SEGMENT_MS`, each the cubic Hermite of the trajectory (position and
-   velocity at both ends, so joins are C1 before rounding), bisected on the ms grid until
-   within ``tolerance`` of the trajectory at :data:`ERROR_SAMPLES` points;
-2. every Bézier point rounded to the nearest grid unit. A Bézier point of the curve is a
-   convex combination of its control points, each off by at most half a unit per axis, so
-   the rounding moves the curve by at most ``sqrt(3) / 2`` units (0.87 mm) anywhere.
+1. segment boundaries (:mod:`.keyframe_times`): the plan's own cubic pieces (time-optimal
+   moves, holds) are exact segments; everything else is cut into *fit regions* of segments
+   long enough that the grid's rounding moves the derivatives by a bounded share of the
+   limits;
+2. the curve (:mod:`.keyframe_fit`): exact segments are the plan's cubic (its position and
+   velocity at both ends); fit regions are the C2 cubic spline nearest the plan that keeps
+   the plan's limits on its Bézier hull, with the plan's position, velocity and acceleration
+   where it meets the exact pieces, so the joins are C2 (before rounding; within a
+   half-millisecond break of the plan's pieces everywhere);
+3. the grid (:mod:`.grid_rounding`): every Bézier point to the nearest unit, except where
+   that would cross a limit, where the nearest combination that does not is chosen.
 
-Why 250 ms: the rounding perturbs the k-th derivative by about ``unit / h^k`` (the jerk of a
-cubic is ``6 (P3 - 3 P2 + 3 P1 - P0) / h^3``: up to 12 m/s^3 at 100 ms, 0.8 m/s^3 at
-250 ms), while the cubic's own error grows as ``h^4 snap / 384`` (0.4 mm at 250 ms for 永,
-whose snap peaks at 47 m/s^4). Measured on 永: 100 ms segments exceed its jerk limit by 147 %
-after rounding, 250 ms segments keep acceleration and jerk inside and the speed within
-0.013 % of its limit.
+**Why cubics, not degree 5 or 7.** Skybrush's binary format stores 1, 2, 4 or 8 points per
+axis (libskybrush ``src/trajectory/utils.c``, ``sb_i_get_num_coords``: degree 0, 1, 3 or 7;
+skybrush-server ``show/formats.py``, ``SegmentEncoder._encode_coordinate_series``: degrees 4
+to 6 raise ``NotImplementedError``), so a quintic would be flown as a degree-7 segment; the
+firmware plays those, but skybrush.js (``packages/show-format/src/trajectory.ts``,
+``createSegmentFunctions``: "Only quadratic and cubic Bezier segments are supported") and so
+every tool built on it cannot show them. And the rounding is the limit: a degree-``n``
+Bézier's ``k``-th derivative moves by ``n!/(n-k)! 2^(k-1) u / h^k`` per axis when its points
+move by half a unit ``u``, which for the jerk is 35 times more at degree 7 (840 ``u/h^3``)
+than at degree 3 (24 ``u/h^3``): the same bound needs 3.3 times longer segments. A C2 cubic
+spline has continuous acceleration, which is what the joins need.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-from skyquill.errors import InputError
+from skyquill.errors import InfeasibleError, InputError
+from skyquill.export.skybrush.grid_rounding import Rounding, round_to_grid
+from skyquill.export.skybrush.keyframe_fit import fit_region
+from skyquill.export.skybrush.keyframe_times import Segmentation, segmentation
 from skyquill.export.skybrush.playback import quantize, scaling_factor
-from skyquill.trajectory import PiecewisePolynomial, RestToRestSequence, Trajectory
+from skyquill.limits import DerivativeLimit
+from skyquill.trajectory import Trajectory
 from skyquill.validation import FloatArray, as_float
 
-#: Length of a segment before bisection, ms.
-SEGMENT_MS = 250
-#: Longest segment over one of the trajectory's own cubic pieces (exact there), ms.
-CUBIC_SEGMENT_MS = 1000
-#: Shortest cubic piece given its own segment, ms: a shorter one (a time-optimal move's
-#: brief jerk phase) would amplify the mm rounding (``unit / h^2``); it joins the next span.
-MIN_CUBIC_MS = 100
-#: Shortest segment bisection makes, ms.
-MIN_SEGMENT_MS = 10
-#: Default largest distance of the cubics from the trajectory before rounding, m (the
-#: rounding adds at most 0.87 mm: 1.37 mm in all, inside the 2 mm the export promises).
-FIT_TOLERANCE_M = 0.5e-3
-#: Points per segment at which the cubic's error is measured (ends included).
+#: Points per segment at which the keyframes' distance from the plan is measured (ends included).
 ERROR_SAMPLES = 17
-#: Most segments per drone (a 40-hour show at 250 ms): bounds memory and time.
-MAX_SEGMENTS = 600_000
 #: Times the scaling factor is re-proposed after rounding (it settles after one).
 SCALE_ROUNDS = 4
 
 
 @dataclass(frozen=True)
 class Keyframes:
-    """One drone's cubic Bézier segments on Skybrush's grid.
+    """One drone's C2 cubic Bézier segments on Skybrush's grid.
 
     Attributes
     ----------
@@ -73,12 +73,39 @@ class Keyframes:
         Skybrush's scaling factor for these points (1 within 32.767 m of the origin).
     fit_error_m
         Largest distance of the cubics from the trajectory before rounding, m.
+    exact_segments
+        Segments that are the plan's own cubic pieces.
+    fit_segment_ms
+        Length of the fit regions' segments, ms.
+    rounding
+        What the rounding to the grid did (:mod:`.grid_rounding`).
     """
 
     times_ms: NDArray[np.int64]
     units: NDArray[np.int64]
     scale: int
     fit_error_m: float
+    exact_segments: int = 0
+    fit_segment_ms: int = 0
+    rounding: Rounding | None = None
+
+    def report(self) -> dict[str, Any]:
+        """JSON-ready: how the keyframes were made (segments, fit, rounding)."""
+        out: dict[str, Any] = {
+            "segments": int(self.units.shape[0]),
+            "exact_segments": self.exact_segments,
+            "fit_segment_ms": self.fit_segment_ms,
+            "fit_error_m": self.fit_error_m,
+            "scale_mm": self.scale,
+        }
+        if self.rounding is not None:
+            out["rounding"] = {
+                "adjusted_segments": self.rounding.adjusted,
+                "unresolved_segments": len(self.rounding.unresolved),
+                # None for an order without a limit
+                "hull_excess": [e if math.isfinite(e) else None for e in self.rounding.hull_excess],
+            }
+        return out
 
     def points(self) -> list[list[Any]]:
         """The ``points`` list of ``show.json``: ``[t, [x, y, z], [[c1], [c2]]]``, s and m."""
@@ -133,92 +160,65 @@ def _errors(traj: Trajectory, times_ms: NDArray[np.int64], ctrl: FloatArray) -> 
     return np.asarray(np.linalg.norm(bez - exact, axis=2).max(axis=1))
 
 
-def _boundaries(traj: Trajectory) -> NDArray[np.int64]:
-    """First segment boundaries over the duration, ms (the end rounded up).
+#: Times a fit region that cannot keep the limits is grown before the fit gives up.
+GROW_ROUNDS = 3
 
-    Segments of :data:`SEGMENT_MS`, except over the trajectory's own cubic pieces
-    (:func:`_cubic_spans`): a cubic Bézier is such a piece exactly, so it is one segment
-    of up to :data:`CUBIC_SEGMENT_MS` with no fit error and no bisection, and the longer
-    segment shrinks the ms/mm rounding's effect on acceleration and jerk (``unit / h^2``,
-    ``unit / h^3``).
+
+def _curve(
+    traj: Trajectory,
+    limits: Sequence[DerivativeLimit],
+    unit_m: float,
+    *,
+    margin: float,
+    exact: bool,
+    segment_scale: float,
+) -> tuple[Segmentation, FloatArray]:
+    """Segments and their unrounded Bézier points (S, 4, 3), m: exact pieces and fit regions.
+
+    A fit region that cannot keep the limits (a short region around a rest, where the plan
+    stops and starts again faster than a few cubics can follow) is grown and fitted again.
     """
-    total = max(1, math.ceil(traj.duration * 1000 - 1e-6))
-    out: list[NDArray[np.int64]] = []
-    for start, end, cubic in _cubic_spans(traj, total):
-        n = math.ceil((end - start) / (CUBIC_SEGMENT_MS if cubic else SEGMENT_MS))
-        out.append(np.round(np.linspace(start, end, n + 1)).astype(np.int64)[:-1])
-    times = np.append(np.concatenate(out), total)
-    if times.size - 1 > MAX_SEGMENTS:
-        raise InputError(
-            f"trajectory: got {traj.duration:.6g} s, expected at most "
-            f"{MAX_SEGMENTS * SEGMENT_MS / 3.6e6:g} h for one Skybrush drone"
-        )
-    return times
+    grow = 1.0
+    for attempt in range(GROW_ROUNDS + 1):
+        seg = segmentation(traj, limits, unit_m, exact=exact, scale=segment_scale, grow=grow)
+        points = _hermite(traj, seg.times_ms)
+        try:
+            for first, stop in seg.regions:
+                points[first:stop] = fit_region(
+                    traj, seg.times_ms[first : stop + 1].astype(float), limits, margin
+                )
+        except InfeasibleError:
+            if attempt == GROW_ROUNDS:
+                raise
+            grow *= 2.0
+            continue
+        return seg, points
+    raise AssertionError("unreachable")  # pragma: no cover
 
 
-def _cubic_spans(traj: Trajectory, total_ms: int) -> list[tuple[int, int, bool]]:
-    """``(start, end, cubic)`` spans covering ``[0, total_ms]``, ms.
-
-    ``cubic``: the trajectory is one polynomial of degree <= 3 there (a time-optimal move's
-    phase, a hold). Piece ends are rounded to the ms (a cubic Hermite across a break at
-    most 0.5 ms off is within nanometres); pieces shorter than :data:`MIN_CUBIC_MS` are
-    merged into the span after them, which is then not exact (and bisected if needed).
-    """
-    breaks, cubic = _cubic_breaks(traj)
-    ms = np.round(np.asarray(breaks) * 1000).astype(np.int64)
-    spans: list[tuple[int, int, bool]] = []
-    start = 0
-    for k in range(len(cubic)):
-        end = int(min(ms[k + 1], total_ms))
-        if end - start < MIN_CUBIC_MS and k + 1 < len(cubic):
-            continue  # too short for its own segment: joins the next span
-        exact = cubic[k] and end - start == int(ms[k + 1] - ms[k])
-        spans.append((start, end, exact))
-        start = end
-    if start < total_ms:  # the end rounded up: held
-        spans.append((start, total_ms, False))
-    return [span for span in spans if span[1] > span[0]]
-
-
-def _cubic_breaks(traj: Trajectory) -> tuple[list[float], list[bool]]:
-    """Break times (s) and, per span between them, whether it is one cubic polynomial."""
-    if isinstance(traj, PiecewisePolynomial):
-        cubic = traj.coeffs.shape[1] <= 4
-        breaks = list(np.asarray(traj.breaks, dtype=float)) if cubic else [0.0, traj.duration]
-        return breaks, [cubic] * (len(breaks) - 1)
-    if isinstance(traj, RestToRestSequence):
-        breaks, flags = [0.0], []
-        for offset, piece in zip(traj.starts, traj.pieces, strict=False):
-            inner, inner_flags = _cubic_breaks(piece)
-            breaks.extend(float(offset) + b for b in inner[1:])
-            flags.extend(inner_flags)
-        return breaks, flags
-    return [0.0, traj.duration], [False]
-
-
-def _fit(traj: Trajectory, tolerance: float) -> tuple[NDArray[np.int64], FloatArray, float]:
-    """Boundaries (ms), unrounded Bézier points (m) and largest error (m), bisected to fit."""
-    times = _boundaries(traj)
-    while True:
-        ctrl = _hermite(traj, times)
-        err = _errors(traj, times, ctrl)
-        split = (err > tolerance) & (np.diff(times) >= 2 * MIN_SEGMENT_MS)
-        if not split.any() or times.size > MAX_SEGMENTS:
-            return times, ctrl, float(err.max())
-        middles = (times[:-1][split] + times[1:][split]) // 2
-        times = np.sort(np.concatenate([times, middles]))
-
-
-def skybrush_keyframes(traj: Trajectory, tolerance: float = FIT_TOLERANCE_M) -> Keyframes:
-    """Cubic Bézier keyframes of ``traj`` on Skybrush's ms and mm grid.
+def skybrush_keyframes(
+    traj: Trajectory,
+    limits: Sequence[DerivativeLimit] = (),
+    *,
+    margin: float = 0.0,
+    exact: bool = True,
+    segment_scale: float = 1.0,
+) -> Keyframes:
+    """C2 cubic Bézier keyframes of ``traj`` on Skybrush's ms and mm grid, inside ``limits``.
 
     Parameters
     ----------
     traj
         Any 3-D trajectory, z-up world frame (Skybrush's show frame), m, from 0 s.
-    tolerance
-        Largest distance of the cubics from ``traj`` before rounding to the grid, m, for
-        Skybrush's millimetre unit; times its unit where that is coarser.
+    limits
+        The limits it was planned for: the fit keeps them on its hull, the rounding does not
+        cross them by more than :data:`~.grid_rounding.ALLOWED_EXCESS` (none: no limit).
+    margin
+        Relative shrink of the limits for the fit, in [0, 0.5] (a refit asks for one).
+    exact
+        Keep the plan's cubic pieces as exact segments (``False``: fit everything).
+    segment_scale
+        Factor on the fit regions' segment length, in [0.25, 8] (a refit asks for longer).
 
     Returns
     -------
@@ -228,28 +228,53 @@ def skybrush_keyframes(traj: Trajectory, tolerance: float = FIT_TOLERANCE_M) -> 
     Raises
     ------
     InputError
-        When ``traj`` is not 3-D, ``tolerance`` is not positive, or the trajectory needs more
-        than :data:`MAX_SEGMENTS` segments.
+        When ``traj`` is not 3-D, an option is out of range, or the trajectory needs more
+        than :data:`~.keyframe_times.MAX_SEGMENTS` segments or lies beyond what Skybrush
+        can store (about 4 km from the origin).
+    InfeasibleError
+        When a fit region cannot keep the limits.
     """
-    tolerance = as_float("tolerance", tolerance, positive=True)
     if traj.dim != 3:
         raise InputError(f"traj: got a {traj.dim}-D trajectory, expected 3-D (x, y, z up)")
-    # Far from the origin Skybrush's unit is ``scale`` mm (3 mm for a 100 m show): a fit
-    # finer than half a unit buys nothing after rounding, and the bisection it would need
-    # makes short segments, where the rounding moves the acceleration most.
+    margin = as_float("margin", margin, nonneg=True)
+    if margin > 0.5:
+        raise InputError(f"margin: got {margin:g}, expected at most 0.5")
+    segment_scale = as_float("segment_scale", segment_scale, positive=True)
+    if not 0.25 <= segment_scale <= 8.0:
+        raise InputError(f"segment_scale: got {segment_scale:g}, expected 0.25 to 8")
+    # Far from the origin Skybrush's unit is ``scale`` mm (3 mm for a 100 m show).
     coarse = scaling_factor(traj.evaluate(np.linspace(0.0, traj.duration, 1001)))
-    times, ctrl, fit_error = _fit(traj, tolerance * coarse)
+    seg, points = _curve(
+        traj, limits, coarse / 1000.0, margin=margin, exact=exact, segment_scale=segment_scale
+    )
+    fit_error = float(_errors(traj, seg.times_ms, points).max())
+    h = np.diff(seg.times_ms) / 1000.0
     # A keyframe is the same number in both its segments, so it rounds to the same unit.
-    scale = 1
+    scale = max(1, scaling_factor(points))
+    rounding = round_to_grid(points, h, limits, scale / 1000.0)
     for _ in range(SCALE_ROUNDS):
-        units = np.rint(ctrl * (1000.0 / scale)).astype(np.int64)
-        proposed = scaling_factor(encode(units, scale))
+        proposed = scaling_factor(encode(rounding.units, scale))
         if proposed == scale:
             break
         scale = proposed
+        rounding = round_to_grid(points, h, limits, scale / 1000.0)
     if scale >= 128:
         raise InputError(
-            f"traj: got positions up to {float(np.abs(ctrl).max()):.6g} m from the origin, "
+            f"traj: got positions up to {float(np.abs(points).max()):.6g} m from the origin, "
             "expected a show Skybrush can store (within about 4 km)"
         )
-    return Keyframes(times, units, scale, fit_error)
+    return Keyframes(
+        seg.times_ms,
+        rounding.units,
+        scale,
+        fit_error,
+        int(seg.exact.sum()),
+        _fit_length(seg),
+        rounding,
+    )
+
+
+def _fit_length(seg: Segmentation) -> int:
+    """The median length of the fit regions' segments, ms (0 without any)."""
+    fitted = np.diff(seg.times_ms)[~seg.exact]
+    return round(float(np.median(fitted))) if fitted.size else 0

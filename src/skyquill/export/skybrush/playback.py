@@ -25,6 +25,7 @@ become a polynomial in the relative time ``u = (t - start) / duration``
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -102,17 +103,39 @@ def quantize(values: FloatArray, scale: int) -> NDArray[np.int64]:
     return np.trunc(np.asarray(values, dtype=float) * (1000 / scale)).astype(np.int64)
 
 
+@dataclass(frozen=True)
+class _Segments:
+    """``iter_segments(absolute=True)`` of one drone, every segment at once.
+
+    Attributes
+    ----------
+    durations_ms
+        Each segment's ``floor(1000 * round(dt, 3))``, (S,).
+    points
+        Each segment's ``[start, *controls, end]``, padded with the end to four points,
+        (S, 4, 3), m.
+    controls
+        Each segment's number of control points, 0 to 2, (S,).
+    """
+
+    durations_ms: NDArray[np.int64]
+    points: FloatArray
+    controls: NDArray[np.intp]
+
+
 def _segments(
     where: str, points: Sequence[Any], takeoff_s: float, home: Sequence[float]
-) -> list[tuple[int, list[Sequence[float]]]]:
-    """``iter_segments(absolute=True)``: (duration ms, [start, *controls, end]) per segment."""
+) -> _Segments:
+    """``iter_segments(absolute=True)``: the duration (ms) and points of every segment."""
     keyframes = list(points)
     if takeoff_s > 0:  # a still segment from -takeoff to the first keyframe
         keyframes.insert(0, [-takeoff_s, list(home), []])
-    out: list[tuple[int, list[Sequence[float]]]] = []
-    for i in range(1, len(keyframes)):
-        (t0, p0, _), (t1, p1, controls) = keyframes[i - 1], keyframes[i]
-        dt = round(float(t1) - float(t0), 3)
+    times = [float(k[0]) for k in keyframes]
+    # Python's round and floor on Python floats, as the server computes them.
+    dts = [round(t1 - t0, 3) for t0, t1 in itertools.pairwise(times)]
+    counts = [len(k[2]) for k in keyframes[1:]]
+    for i, (dt, count) in enumerate(zip(dts, counts, strict=True), start=1):
+        t0, t1 = keyframes[i - 1][0], keyframes[i][0]
         if dt <= 0:
             raise InputError(
                 f"{where}.points[{i}][0]: got {t1!r} after {t0!r}, expected a time at least "
@@ -123,49 +146,98 @@ def _segments(
                 f"{where}.points[{i}][0]: got a {dt:g} s segment, expected at most "
                 f"{MAX_SEGMENT_S:g} s (Skybrush's server splits longer ones off the ms grid)"
             )
-        if len(controls) > 2:
+        if count > 2:
             raise InputError(
-                f"{where}.points[{i}][2]: got {len(controls)} control points, expected at most 2 "
+                f"{where}.points[{i}][2]: got {count} control points, expected at most 2 "
                 "(Skybrush Live plays linear, quadratic and cubic segments)"
             )
-        out.append((math.floor(dt * 1000), [p0, *controls, p1]))
-    return out
+    ends = np.array([k[1] for k in keyframes], dtype=float).reshape(-1, 3)
+    stacked = np.repeat(ends[1:, None, :], 4, axis=1)  # (S, 4, 3): padded with the end
+    stacked[:, 0] = ends[:-1]
+    for i, k in enumerate(keyframes[1:]):
+        for j, control in enumerate(k[2]):
+            stacked[i, 1 + j] = control
+    durations = np.array([math.floor(dt * 1000) for dt in dts], dtype=np.int64)
+    return _Segments(durations, stacked, np.array(counts, dtype=np.intp))
 
 
 def _bezier_float32(points: NDArray[np.float32]) -> NDArray[np.float32]:
-    """``sb_poly_make_bezier(poly, 1, xs, n)`` on one axis; ``points`` (n,), float32."""
-    n = points.size - 1
-    out = np.zeros(4, dtype=np.float32)
+    """``sb_poly_make_bezier(poly, 1, xs, n)``, for many: ``points`` (M, n + 1), float32.
+
+    Returns the power-basis coefficients (M, n + 1), float32, with poly.c's operations
+    in poly.c's order on every row (so each row is what the firmware computes).
+    """
+    n = points.shape[1] - 1
+    out = np.zeros(points.shape, dtype=np.float32)
     if n == 0:
-        out[0] = points[0]
+        out[:, 0] = points[:, 0]
         return out
     if n == 1:  # sb_poly_make_linear with duration 1
-        out[0], out[1] = points[0], points[1] - points[0]
+        out[:, 0], out[:, 1] = points[:, 0], points[:, 1] - points[:, 0]
         return out
     for j in range(n + 1):
-        coeff = np.float32(0.0)
+        coeff = np.zeros(points.shape[0], dtype=np.float32)
         sign = -1 if j % 2 else 1
         for i in range(j + 1):
-            term = np.float32(sign) * points[i]
+            term = np.float32(sign) * points[:, i]
             coeff = coeff + term / np.float32(_FACTORIALS[i]) / np.float32(_FACTORIALS[j - i])
             sign = -sign
-        out[j] = coeff * np.float32(_FACTORIALS[n]) / np.float32(_FACTORIALS[n - j])
+        out[:, j] = coeff * np.float32(_FACTORIALS[n]) / np.float32(_FACTORIALS[n - j])
     return out
 
 
-def _axis_points(series: NDArray[np.int64]) -> NDArray[np.int64]:
-    """``SegmentEncoder._encode_coordinate_series``: the stored points of one axis (start first)."""
-    first, rest = series[0], series[1:]
-    if np.all(rest == first):
-        return series[:1]  # constant
-    if rest.size == 2:  # quadratic raised to cubic, on the integer grid
-        raised = ((first + 2 * rest[0]) / 3, (2 * rest[0] + rest[1]) / 3, rest[1])
-        return np.array([first, *(round(x) for x in raised)], dtype=np.int64)
-    return series
+def _encoded(stored: NDArray[np.int64], controls: NDArray[np.intp]) -> NDArray[np.int64]:
+    """``SegmentEncoder._encode_coordinate_series`` of every segment and axis.
+
+    ``stored`` (S, 4, 3): each segment's start, controls and end on the integer grid,
+    padded with the end. Returns the points stored per segment and axis as a cubic
+    (S, 4, 3) and, through the number of distinct points, their degree: a constant
+    axis is its start repeated, a straight one its start and end, a quadratic raised
+    to a cubic on the integer grid (``int(round(...))``).
+    """
+    first = stored[:, :1]
+    constant = np.all(stored == first, axis=1, keepdims=True)  # (S, 1, 3)
+    out = stored.copy()
+    quadratic = (controls == 1)[:, None]
+    if quadratic.any():
+        rest0, rest1 = stored[:, 1], stored[:, 2]
+        raised = np.stack(
+            [
+                stored[:, 0],
+                np.rint((stored[:, 0] + 2 * rest0) / 3).astype(np.int64),
+                np.rint((2 * rest0 + rest1) / 3).astype(np.int64),
+                rest1,
+            ],
+            axis=1,
+        )
+        out = np.where(quadratic[:, :, None], raised, out)
+    return np.where(constant, first, out)
+
+
+def _coefficients(
+    stored: NDArray[np.int64], controls: NDArray[np.intp], scale: int
+) -> NDArray[np.float32]:
+    """segment.c: every segment's float32 polynomial per axis (S, 4, 3), mm."""
+    series = _encoded(stored, controls)
+    constant = np.all(series == series[:, :1], axis=1)  # (S, 3)
+    straight = (controls == 0)[:, None] & ~constant
+    coeffs = np.zeros(series.shape, dtype=np.float32)
+    xs = (series * scale).astype(np.float32)  # coords[i] = int16 * scale, as float32
+    for mask, width in ((constant, 1), (straight, 2), (~constant & ~straight, 4)):
+        seg, axis = np.nonzero(mask)
+        if not seg.size:
+            continue
+        rows = xs[seg, :, axis]  # (M, 4)
+        picked = rows[:, :1] if width == 1 else rows[:, [0, 3]] if width == 2 else rows
+        coeffs[seg, :width, axis] = _bezier_float32(np.ascontiguousarray(picked))
+    return coeffs
 
 
 def played_trajectory(where: str, trajectory: dict[str, Any]) -> PlayedTrajectory:
     """The firmware's copy of one validated ``trajectory`` object of ``show.json``.
+
+    Every segment is encoded and turned into its polynomial at once (numpy), with the
+    server's and the firmware's arithmetic on each.
 
     Parameters
     ----------
@@ -193,24 +265,17 @@ def played_trajectory(where: str, trajectory: dict[str, Any]) -> PlayedTrajector
             "a show Skybrush can store (scaling factor below 128)"
         )
     start = quantize(np.array(points[0][1] if takeoff <= 0 else home, dtype=float), scale)
-    durations = np.array([d for d, _ in segments], dtype=np.int64)
-    coeffs = np.zeros((len(segments), 4, 3), dtype=np.float32)
-    current = start
-    for k, (_, raw) in enumerate(segments):
-        stored = quantize(np.array(raw, dtype=float), scale)
-        stored[0] = current  # the start point is the previous end, never re-encoded
-        ends = []
-        for axis in range(3):
-            series = _axis_points(stored[:, axis])
-            # segment.c: coords[i] = int16 * scale, as float32
-            coeffs[k, :, axis] = _bezier_float32((series * scale).astype(np.float32))
-            ends.append(series[-1])
-        current = np.array(ends, dtype=np.int64)
-    if not segments:  # one keyframe: the drone holds it
-        durations = np.array([1], dtype=np.int64)
+    if not segments.durations_ms.size:  # one keyframe: the drone holds it
         coeffs = np.zeros((1, 4, 3), dtype=np.float32)
         coeffs[0, 0] = (start * scale).astype(np.float32)
-    return PlayedTrajectory(durations, coeffs, scale)
+        return PlayedTrajectory(np.array([1], dtype=np.int64), coeffs, scale)
+    stored = quantize(segments.points, scale)
+    # The start point is the previous end, never re-encoded: every encoding keeps the
+    # end, so it is the previous keyframe's quantised end (the first: the start).
+    stored[0, 0] = start
+    stored[1:, 0] = stored[:-1, 3]
+    coeffs = _coefficients(stored, segments.controls, scale)
+    return PlayedTrajectory(segments.durations_ms, coeffs, scale)
 
 
 def played_show(show: dict[str, Any]) -> list[PlayedTrajectory]:

@@ -1,16 +1,20 @@
 """Skybrush ``.skyc`` show: keyframes on Skybrush's ms and mm grid, lights, yaw, validation.
 
-Each drone's plan becomes cubic Bézier keyframes on the grid Skybrush's server stores
-(:mod:`skyquill.export.skybrush.keyframes`), a light program that is on in the chosen colour
+Each drone's plan becomes C2 cubic Bézier keyframes on the grid Skybrush's server stores,
+played back and refitted until they play inside the plan's limits
+(:mod:`skyquill.export.skybrush.refit`), starting and ending on its pad
+(:mod:`skyquill.export.skybrush.pads`), a light program that is on in the chosen colour
 while the pen is down (:mod:`skyquill.export.skybrush.lights`), a constant yaw of 0, and the
-show gets the validation settings its plan implies (:mod:`.skybrush_validation`). The
-written file is then read back and played with Skybrush's own arithmetic
+show gets validation settings that the played curves meet (:mod:`.validation`). The written
+file is then read back and played with Skybrush's own arithmetic
 (:mod:`skyquill.export.skybrush.playback`): the distance from the plan and the dense limit check
-are measured on what the drones will fly, and the lights on what they will show.
+are measured on what the drones will fly (``as_played`` in the summary), and the lights on
+what they will show.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -22,21 +26,23 @@ from skyquill.colors import RGB
 from skyquill.coverage.geo import GeoFrame
 from skyquill.errors import InputError
 from skyquill.export.base import (
+    AsPlayed,
     DeliveredCheck,
     ExportOptions,
     ExportReport,
     NamedPlan,
     check_delivered,
 )
-from skyquill.export.skybrush.keyframes import skybrush_keyframes
 from skyquill.export.skybrush.lights import (
     colored_frames,
     encode_light_program,
-    light_colors,
     light_slices,
+    longest_mismatch_ms,
     program_bytes,
 )
-from skyquill.export.skybrush.playback import played_show, played_trajectory
+from skyquill.export.skybrush.pads import on_pads, takeoff_report
+from skyquill.export.skybrush.playback import played_show
+from skyquill.export.skybrush.refit import played_keyframes
 from skyquill.export.skybrush.skyc_file import (
     SkycDrone,
     read_show_json,
@@ -47,8 +53,6 @@ from skyquill.export.skybrush.skyc_file import (
 from skyquill.export.skybrush.validation import validation_settings
 from skyquill.io.trajectory_json import PlannedTrajectory
 
-#: A limit excess below this counts as none (float rounding of the read-back), relative.
-EXCESS_TOLERANCE = 1e-9
 #: Heading of the show's X+ axis, degrees clockwise from north: skyquill's x is east.
 SHOW_X_HEADING_DEG = 90.0
 
@@ -65,21 +69,20 @@ class SkycExporter:
         self, plans: Sequence[NamedPlan], out: Path, options: ExportOptions
     ) -> ExportReport:
         """Write the show, read it back as the drones play it, check it against the plans."""
+        plans = [(name, on_pads(plan)) for name, plan in plans]  # as Skybrush expects
+        made = [played_keyframes(name, plan) for name, plan in plans]
         drones = [
             SkycDrone(
                 name,
-                skybrush_keyframes(plan.trajectory),
+                keys.keyframes,
                 encode_light_program(
                     plan.pen_windows_s, plan.colors(options.light_rgb), plan.trajectory.duration
                 ),
             )
-            for name, plan in plans
+            for (name, plan), keys in zip(plans, made, strict=True)
         ]
         # The validation settings are measured on what the drones will fly.
-        flown = [
-            played_trajectory(d.name, {"points": d.keyframes.points()}).trajectory() for d in drones
-        ]
-        validation = validation_settings([p.limits for _, p in plans], flown)
+        validation = validation_settings([p.limits for _, p in plans], [m.played for m in made])
         frame = options.origin
         location = (
             None
@@ -101,6 +104,12 @@ class SkycExporter:
             for i, ((_, plan), back) in enumerate(zip(plans, played, strict=True))
         ]
         details = _details(drones, delivered, lights, validation)
+        details["pads"] = [
+            takeoff_report(plan.trajectory) | {"drone": name} for name, plan in plans
+        ]
+        details["keyframes"] = [
+            keys.report() | {"drone": name} for (name, _), keys in zip(plans, made, strict=True)
+        ]
         shift = 0.0 if frame is None else _location_shift(show, frame)
         if frame is not None:
             details["location"] = show["environment"]["location"] | {"shift_m": shift}
@@ -110,7 +119,7 @@ class SkycExporter:
             exact=False,
             # the whole show is flown around the stored (rounded) origin
             max_error_m=max(d.max_error_m for d in delivered) + shift,
-            message=_message(path, details),
+            message=_message(path, details, AsPlayed.of(delivered)),
             details=details,
             delivered=delivered,
         )
@@ -144,16 +153,16 @@ def _light_mismatch(
     """
     where = f"show.json: swarm.drones[{index}].settings.lights"
     data = program_bytes(where, show["swarm"]["drones"][index]["settings"]["lights"])
-    t_ms = np.arange(0.0, np.ceil(duration_s * 1000) + 1)
-    shown = light_colors(light_slices(where, data, t_ms[-1]), t_ms)
-    wrong = np.any(shown != plan.light(t_ms / 1000, rgb), axis=1)
+    end_ms = math.ceil(duration_s * 1000)
     # the longest run of wrong milliseconds: how far a switch is from the pen's
-    runs = np.diff(np.flatnonzero(np.diff(np.concatenate([[0], wrong.astype(int), [0]]))))[::2]
+    offset = longest_mismatch_ms(
+        light_slices(where, data, end_ms), plan.pen_windows_s, plan.colors(rgb), end_ms
+    )
     return {
         "windows": len(plan.pen_windows_s),
         "lit_windows": len(colored_frames(plan.pen_windows_s, plan.colors(rgb))),
         "colors": len(set(plan.colors(rgb))),
-        "max_offset_ms": int(runs.max()) if runs.size else 0,
+        "max_offset_ms": offset,
     }
 
 
@@ -163,33 +172,29 @@ def _details(
     lights: Sequence[dict[str, Any]],
     validation: dict[str, float],
 ) -> dict[str, Any]:
-    excess = max(d.limit_excess for d in delivered)
+    as_played = AsPlayed.of(delivered)
     return {
         "segments": sum(d.keyframes.units.shape[0] for d in drones),
         "keyframe_grid": "integer ms, coordinates in whole units of scale mm",
+        "keyframe_degree": 3,
         "scale_mm": [d.keyframes.scale for d in drones],
         "keyframe_fit_max_m": max(d.keyframes.fit_error_m for d in drones),
         "pen_down_max_error_m": max(d.pen_down_max_error_m for d in delivered),
-        "limit_excess": excess,
-        "limits_hold": bool(excess <= EXCESS_TOLERANCE),
+        "limit_excess": max(d.limit_excess for d in delivered),
+        "limits_hold": as_played.within_allowed,
         "lights": {"frame_ms": 20, "per_drone": list(lights)},
         "yaw_deg": 0.0,
         "validation": validation,
     }
 
 
-def _message(path: Path, details: dict[str, Any]) -> str:
-    excess = details["limit_excess"]
-    limits = (
-        "the limits hold on it"
-        if details["limits_hold"]
-        else f"it exceeds the plan's limits by up to {100 * excess:.3g} % (see delivered)"
-    )
+def _message(path: Path, details: dict[str, Any], as_played: AsPlayed) -> str:
     offset = max(light["max_offset_ms"] for light in details["lights"]["per_drone"])
     return (
-        f"wrote {len(details['scale_mm'])} drone(s), {details['segments']} Bézier segment(s) on "
-        f"Skybrush's ms/mm grid to {path.name}; as Skybrush plays it, {limits}; lights switch "
-        f"within {offset} ms of the pen (20 ms light frames)"
+        f"wrote {len(details['scale_mm'])} drone(s), {details['segments']} C2 Bézier segment(s) "
+        f"on Skybrush's ms/mm grid to {path.name}; as Skybrush plays it: "
+        f"{as_played.describe()} (as_played in the summary); lights switch within {offset} ms "
+        "of the pen (20 ms light frames)"
     )
 
 

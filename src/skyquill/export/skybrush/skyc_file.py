@@ -40,6 +40,7 @@ horizontal and z up, metres and seconds, which is skyquill's world frame.
 
 from __future__ import annotations
 
+import itertools
 import json
 import math
 import zipfile
@@ -55,10 +56,13 @@ from skyquill.export.skybrush.lights import lights_json, program_bytes
 from skyquill.export.skybrush.playback import MAX_SEGMENT_S, played_show
 from skyquill.io.atomic import atomic_path
 from skyquill.io.json_read import parse_json
+from skyquill.io.source import open_binary
 from skyquill.trajectory import PiecewisePolynomial
 
 #: Largest ``show.json`` read from an archive, bytes (checked before inflating it).
 MAX_SHOW_BYTES = 256 * 2**20
+#: Largest .skyc file read, bytes: compressed, the show.json of that size takes far less.
+MAX_SKYC_BYTES = 256 * 2**20
 #: Environments Skybrush knows.
 ENVIRONMENTS = ("indoor", "outdoor")
 #: Most control points of a segment Skybrush Live plays (cubic).
@@ -233,10 +237,13 @@ def read_show_json(path: str | Path) -> dict[str, Any]:
         or :func:`validate_show` rejects it.
     """
     file = Path(path)
-    if not file.is_file():
+    if not file.exists():
         raise InputError(f"skyc file: got {str(file)!r}, expected an existing .skyc file")
     try:
-        with zipfile.ZipFile(file) as archive:
+        with (
+            open_binary(file, "a .skyc show", max_bytes=MAX_SKYC_BYTES, name=file.name) as stream,
+            zipfile.ZipFile(stream) as archive,
+        ):
             if "show.json" not in archive.namelist():
                 raise InputError(
                     f"{file.name}: got members {archive.namelist()[:10]}, expected a show.json"
@@ -295,6 +302,8 @@ def _check_trajectory(where: str, traj: Any) -> None:
     points = traj.get("points")
     if not isinstance(points, list) or len(points) == 0:
         raise InputError(f"{where}.points: got {points!r:.60}, expected a non-empty list")
+    if _well_formed(points):
+        return
     prev_t: float | None = None
     for i, point in enumerate(points):
         here = f"{where}.points[{i}]"
@@ -327,6 +336,36 @@ def _check_trajectory(where: str, traj: Any) -> None:
         for j, c in enumerate(controls):
             _vec3(f"{here}[2][{j}]", c)
         prev_t = float(t)
+
+
+def _well_formed(points: list[Any]) -> bool:
+    """Whether every keyframe passes the checks of :func:`_check_trajectory`, tested in bulk.
+
+    The same rules over whole lists at a time (types by ``set(map(type, ...))``,
+    ``math.isfinite`` mapped over the numbers, the server's ``round`` on every step): a
+    thousand drones' 350,000 keyframes took seconds one field at a time. ``False`` when
+    anything is off (or of an unusual type): the field by field loop then finds and
+    names it.
+    """
+    if not all(type(p) is list and len(p) == 3 for p in points):
+        return False
+    times = [p[0] for p in points]
+    controls = [p[2] for p in points]
+    if points[0][2] != [] or not all(type(c) is list and len(c) <= MAX_CONTROLS for c in controls):
+        return False
+    vectors = [p[1] for p in points] + [c for each in controls for c in each]
+    if not all(type(v) is list and len(v) == 3 for v in vectors):
+        return False
+    numbers = times + [x for v in vectors for x in v]
+    if not set(map(type, numbers)) <= {int, float}:
+        return False
+    try:
+        if not all(map(math.isfinite, numbers)):
+            return False
+    except OverflowError:  # an integer beyond the float range
+        return False
+    steps = [round(float(b) - float(a), 3) for a, b in itertools.pairwise(times)]
+    return all(0 < step <= MAX_SEGMENT_S for step in steps)
 
 
 def _check_yaw(where: str, yaw: Any) -> None:

@@ -5,9 +5,12 @@ Skybrush Live warns when a show leaves these bounds (skybrush-io/live
 ``maxVelocityZ`` downwards and ``maxVelocityZUp`` upwards, the same three for the
 acceleration, ``minDistance``; the types in skybrush-io/skybrush.js
 ``packages/show-format/src/types.ts``). The speeds and accelerations come from the plan's
-limits, stated as Skybrush states them (horizontal norm, vertical up and down); the altitude
-and the distance between drones are measured on the trajectories, rounded outwards to the
-millimetre so that the show passes its own validation.
+limits, stated as Skybrush states them (horizontal norm, vertical up and down), raised where
+the played curves go beyond them (within the excess an export allows over a limit, a
+millimetre grid's rounding: :data:`~skyquill.export.base.ALLOWED_EXCESS`): the settings
+written are ones the played curves meet. The altitude and the distance between drones are
+measured on the trajectories; every measured value is rounded outwards to the millimetre
+(per second, per second squared), so that the show passes its own validation.
 """
 
 from __future__ import annotations
@@ -64,21 +67,42 @@ def validation_settings(
     -------
     dict
         ``maxAltitude`` (m), the speed and acceleration bounds that the limits imply (the
-        tightest over all drones; a bound no limit implies is left out), and ``minDistance``
-        (m) when there are two drones or more.
+        tightest over all drones; a bound no limit implies is left out), each raised to what
+        the trajectories reach where they go beyond it, and ``minDistance`` (m) when there
+        are two drones or more.
     """
     settings: dict[str, float] = {}
+    played = _played_maxima(trajectories)
     for order, keys in KEYS.items():
         found = [_bounds(lim) for lims in limits for lim in lims if lim.order == order]
         implied = [b for b in found if b is not None]
         for i, key in enumerate(keys):
             if implied:
-                settings[key] = min(b[i] for b in implied)
+                bound = min(b[i] for b in implied)
+                settings[key] = max(bound, math.ceil(played[order][i] * 1000) / 1000)
     top = max(float(_positions(t, dense_times(t.breakpoints))[:, 2].max()) for t in trajectories)
     settings["maxAltitude"] = math.ceil(top * 1000) / 1000
     if len(trajectories) > 1:
         settings["minDistance"] = math.floor(_closest(trajectories) * 1000) / 1000
     return settings
+
+
+def _played_maxima(trajectories: Sequence[Trajectory]) -> dict[int, tuple[float, float, float]]:
+    """Per order (1, 2): the largest (horizontal, down, up) value over every drone, sampled
+    densely."""
+    out: dict[int, tuple[float, float, float]] = {}
+    for order in KEYS:
+        worst = np.zeros(3)
+        for traj in trajectories:
+            d = traj.evaluate(dense_times(traj.breakpoints), order)
+            here = [
+                float(np.hypot(d[:, 0], d[:, 1]).max()),
+                float(-d[:, 2].min()),
+                float(d[:, 2].max()),
+            ]
+            worst = np.maximum(worst, here)
+        out[order] = (float(worst[0]), float(worst[1]), float(worst[2]))
+    return out
 
 
 def _closest(trajectories: Sequence[Trajectory]) -> float:

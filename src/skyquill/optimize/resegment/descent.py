@@ -43,6 +43,7 @@ from dataclasses import dataclass, field
 from typing import Literal
 
 import numpy as np
+from numpy.typing import NDArray
 
 from skyquill.errors import InfeasibleError, InputError
 from skyquill.optimize.resegment.gradient import time_gradient
@@ -76,6 +77,11 @@ class _Search:
     n_ctrl: int
     interior: bool = False
     n_solves: int = 0
+    #: Trial points of the last line search rejected as infeasible (or, ``interior``,
+    #: where a limit would bind).
+    rejected: int = 0
+    #: Segments whose durations stay as given (``None``: all move).
+    frozen: NDArray[np.bool_] | None = None
     grad_time: float = 0.0
     #: Every solve of the run shares it: the problems differ only in the times.
     workspace: Workspace = field(default_factory=Workspace)
@@ -108,7 +114,13 @@ class _Search:
         ).grad_segments
         g = g + self.rho
         self.grad_time += time.perf_counter() - tic
-        return g - g.mean() if self.mode == "fixed" else g
+        if self.frozen is None:
+            return g - g.mean() if self.mode == "fixed" else g
+        free = ~self.frozen
+        g = np.where(free, g, 0.0)
+        if self.mode == "fixed" and free.any():  # the projection on sum(dT) = 0 among them
+            g[free] -= g[free].mean()
+        return g
 
     def line_search(
         self, T: FloatArray, F: float, g: FloatArray, trial: float
@@ -116,9 +128,11 @@ class _Search:
         """Backtracking (Armijo) along ``-g`` from the step ``trial`` (0: a first guess).
 
         No segment may shrink by more than half in one step, which keeps
-        ``T > 0``. Infeasible trial points are rejected like costlier ones.
+        ``T > 0``. Infeasible trial points are rejected like costlier ones
+        (and counted in :attr:`rejected`, which the next first trial heeds).
         Returns ``(T, t, result, F, step)`` or ``None`` when no decrease is found.
         """
+        self.rejected = 0
         direction = -g
         shrinking = direction < 0
         cap = math.inf
@@ -133,6 +147,7 @@ class _Search:
             if self.mode == "fixed":
                 T_new = T_new * (self.total / T_new.sum())
             out = self.evaluate(T_new)
+            self.rejected += out is None
             if out is not None:
                 F_new = self.objective(*out)
                 if F_new <= F + _ARMIJO * trial * slope:
@@ -157,6 +172,19 @@ def _start(search: _Search, t: FloatArray, initial: FitResult | None) -> tuple[_
     return search, solve(first, search.solver, workspace=search.workspace)
 
 
+def _frozen(frozen: NDArray[np.bool_] | None, n: int) -> NDArray[np.bool_] | None:
+    """The validated mask of segments that keep their durations (``None``: none, or all)."""
+    if frozen is None:
+        return None
+    mask = np.asarray(frozen, dtype=bool)
+    if mask.shape != (n,):
+        raise InputError(
+            f"frozen: got shape {mask.shape}, expected ({n},): one flag per segment "
+            "between consecutive points"
+        )
+    return mask if mask.any() else None
+
+
 def _initial_times(times: FloatArray, n: int) -> FloatArray:
     """Validated times (n,), shifted to start at 0."""
     t = as_array("times", times, shape=(n,))
@@ -178,6 +206,7 @@ def resegment(
     initial_result: FitResult | None = None,
     workspace: Workspace | None = None,
     interior: bool = False,
+    frozen: NDArray[np.bool_] | None = None,
 ) -> ResegmentResult:
     """Re-segment the point times by gradient descent (paper 000 §5.4).
 
@@ -236,6 +265,11 @@ def resegment(
         of the run is the closed form. The descent may stop earlier than it
         would across the limits; a writing plan re-segmented from the home
         (its long legs at the speed limit) spent 80 % of its time there.
+    frozen
+        Segments (N - 1,) whose durations stay as given: the descent moves time
+        among the others only (in fixed mode their total is kept). A writing
+        plan freezes its legs from and to home, timed near the speed limit:
+        steps that shortened them were rejected at the limit, two in five.
 
     Returns
     -------
@@ -276,6 +310,7 @@ def resegment(
         initial_result,
     )
     search.interior = interior and res.method == "closed_form"
+    search.frozen = _frozen(frozen, pts.shape[0] - 1)
     T = np.diff(t)
     F = search.objective(t, res)
     g = search.gradient(t, res)
@@ -304,6 +339,11 @@ def resegment(
             curvature = float(s_k @ y_k)
             if curvature > 0.0:
                 trial = float(s_k @ s_k) / curvature
+            if search.rejected:
+                # Where the feasible (or limit-free) region, not the curvature, held
+                # the step, Barzilai-Borwein overshoots it again: 5-11 rejected solves
+                # per step on a writing route (职). Twice the step that was taken.
+                trial = min(trial, 2.0 * step)
         if decrease <= ftol * abs(F):
             status = "converged"
             break

@@ -43,7 +43,7 @@ from collections.abc import Callable
 import numpy as np
 from numpy.typing import NDArray
 
-from skyquill.optimize.assemble import AssemblyCache, _params, design_matrix, point_rows
+from skyquill.optimize.assemble import AssemblyCache, _params, curves_at
 from skyquill.optimize.problem import PointDeviation, SmoothingProblem
 from skyquill.optimize.resegment.multipliers import Multipliers, multipliers
 from skyquill.optimize.resegment.problems import ProblemFactory, check_problem, zero_based
@@ -192,15 +192,15 @@ def _point_terms(
     ``alpha`` itself as ``2 c alpha B_2(s_i) C``.
     """
     alpha = problem.alpha
-    r = np.zeros_like(term.points)
-    for mask, H in point_rows(problem, term, cache):
-        r += (H @ C - term.points) * mask
-    v = design_matrix(problem, term.times, 1, cache) @ C
-    g_alpha = 0.0
-    if term.accel_gain is not None:
+    if term.accel_gain is None:
+        position, v = curves_at(problem, term.times, C, 2, cache)
+        r = position - term.points
+        g_alpha = 0.0
+    else:
         gain = term.accel_gain
-        v = v + alpha**2 * gain * (design_matrix(problem, term.times, 3, cache) @ C)
-        acc_s = design_matrix(problem, term.times, 2, cache) @ C
+        position, v, acc_s, jerk_s = curves_at(problem, term.times, C, 4, cache)
+        r = position + alpha**2 * gain * acc_s - term.points
+        v = v + alpha**2 * gain * jerk_s
         g_alpha = 2.0 * term.weight * float(np.sum(r * (2.0 * alpha * gain * acc_s)))
     at_times(term.times, 2.0 * term.weight * np.sum(r * v, axis=1))
     return g_alpha

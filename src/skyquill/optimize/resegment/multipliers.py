@@ -27,6 +27,7 @@ import numpy as np
 
 from skyquill.limits import NormLimit
 from skyquill.optimize.assemble import Assembled, assemble, problem_cost
+from skyquill.optimize.banded import stationarity_residual
 from skyquill.optimize.problem import SmoothingProblem
 from skyquill.optimize.resegment.polish import polish
 from skyquill.optimize.solve import FitResult, _closed_form_kkt, _to_qp
@@ -86,6 +87,11 @@ def multipliers(result: FitResult, workspace: Workspace | None = None) -> Multip
     same problem is then re-used.
     """
     problem = result.problem
+    if result.method == "closed_form":
+        cache = workspace.assembly if workspace is not None else None
+        residual = stationarity_residual(problem, result.trajectory.control_points, result.y, cache)
+        if residual is not None:  # nothing holds the point but the equalities
+            return _equality_multipliers(result, residual)
     # Assembled again (or taken from the solve's workspace) rather than kept in
     # FitResult: the matrices are 4-5x the size of the rest of a result, which
     # missions pickle across processes.
@@ -129,6 +135,21 @@ def multipliers(result: FitResult, workspace: Workspace | None = None) -> Multip
         residual,
         cost,
     )
+
+
+def _equality_multipliers(result: FitResult, residual: float) -> Multipliers:
+    """The closed form's multipliers: its equality rows' own, no inequality or cone active.
+
+    A banded problem's closed form (:mod:`skyquill.optimize.banded`) needs no
+    assembly for them: its ``y`` solves the KKT system, which ``residual``
+    measures; every inequality and cone multiplier is 0 there.
+    """
+    C = result.trajectory.control_points
+    empty = np.zeros(0)
+    return Multipliers(
+        C, result.y.reshape(-1, C.shape[1]), empty, empty, empty, empty, empty, empty,
+        residual, result.cost,
+    )  # fmt: skip
 
 
 def _equality_solve(asm: Assembled) -> Callable[[], tuple[FloatArray, FloatArray]] | None:

@@ -555,9 +555,28 @@ function markStale() {
 // -------------------------------------------------------------- results
 
 function verdict(result) {
-  // The one place the page words its verdict on the limits.
+  // The one place the page words its verdict on the limits: "every limit met" only when the
+  // plan and every download as its vehicle plays it meet them (result.delivered, which is
+  // summary.json's exports.<file>.as_played).
+  const pct = (x) => `${(100 * x).toFixed(2)} %`;
   const excess = Math.max(...result.drones.flatMap((d) => d.checks.map((c) => c.relative_excess)));
-  return excess > 0 ? `limits exceeded by ${(100 * excess).toFixed(2)} %` : "every limit met";
+  if (excess > 0) return `limits exceeded by ${pct(excess)}`;
+  const delivered = result.delivered || [];
+  const worded = (d) => Object.entries(d.relative_excess)
+    .filter(([, e]) => e > 1e-6)
+    .map(([name, e]) => `${name} ${pct(e)}`)
+    .join(", ");
+  const refused = delivered.filter((d) => d.verdict === "refused");
+  if (refused.length) {
+    return "limits met as planned, but " +
+      refused.map((d) => `the ${d.kind} file would fly over them and was not made`).join("; ");
+  }
+  const over = delivered.filter((d) => d.verdict !== "every limit met");
+  if (over.length) {
+    return "limits met as planned, but as flown from the files over them: " +
+      over.map((d) => `${d.kind} ${worded(d)}`).join("; ");
+  }
+  return "every limit met";
 }
 
 function showResult(result, waitedS) {

@@ -1,0 +1,56 @@
+"""polyline_distance: exact (against the table of every point and segment), in linear memory."""
+
+from __future__ import annotations
+
+import tracemalloc
+
+import numpy as np
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from hypothesis.extra.numpy import arrays
+
+from skyquill.geometry import polyline_distance
+
+
+def _table(p: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Every point against every segment: the reference (quadratic memory)."""
+    a, ab = v[:-1], v[1:] - v[:-1]
+    length2 = (ab * ab).sum(1)
+    q = p[:, None, :] - a[None]
+    s = np.clip((q * ab[None]).sum(2) / np.where(length2 > 0, length2, 1.0), 0.0, 1.0)
+    gap = q - s[:, :, None] * ab[None]
+    return np.sqrt((gap * gap).sum(2).min(1))
+
+
+coords = st.floats(-100.0, 100.0, allow_nan=False, allow_infinity=False)
+
+
+@settings(max_examples=150, deadline=None)
+@given(
+    v=arrays(np.float64, st.tuples(st.integers(2, 30), st.just(2)), elements=coords),
+    p=arrays(np.float64, st.tuples(st.integers(1, 40), st.just(2)), elements=coords),
+)
+def test_the_distance_is_the_nearest_segments(v: np.ndarray, p: np.ndarray) -> None:
+    np.testing.assert_allclose(polyline_distance(p, v), _table(p, v), rtol=1e-9, atol=1e-9)
+
+
+def test_three_dimensions_repeated_vertices_and_a_long_segment() -> None:
+    rng = np.random.default_rng(3)
+    v = np.cumsum(rng.normal(size=(50, 3)), axis=0)
+    v[10:13] = v[10]
+    v[30] = v[29] + 500.0  # one segment far longer than the others
+    p = rng.normal(size=(500, 3)) * 50.0
+    np.testing.assert_allclose(polyline_distance(p, v), _table(p, v), rtol=1e-9, atol=1e-9)
+
+
+def test_memory_grows_with_the_points_and_segments_not_their_product() -> None:
+    """Issue 25: the write of one SVG path spent 6.7 GB in this table."""
+    t = np.linspace(0.0, 60.0, 60_000)
+    v = np.column_stack([np.cos(t), np.sin(t)])
+    tracemalloc.start()
+    try:
+        polyline_distance(v[::2] + 1e-3, v)
+        _, peak = tracemalloc.get_traced_memory()
+    finally:
+        tracemalloc.stop()
+    assert peak < 100 * 2**20  # the table would take 30,000 x 60,000 x 16 B = 29 GB
