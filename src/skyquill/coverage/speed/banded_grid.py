@@ -23,6 +23,7 @@ from collections.abc import Callable
 import numpy as np
 
 from skyquill.coverage.deadline import Deadline
+from skyquill.coverage.speed.active_rows import KEEP, solve_active_rows
 from skyquill.coverage.speed.banded import TOLERANCE, BandedRows, solve_banded_lp
 from skyquill.coverage.speed.reach import AccelerationRows, ReachPass
 from skyquill.coverage.speed.rows import _GridLP, jerk_coefficients
@@ -114,6 +115,9 @@ class BandedGrid:
         self.ipm_time = 0.0
         self.ipm_solves = 0
         self.ipm_iterations = 0
+        #: The last interior-point solution: the guess of the rows that bind in the next
+        #: solve (the jerk-free optimum is no guess: it breaks most jerk rows).
+        self._last: FloatArray | None = None
 
     @property
     def time(self) -> float:
@@ -144,11 +148,17 @@ class BandedGrid:
                 return b
         start = time.perf_counter()
         tol = ROUGH_TOLERANCE if rough else TOLERANCE
-        sol = solve_banded_lp(self.rows, bound, ub, np.ones(n), tolerance=tol)
+        if self._last is not None and self.q > KEEP:
+            # A polygon's directions: only the few nearest the vector can bind.
+            sol, solves = solve_active_rows(self.rows, bound, ub, guess=self._last, blocks=3,
+                                            tolerance=tol)  # fmt: skip
+        else:
+            sol, solves = solve_banded_lp(self.rows, bound, ub, np.ones(n), tolerance=tol), 1
         self.ipm_time += time.perf_counter() - start
-        self.ipm_solves += 1
+        self.ipm_solves += solves
         self.ipm_iterations += sol.iterations
         if sol.status == "optimal":
+            self._last = sol.b
             return sol.b
         _log.warning("banded interior point did not converge (%s); HiGHS answers", sol.status)
         if self._lp is None:

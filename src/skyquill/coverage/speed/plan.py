@@ -131,10 +131,14 @@ def plan_speed(
         LP's optimum, in linear time). ``"banded"``: with a jerk limit, the
         jerk-free problems by the passes and the pseudo-jerk LPs by the
         banded interior-point method (:mod:`.banded`, linear time per Newton
-        step); without one it is ``"reach"``. ``"lp"``: every problem by the
-        HiGHS grid LP (the reference). ``"auto"``: ``"reach"`` without a
-        jerk limit, ``"banded"`` with one (``"reach"`` with a jerk limit is
-        refused: its rows couple three nodes).
+        step; with a norm limit on the rows of the polygon's directions that
+        can bind, :mod:`.active_rows`); without one it is ``"reach"``.
+        ``"lp"``: every problem by the HiGHS grid LP (the reference).
+        ``"auto"``: ``"reach"`` without a jerk limit; with one ``"lp"`` below
+        :data:`~.validate.BANDED_FROM_POINTS` grid points (its simplex
+        re-solves from the last basis, which is faster on small grids) and
+        ``"banded"`` from there (``"reach"`` with a jerk limit is refused:
+        its rows couple three nodes).
 
     Returns
     -------
@@ -161,8 +165,8 @@ def plan_speed(
         safety=safety,
     )
     backend = _validate_refine(max_excess, refine_rounds, lp_backend, grid)
-    solver = _validate_method(method, jerk=jmax is not None)
     n = args.n
+    solver = _validate_method(method, jerk=jmax is not None, n=n)
     d = _eval(curve, np.array([0.0, 1.0]), 1).shape[1]
     norm = _validate_norm_sides(norm_sides, d)
     amax_a, jmax_a = _validate_limits(amax, jmax, d, norm_sides=norm)
