@@ -2,8 +2,9 @@
 
 Run from the repository root::
 
-    .venv/bin/python bench/coverage_scale.py           # full run, about 5 minutes
-    .venv/bin/python bench/coverage_scale.py --quick   # 1 timed run per field
+    .venv/bin/python bench/coverage_scale.py                 # full run, about 15 minutes
+    .venv/bin/python bench/coverage_scale.py --quick         # 1 timed run per field
+    .venv/bin/python bench/coverage_scale.py --keepout-only  # the keep-out fields, ~10 min
 
 It writes ``bench/results/coverage_scale.json`` (``coverage_scale_quick.json``
 with ``--quick``) and prints one table. BLAS is pinned to one thread
