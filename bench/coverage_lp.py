@@ -46,8 +46,13 @@ adaptive grid, which ``plan_speed`` solves, and a uniform one):
    the equivalent per-axis bounds ``vmax |C'_i| / |C'|`` through
    ``JointVelocityConstraintVarying``; amax 5 m/s^2 per axis for both) and
    ``acceleration_only`` (vmax 100 m/s); the grid LP (``method="lp"``) as
-   the reference up to :data:`LP_MAX_POINTS`; with jerk (jmax 3 m/s^3, the
-   pseudo-jerk LP, the only jerk method) up to :data:`JERK_MAX_POINTS`.
+   the reference up to :data:`LP_MAX_POINTS`; with jerk (jmax 3 m/s^3) the
+   pseudo-jerk iteration solved by the banded interior point
+   (``method="banded"``, to 32,000 points) and by the HiGHS LP
+   (``method="lp"``, up to :data:`LP_JERK_MAX_POINTS`), interleaved; ``auto``
+   is whichever of the two ``plan_speed`` picks at that size
+   (``BANDED_FROM_POINTS``), and ``jerk_on.over_jerk_off`` its time over the
+   jerk-free plan's.
    Log-log slopes from 2,000 to 32,000 points, time ratios ours / toppra,
    duration ratios.  Goals: ours <= toppra at 32,000 points, slope <= 1.1,
    jerk on <= 3x jerk off.
@@ -83,6 +88,7 @@ from skyquill.coverage.speed.rows import (
     _ones,
     _speed_bounds,
 )
+from skyquill.coverage.speed.validate import BANDED_FROM_POINTS
 
 RESULTS = Path(__file__).resolve().parent / "results" / "coverage_lp.json"
 QUICK_RESULTS = RESULTS.with_name("coverage_lp_quick.json")
@@ -96,8 +102,9 @@ SCALE_POINTS = (500, 1000, 2000, 4000, 8000, 16000, 32000)
 SCALE_RUNS = 3
 #: The grid LP is timed as the reference up to this many points (52 s at 32,000).
 LP_MAX_POINTS = 8000
-#: The jerk-limited plan (pseudo-jerk LP) is timed up to this many points (85 s at 32,000).
-JERK_MAX_POINTS = 8000
+#: The jerk-limited plan through the HiGHS LP is timed up to this many points (85 s at
+#: 32,000); through the banded interior point at every size.
+LP_JERK_MAX_POINTS = 8000
 SCALE_GOALS = {
     "time_ratio_ours_over_toppra_at_32000": 1.0,
     "slope_2000_32000": 1.1,
@@ -361,14 +368,7 @@ def scaling_case(runs: int, points: tuple[int, ...]) -> dict[str, Any]:
                 entry["duration_ratio_ours_over_lp"] = res["ours"].duration / res["lp"].duration
                 entry["time_ratio_lp_over_ours"] = med["lp"] / med["ours"]
             row[label] = entry
-        if n <= JERK_MAX_POINTS:
-            jerk = {"jerk": lambda k=n: plan_speed(curve, VMAX, AMAX, JMAX, n=k)}
-            got = _interleaved(jerk, runs)
-            row["jerk_on"] = {
-                "median_s": got["median_s"]["jerk"],
-                "duration_s": got["results"]["jerk"].duration,
-                "over_jerk_off": got["median_s"]["jerk"] / row["speed_norm"]["median_s"]["ours"],
-            }
+        row["jerk_on"] = jerk_on(curve, n, runs, row["speed_norm"]["median_s"]["ours"])
         rows.append(row)
     ns = [r["grid_points"] for r in rows]
     slopes = {
@@ -378,6 +378,30 @@ def scaling_case(runs: int, points: tuple[int, ...]) -> dict[str, Any]:
         if all(who in r[label]["median_s"] for r in rows)
     }
     return {"id": "scaling", "goals": SCALE_GOALS, "rows": rows, "loglog_slope_2000_up": slopes}
+
+
+def jerk_on(curve: Any, n: int, runs: int, jerk_off_s: float) -> dict[str, Any]:
+    """The jerk-limited plan by the banded interior point and (to LP_JERK_MAX_POINTS) the LP."""
+    calls: dict[str, Callable[[], Any]] = {
+        "banded": lambda: plan_speed(curve, VMAX, AMAX, JMAX, n=n, method="banded")
+    }
+    if n <= LP_JERK_MAX_POINTS:
+        calls["lp"] = lambda: plan_speed(curve, VMAX, AMAX, JMAX, n=n, method="lp")
+    got = _interleaved(calls, runs)
+    med, res = got["median_s"], got["results"]
+    auto = "banded" if n >= BANDED_FROM_POINTS else "lp"
+    entry: dict[str, Any] = {
+        "median_s": med,
+        "duration_s": {k: v.duration for k, v in res.items()},
+        "lp_solves": {k: v.lp_solves for k, v in res.items()},
+        "auto": auto,
+        "over_jerk_off": med[auto] / jerk_off_s if auto in med else None,
+        "banded_over_jerk_off": med["banded"] / jerk_off_s,
+    }
+    if "lp" in med:
+        entry["time_ratio_banded_over_lp"] = med["banded"] / med["lp"]
+        entry["duration_ratio_banded_over_lp"] = res["banded"].duration / res["lp"].duration
+    return entry
 
 
 def print_summary(out: dict[str, Any]) -> None:
@@ -420,9 +444,11 @@ def print_scaling(case: dict[str, Any]) -> None:
             if "lp" in e["median_s"]:
                 line += f" lp {e['median_s']['lp']:.3f} s"
         if "jerk_on" in r:
-            line += (
-                f"  jerk on {r['jerk_on']['median_s']:.3f} s (x{r['jerk_on']['over_jerk_off']:.1f})"
-            )
+            j = r["jerk_on"]
+            line += f"  jerk on: banded {j['median_s']['banded']:.3f} s"
+            if "lp" in j["median_s"]:
+                line += f" lp {j['median_s']['lp']:.3f} s"
+            line += f" (auto = {j['auto']}: x{j['over_jerk_off'] or float('nan'):.1f} jerk off)"
         print(line)
     print(f"log-log slopes from 2,000 points: {case['loglog_slope_2000_up']}")
 

@@ -2,8 +2,9 @@
 
 Run from the repository root::
 
-    .venv/bin/python bench/coverage_scale.py           # full run, about 5 minutes
-    .venv/bin/python bench/coverage_scale.py --quick   # 1 timed run per field
+    .venv/bin/python bench/coverage_scale.py                 # full run, about 15 minutes
+    .venv/bin/python bench/coverage_scale.py --quick         # 1 timed run per field
+    .venv/bin/python bench/coverage_scale.py --keepout-only  # the keep-out fields, ~10 min
 
 It writes ``bench/results/coverage_scale.json`` (``coverage_scale_quick.json``
 with ``--quick``) and prints one table. BLAS is pinned to one thread
@@ -19,6 +20,18 @@ growth is read from the log-log slope of planning time against path length
 (1 = linear) and from the time per kilometre, as a ratio to the 1 ha field's
 measured in the same run. Read ratios, not absolute times: the reference
 machine has 2 noisy cores shared with other jobs.
+
+``keepout`` (issue 27 part 3; ``--keepout-only`` runs it alone and merges it
+into the JSON): the fields with two holes each in ``examples/coverage/``
+(:data:`KEEPOUT_FIELDS`: 1.3 ha, the held-out 1.3 ha field of
+``tests/cli/test_cover_heldout.py`` scaled x5.8, 10 ha at a 5 m swath; 100 ha
+at a 10 m swath) planned as ``skyquill cover`` plans them
+(``plan_tuned`` to 99 % coverage, the default spiral and limits) with and
+without their holes (the same outline), one timed run each: the
+``planning_time_s`` ``summary.json`` reports (the whole planning), its ratio
+to the field without holes, and where the budget (:data:`KEEPOUT_BUDGET_S`)
+ran out, the step it stopped at. Goals: <= 5 s (1.3 and 10 ha), <= 60 s
+(100 ha), <= 2x the field without holes.
 
 ``lp_growth``: the speed LP alone against its grid size (1,000 to 8,000 points
 on the 10 m square's spiral of ``bench/coverage_lp.py``, one timed run each):
@@ -37,13 +50,16 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from shapely.geometry import box
+from shapely.geometry import Polygon, box
 from threadpoolctl import threadpool_info, threadpool_limits
 
 from common import jsonable, machine_info, time_calls, time_stats, toppra_path
 from coverage_lp import spiral
-from skyquill.coverage.plan import CoverageOptions, CoveragePlan, plan_coverage
+from skyquill.coverage import DEFAULT_MIN_COVERAGE
+from skyquill.coverage.plan import CoverageOptions, CoveragePlan, plan_coverage, plan_tuned
+from skyquill.coverage.regions import load_region
 from skyquill.coverage.speed import plan_speed
+from skyquill.errors import SkyquillError
 
 RESULTS = Path(__file__).parent / "results" / "coverage_scale.json"
 QUICK_RESULTS = Path(__file__).parent / "results" / "coverage_scale_quick.json"
@@ -54,6 +70,16 @@ RUNS = 3
 #: Issue 16's target: a 10 ha field at a 5 m swath "well under a minute".
 TARGET_10HA_S = 60.0
 LP_GRIDS = (1000, 2000, 4000, 8000)
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples" / "coverage"
+#: Issue 27's fields with keep-outs: (file in examples/coverage, swath m, goal s).
+KEEPOUT_FIELDS = (
+    ("holes_1_3ha", 5.0, 5.0),
+    ("heldout_holes_1_3ha", 5.0, 5.0),
+    ("holes_10ha", 5.0, 5.0),
+    ("holes_100ha", 10.0, 60.0),
+)
+#: Planning budget of one keep-out field, s (a plan not done by then is reported as such).
+KEEPOUT_BUDGET_S = 180.0
 
 
 def options() -> CoverageOptions:
@@ -81,6 +107,62 @@ def field_case(hectares: float, runs: int) -> dict[str, Any]:
         else {"grid_points": int(lp.u.size), "solves": lp.lp_solves, "solve_time_s": lp.solve_time},
         "planning": time_stats(times, warmup=0),
     }
+
+
+def _tuned_time(region: Any, width: float) -> dict[str, Any]:
+    """``plan_tuned`` as ``skyquill cover`` runs it: its planning time, or where it stopped."""
+    opts = CoverageOptions(width=width, time_limit=KEEPOUT_BUDGET_S)
+    start = time.perf_counter()
+    try:
+        plan = plan_tuned(region, opts, DEFAULT_MIN_COVERAGE)
+    except SkyquillError as exc:
+        return {"planned": False, "wall_s": time.perf_counter() - start, "error": str(exc)}
+    return {
+        "planned": True,
+        "wall_s": time.perf_counter() - start,
+        "planning_time_s": plan.planning_time,
+        "path_length_m": plan.path_length,
+        "duration_s": plan.duration,
+        "coverage_fraction": plan.coverage,
+        "max_excess": plan.limits["max_excess"],
+    }
+
+
+def keepout_cases() -> list[dict[str, Any]]:
+    """Each keep-out field with and without its holes."""
+    cases = []
+    for name, width, goal in KEEPOUT_FIELDS:
+        region = load_region(EXAMPLES / f"{name}.geojson")
+        outline = Polygon(region.exterior)
+        holed = _tuned_time(region, width)
+        open_field = _tuned_time(outline, width)
+        case = {
+            "field": name,
+            "hectares_outline": outline.area / 1e4,
+            "width_m": width,
+            "goal_s": goal,
+            "with_holes": holed,
+            "without_holes": open_field,
+        }
+        if holed["planned"] and open_field["planned"]:
+            case["ratio_with_over_without"] = (
+                holed["planning_time_s"] / open_field["planning_time_s"]
+            )
+        cases.append(case)
+        print_keepout([case])
+    return cases
+
+
+def print_keepout(cases: list[dict[str, Any]]) -> None:
+    for c in cases:
+        line = f"{c['field']:>20} ({c['hectares_outline']:.2f} ha, {c['width_m']:g} m swath):"
+        for label in ("with_holes", "without_holes"):
+            r = c[label]
+            got = f"{r['planning_time_s']:.1f} s" if r["planned"] else f"not planned ({r['error']})"
+            line += f" {label.replace('_', ' ')} {got};"
+        if "ratio_with_over_without" in c:
+            line += f" ratio {c['ratio_with_over_without']:.2f} (goal <= {c['goal_s']:g} s, 2x)"
+        print(line)
 
 
 def growth(cases: list[dict[str, Any]]) -> dict[str, Any]:
@@ -173,6 +255,9 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--quick", action="store_true", help="1 timed run per field")
     parser.add_argument("--out", type=Path, default=None, help="JSON output path")
+    parser.add_argument(
+        "--keepout-only", action="store_true", help="only the keep-out fields (merged)"
+    )
     args = parser.parse_args(argv)
     runs = 1 if args.quick else RUNS
     out_path: Path = args.out or (QUICK_RESULTS if args.quick else RESULTS)
@@ -180,7 +265,10 @@ def main(argv: list[str] | None = None) -> int:
     with threadpool_limits(limits=1):
         blas = threadpool_info()
         plan_coverage(box(0.0, 0.0, 100.0, 100.0), options())  # warm-up: imports, caches
+        if args.keepout_only:
+            return _keepout_only(out_path)
         cases = [field_case(ha, runs) for ha in HECTARES]
+        keepout = keepout_cases()
         lp = lp_growth()
     out = {
         "schema": 1,
@@ -199,12 +287,25 @@ def main(argv: list[str] | None = None) -> int:
         "targets": {"10ha_planning_s_below": TARGET_10HA_S},
         "cases": cases,
         "growth": growth(cases),
+        "keepout": keepout,
         "lp_growth": lp,
     }
     out_path.parent.mkdir(parents=True, exist_ok=True)
     out_path.write_text(json.dumps(jsonable(out), indent=2) + "\n")
     print_summary(out)
     print(f"wrote {out_path} in {out['total_wall_s']:.1f} s")
+    return 0
+
+
+def _keepout_only(out_path: Path) -> int:
+    """The keep-out fields alone, replacing their entry in an existing results file."""
+    keepout = keepout_cases()
+    out = json.loads(out_path.read_text()) if out_path.exists() else {"schema": 1}
+    out["keepout"] = keepout
+    out["keepout_generated_utc"] = datetime.now(UTC).isoformat(timespec="seconds")
+    out["keepout_machine"] = machine_info(("scipy", "highspy", "shapely"))
+    out_path.write_text(json.dumps(jsonable(out), indent=2) + "\n")
+    print(f"wrote {out_path}")
     return 0
 
 

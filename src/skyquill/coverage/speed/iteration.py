@@ -20,6 +20,8 @@ _MAX_SAMPLES = 256
 #: Grid size up to which every interval gets _SAMPLES, and the fewest on finer grids.
 _SAMPLE_GRID = 2000
 _MIN_SAMPLES = 3
+#: Weight of the last solution in the next pseudo-jerk reference (geometric mean).
+DAMPING = 0.65
 
 
 def _initial_solve(
@@ -50,25 +52,32 @@ def _pseudo_jerk(
     stop: tuple[int, float],
     log: tuple[list[float], list[float]],
 ) -> tuple[FloatArray, int]:
-    """Pseudo-jerk fixed-point iteration from ``start``, then the certification LP.
+    """Damped pseudo-jerk fixed-point iteration from ``start``, then the certification LP.
 
-    Starting from an over-estimate (the jerk-free optimum, or the previous
-    plan before a refinement), each LP linearises ``sqrt(b)`` at the previous
-    iterate; the iterates then alternate around the fixed point with
-    shrinking amplitude.  The final LP linearises at
-    ``B = max(b_k, b_{k-1})`` and imposes ``b <= B``, which makes the true
-    grid jerk ``sqrt(b) |X| <= sqrt(B) |X| <= jmax``.
+    Each LP linearises ``sqrt(b)`` at a reference ``ref`` (the jerk rows read
+    ``sqrt(ref) |X(b)| <= jmax``). The undamped iteration (``ref`` = the last
+    solution, paper 001's) alternates around the fixed point and shrinks its
+    error by about 0.55 a step: a reference too high gives rows too tight and
+    a solution too low, and back. The next reference is therefore the
+    geometric mean of the last reference and the last solution
+    (:data:`DAMPING`), which removes most of that swing: on the 10 m square's
+    spiral 4-6 LPs instead of 13-23, to the same fixed point.
+
+    The final LP linearises at ``B = max(ref, b)`` and imposes ``b <= B``,
+    which makes the true grid jerk ``sqrt(b) |X| <= sqrt(B) |X| <= jmax``.
 
     Parameters
     ----------
     lp
-        The grid LP (hot-started between solves).
+        The grid problem's solver.
     bounds
         Row/column bounds with the refinement factors.
     start
-        First linearisation point.
+        First reference (an over-estimate: the jerk-free optimum, or the
+        previous plan before a refinement).
     stop
-        ``(max_iterations, tolerance)`` on the relative change of ``sqrt(b)``.
+        ``(max_iterations, tolerance)`` on the relative change of ``sqrt(b)``
+        between a reference and its solution.
     log
         Lists that receive the objectives and the relative changes.
 
@@ -80,19 +89,19 @@ def _pseudo_jerk(
     max_iter, tol = stop
     objectives, changes = log
     ub = bounds.cols()
-    prev = prev2 = start
+    ref = b = start
     iterations = 0
     for _ in range(max_iter):
-        bn = lp.solve(bounds.rows(prev), ub)
+        b = lp.solve(bounds.rows(ref), ub, rough=True)
         iterations += 1
-        objectives.append(float(bn.sum()))
-        sq_new = np.sqrt(bn)
-        change = float(np.max(np.abs(sq_new - np.sqrt(prev))) / max(np.max(sq_new), 1e-300))
+        objectives.append(float(b.sum()))
+        sq = np.sqrt(b)
+        change = float(np.max(np.abs(sq - np.sqrt(ref))) / max(np.max(sq), 1e-300))
         changes.append(change)
-        prev2, prev = prev, bn
-        if change < tol and iterations >= 2:
+        if change < tol:
             break
-    big = np.maximum(prev, prev2)
+        ref = ref ** (1.0 - DAMPING) * b**DAMPING
+    big = np.maximum(ref, b)
     b = lp.solve(bounds.rows(big), np.minimum(ub, big))
     objectives.append(float(b.sum()))
     return b, iterations

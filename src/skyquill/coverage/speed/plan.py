@@ -11,6 +11,7 @@ import numpy.typing as npt
 from scipy import sparse
 
 from skyquill.coverage.deadline import Deadline
+from skyquill.coverage.speed.banded_grid import BandedGrid, banded_rows
 from skyquill.coverage.speed.curve import PathCurve, _derivs3, _eval, _Reparam
 from skyquill.coverage.speed.grid import _grid_map
 from skyquill.coverage.speed.iteration import _initial_solve, _refine
@@ -124,12 +125,20 @@ def plan_speed(
     deadline : Deadline, optional
         A wall-time budget: checked before every LP solve, whose HiGHS time
         limit is what is left of it (see :class:`~skyquill.coverage.deadline.Deadline`).
-    method : {"auto", "reach", "lp"}, default "auto"
-        How the jerk-free problem is solved: ``"reach"``, by the backward and
-        forward reachability passes (:mod:`.reach`; the LP's optimum, in
-        linear time), ``"lp"`` by the grid LP (the reference). ``"auto"``:
-        the passes without a jerk limit, the LP with one (``"reach"`` with a
-        jerk limit is refused: its rows couple three nodes).
+    method : {"auto", "reach", "banded", "lp"}, default "auto"
+        How the grid problems are solved. ``"reach"``: without a jerk limit,
+        by the backward and forward reachability passes (:mod:`.reach`; the
+        LP's optimum, in linear time). ``"banded"``: with a jerk limit, the
+        jerk-free problems by the passes and the pseudo-jerk LPs by the
+        banded interior-point method (:mod:`.banded`, linear time per Newton
+        step; with a norm limit on the rows of the polygon's directions that
+        can bind, :mod:`.active_rows`); without one it is ``"reach"``.
+        ``"lp"``: every problem by the HiGHS grid LP (the reference).
+        ``"auto"``: ``"reach"`` without a jerk limit; with one ``"lp"`` below
+        :data:`~.validate.BANDED_FROM_POINTS` grid points (its simplex
+        re-solves from the last basis, which is faster on small grids) and
+        ``"banded"`` from there (``"reach"`` with a jerk limit is refused:
+        its rows couple three nodes).
 
     Returns
     -------
@@ -156,8 +165,8 @@ def plan_speed(
         safety=safety,
     )
     backend = _validate_refine(max_excess, refine_rounds, lp_backend, grid)
-    solver = _validate_method(method, jerk=jmax is not None)
     n = args.n
+    solver = _validate_method(method, jerk=jmax is not None, n=n)
     d = _eval(curve, np.array([0.0, 1.0]), 1).shape[1]
     norm = _validate_norm_sides(norm_sides, d)
     amax_a, jmax_a = _validate_limits(amax, jmax, d, norm_sides=norm)
@@ -185,11 +194,22 @@ def plan_speed(
     if jlim is not None:
         a = sparse.vstack([a, _jerk_matrix((p1, p2, p3), jlim * args.safety, vb)], format="csr")
     lp: GridSolver
-    if solver == "reach":
-        rows = acceleration_rows(p1, p2, float(sig[1] - sig[0]), component_limits(amax_a, norm))
-        lp = ReachGrid(rows, lambda: _GridLP(a, backend=backend, deadline=deadline), deadline)
+
+    def highs() -> _GridLP:
+        return _GridLP(a, backend=backend, deadline=deadline)
+
+    if solver == "lp":
+        lp = highs()
     else:
-        lp = _GridLP(a, backend=backend, deadline=deadline)
+        acc = acceleration_rows(
+            p1, p2, float(sig[1] - sig[0]), component_limits(amax_a, norm) * args.safety
+        )
+        if solver == "reach":
+            lp = ReachGrid(acc, highs, deadline)
+        else:
+            assert jlim is not None  # "banded" is "reach" without a jerk limit
+            lp = BandedGrid(acc, banded_rows(acc, (p1, p2, p3), jlim * args.safety, vb), highs,
+                            deadline)  # fmt: skip
     bounds = _Bounds(ub, None if jlim is None else vb, p1.shape[1], *_ones(n))
     log: tuple[list[float], list[float]] = ([], [])
     stop = (args.jerk_iterations, args.jerk_tol)
@@ -229,7 +249,7 @@ def plan_speed(
         refinements=rounds,
         excess_estimate=est,
         lp_solves=lp.solves,
-        method="lp" if isinstance(lp, ReachGrid) and lp.used_lp else solver,
+        method="lp" if isinstance(lp, ReachGrid | BandedGrid) and lp.used_lp else solver,
     )
 
 

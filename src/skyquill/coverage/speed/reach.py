@@ -344,8 +344,9 @@ class ReachGrid:
         """Whether the LP had to answer."""
         return self._lp is not None
 
-    def solve(self, r: FloatArray, ub: FloatArray) -> FloatArray:
-        """The optimum for row bounds ``r`` (acceleration factors first) and ``b <= ub``."""
+    def solve(self, r: FloatArray, ub: FloatArray, *, rough: bool = False) -> FloatArray:
+        """The optimum for row bounds ``r`` (acceleration factors first) and ``b <= ub``
+        (``rough`` is not used: the passes are exact)."""
         if self.deadline is not None:
             self.deadline.check(f"speed pass {self.solves + 1}")
         b = self.passes.solve(r[: ub.size - 1], ub)

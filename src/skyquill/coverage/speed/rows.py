@@ -51,13 +51,9 @@ def _jerk_matrix(
     changes bounds; ``scale`` (a fixed speed-like reference) keeps the rows
     well scaled.
     """
-    c1, c2, c3 = derivs
-    n, d = c1.shape
-    h = 1.0 / (n - 1)
+    n, d = derivs[0].shape
     i_idx = np.arange(1, n - 1)
-    cm = -1.5 * c2[1:-1] / (2 * h) + 0.5 * c1[1:-1] / h**2
-    cc = c3[1:-1] - c1[1:-1] / h**2
-    cp = 1.5 * c2[1:-1] / (2 * h) + 0.5 * c1[1:-1] / h**2
+    cm, cc, cp = jerk_coefficients(derivs)
     r = np.sqrt(scale[1:-1])
     ri = np.tile(np.arange(n - 2), 3)
     ci = np.concatenate([i_idx - 1, i_idx, i_idx + 1])
@@ -67,6 +63,32 @@ def _jerk_matrix(
         data = np.concatenate([cm[:, ax] * sc, cc[:, ax] * sc, cp[:, ax] * sc])
         blocks.append(sparse.csr_array((data, (ri, ci)), shape=(n - 2, n)))
     return sparse.vstack(blocks, format="csr")
+
+
+def jerk_coefficients(
+    derivs: tuple[FloatArray, FloatArray, FloatArray],
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Coefficients of ``b_{i-1}``, ``b_i``, ``b_{i+1}`` in ``X_i`` at the interior nodes.
+
+    ``X_i = C3 b_i + 1.5 C2 (b_{i+1} - b_{i-1}) / (2h) + 0.5 C1 (b_{i+1} - 2 b_i + b_{i-1})
+    / h**2`` on the uniform grid of ``[0, 1]`` (``h = 1 / (n - 1)``).
+
+    Parameters
+    ----------
+    derivs : tuple of ndarray, shape (n, q)
+        ``C'``, ``C''``, ``C'''`` (or their limited components) at the nodes.
+
+    Returns
+    -------
+    tuple of ndarray, shape (n - 2, q)
+        The three coefficients of every component at nodes ``1 .. n - 2``.
+    """
+    c1, c2, c3 = derivs
+    h = 1.0 / (c1.shape[0] - 1)
+    cm = -1.5 * c2[1:-1] / (2 * h) + 0.5 * c1[1:-1] / h**2
+    cc = c3[1:-1] - c1[1:-1] / h**2
+    cp = 1.5 * c2[1:-1] / (2 * h) + 0.5 * c1[1:-1] / h**2
+    return cm, cc, cp
 
 
 @dataclass
@@ -152,8 +174,9 @@ class GridSolver(Protocol):
         """Problems solved."""
         ...
 
-    def solve(self, r: FloatArray, ub: FloatArray) -> FloatArray:
-        """``b`` for row bounds ``|A b| <= r`` and column bounds ``0 <= b <= ub``."""
+    def solve(self, r: FloatArray, ub: FloatArray, *, rough: bool = False) -> FloatArray:
+        """``b`` for row bounds ``|A b| <= r`` and column bounds ``0 <= b <= ub``; ``rough``:
+        an iterate of a fixed-point iteration, which a solver may answer less precisely."""
         ...
 
 
@@ -179,7 +202,7 @@ class _GridLP:
         """LPs solved."""
         return self.lp.solves
 
-    def solve(self, r: FloatArray, ub: FloatArray) -> FloatArray:
+    def solve(self, r: FloatArray, ub: FloatArray, *, rough: bool = False) -> FloatArray:
         """Solve with row bounds ``-r <= A b <= r`` (``inf`` = free row) and ``b <= ub``.
 
         With a deadline, no solve is started once it is spent, nor given more

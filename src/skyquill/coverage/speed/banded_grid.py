@@ -1,0 +1,166 @@
+"""The grid problem with jerk rows, solved by the banded interior-point method.
+
+:class:`BandedGrid` answers the grid LP's :class:`~.rows.GridSolver` calls:
+a problem whose jerk rows are all free (the first, jerk-free solve) goes to
+the reachability passes (:mod:`.reach`), every other one to the banded
+interior-point method (:mod:`.banded`). The HiGHS LP (:class:`.rows._GridLP`)
+is built only if one of them does not answer (passes that do not settle, an
+interior-point solve that does not converge).
+
+The rows are the LP's own (:func:`~.rows._acc_matrix`,
+:func:`~.rows._jerk_matrix`), laid out per node: ``2 q`` acceleration rows
+of interval ``i`` (its left and its right end, ``q`` components each) centred
+on node ``i``, and ``q`` jerk rows centred on node ``i``; the row bounds come
+in the LP's order and are mapped onto that layout.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from collections.abc import Callable
+
+import numpy as np
+
+from skyquill.coverage.deadline import Deadline
+from skyquill.coverage.speed.active_rows import KEEP, solve_active_rows
+from skyquill.coverage.speed.banded import TOLERANCE, BandedRows, solve_banded_lp
+from skyquill.coverage.speed.reach import AccelerationRows, ReachPass
+from skyquill.coverage.speed.rows import _GridLP, jerk_coefficients
+from skyquill.validation import FloatArray
+
+_log = logging.getLogger(__name__)
+#: Relative gap of the pseudo-jerk iterates (the iteration stops at a change of 1e-3 of
+#: ``sqrt(b)``; the certification LP is solved to :data:`~.banded.TOLERANCE`).
+ROUGH_TOLERANCE = 1e-6
+
+
+def banded_rows(
+    acc: AccelerationRows,
+    derivs: tuple[FloatArray, FloatArray, FloatArray],
+    jmax: FloatArray,
+    scale: FloatArray,
+) -> BandedRows:
+    """The grid LP's rows (acceleration, then pseudo-jerk) in the per-node layout.
+
+    Parameters
+    ----------
+    acc : AccelerationRows
+        The acceleration rows, ``2 q`` per interval.
+    derivs : tuple of ndarray, shape (n, q)
+        The limited components of ``C'``, ``C''``, ``C'''``.
+    jmax : ndarray, shape (q,)
+        Each component's jerk bound.
+    scale : ndarray, shape (n,)
+        The jerk rows' speed-like reference (as in :func:`~.rows._jerk_matrix`).
+
+    Returns
+    -------
+    BandedRows
+        ``R = 3 q`` rows per node.
+    """
+    n, q = derivs[0].shape
+    rows = 3 * q
+    lower, centre, upper = (np.zeros((rows, n)) for _ in range(3))
+    centre[: 2 * q, :-1] = acc.alpha.T
+    upper[: 2 * q, :-1] = acc.beta.T
+    cm, cc, cp = jerk_coefficients(derivs)
+    factor = np.sqrt(scale[1:-1])[:, None] / jmax
+    lower[2 * q :, 1:-1] = (cm * factor).T
+    centre[2 * q :, 1:-1] = (cc * factor).T
+    upper[2 * q :, 1:-1] = (cp * factor).T
+    return BandedRows(lower=lower, centre=centre, upper=upper)
+
+
+def row_bounds(r: FloatArray, n: int, q: int) -> FloatArray:
+    """The LP's row bounds (acceleration blocks of ``n - 1``, jerk blocks of ``n - 2``) per
+    node, shape (3 q, n); rows that do not exist are free (``inf``)."""
+    out = np.full((3 * q, n), np.inf)
+    acc = 2 * q * (n - 1)
+    out[: 2 * q, :-1] = r[:acc].reshape(2 * q, n - 1)
+    if r.size > acc:
+        out[2 * q :, 1:-1] = r[acc:].reshape(q, n - 2)
+    return out
+
+
+class BandedGrid:
+    """The grid problem behind the LP's interface: passes without jerk, the banded interior
+    point with it, the HiGHS LP for what neither answers.
+
+    Parameters
+    ----------
+    acc : AccelerationRows
+        The acceleration rows (for the passes).
+    rows : BandedRows
+        Every row in the per-node layout.
+    lp : callable
+        Builds the HiGHS grid LP (the fallback).
+    deadline : Deadline, optional
+        Checked before every solve.
+    """
+
+    def __init__(
+        self,
+        acc: AccelerationRows,
+        rows: BandedRows,
+        lp: Callable[[], _GridLP],
+        deadline: Deadline | None,
+    ) -> None:
+        self.passes = ReachPass(acc)
+        self.rows = rows
+        self.q = rows.centre.shape[0] // 3
+        self._build_lp = lp
+        self._lp: _GridLP | None = None
+        self.deadline = deadline
+        self.ipm_time = 0.0
+        self.ipm_solves = 0
+        self.ipm_iterations = 0
+        #: The last interior-point solution: the guess of the rows that bind in the next
+        #: solve (the jerk-free optimum is no guess: it breaks most jerk rows).
+        self._last: FloatArray | None = None
+
+    @property
+    def time(self) -> float:
+        """Wall time of every solve, s."""
+        return self.passes.time + self.ipm_time + (0.0 if self._lp is None else self._lp.time)
+
+    @property
+    def solves(self) -> int:
+        """Problems solved (passes, interior point, LP)."""
+        lp = 0 if self._lp is None else self._lp.solves
+        return self.passes.solves + self.ipm_solves + lp
+
+    @property
+    def used_lp(self) -> bool:
+        """Whether the HiGHS LP had to answer."""
+        return self._lp is not None
+
+    def solve(self, r: FloatArray, ub: FloatArray, *, rough: bool = False) -> FloatArray:
+        """The optimum for the LP's row bounds ``r`` and ``0 <= b <= ub`` (to
+        :data:`ROUGH_TOLERANCE` when ``rough``)."""
+        if self.deadline is not None:
+            self.deadline.check(f"speed solve {self.solves + 1}")
+        n = ub.size
+        bound = row_bounds(r, n, self.q)
+        if not np.any(np.isfinite(bound[2 * self.q :])):
+            b = self.passes.solve(r[: n - 1], ub)
+            if b is not None:
+                return b
+        start = time.perf_counter()
+        tol = ROUGH_TOLERANCE if rough else TOLERANCE
+        if self._last is not None and self.q > KEEP:
+            # A polygon's directions: only the few nearest the vector can bind.
+            sol, solves = solve_active_rows(self.rows, bound, ub, guess=self._last, blocks=3,
+                                            tolerance=tol)  # fmt: skip
+        else:
+            sol, solves = solve_banded_lp(self.rows, bound, ub, np.ones(n), tolerance=tol), 1
+        self.ipm_time += time.perf_counter() - start
+        self.ipm_solves += solves
+        self.ipm_iterations += sol.iterations
+        if sol.status == "optimal":
+            self._last = sol.b
+            return sol.b
+        _log.warning("banded interior point did not converge (%s); HiGHS answers", sol.status)
+        if self._lp is None:
+            self._lp = self._build_lp()
+        return self._lp.solve(r, ub)
