@@ -350,7 +350,20 @@ def uniform_design(degree: int, n_ctrl: int, order: int, n_samples: int) -> sp.c
     sparse product.
     """
     basis = basis_for(degree, n_ctrl)
-    return basis.design_matrix(np.linspace(0.0, basis.n_spans, n_samples), order)
+    basis._check_order(order)
+    local = _uniform_local(degree, n_ctrl, n_samples)
+    return basis.rows(local.first, local.values[order])
+
+
+@lru_cache(maxsize=4)
+def _uniform_local(degree: int, n_ctrl: int, n_samples: int) -> LocalBasis:
+    """The nonzero basis functions and every derivative at ``n_samples`` uniform ``s``.
+
+    One evaluation for all orders: the dense check asks for velocity, acceleration
+    and jerk of the same basis, and the span powers and classes are most of the cost.
+    """
+    basis = basis_for(degree, n_ctrl)
+    return basis.local_values(np.linspace(0.0, basis.n_spans, n_samples), degree)
 
 
 @lru_cache(maxsize=64)
