@@ -393,19 +393,25 @@ def uniform_design(degree: int, n_ctrl: int, order: int, n_samples: int) -> sp.c
     """
     basis = basis_for(degree, n_ctrl)
     basis._check_order(order)
-    local = _uniform_local(degree, n_ctrl, n_samples)
+    local = _uniform_local(degree, n_ctrl, n_samples, max(order, min(_DENSE_ORDERS, degree)))
     return basis.rows(local.first, local.values[order])
 
 
-@lru_cache(maxsize=4)
-def _uniform_local(degree: int, n_ctrl: int, n_samples: int) -> LocalBasis:
-    """The nonzero basis functions and every derivative at ``n_samples`` uniform ``s``.
+#: Derivatives the dense check asks for together (velocity, acceleration, jerk).
+_DENSE_ORDERS = 3
 
-    One evaluation for all orders: the dense check asks for velocity, acceleration
-    and jerk of the same basis, and the span powers and classes are most of the cost.
+
+@lru_cache(maxsize=4)
+def _uniform_local(degree: int, n_ctrl: int, n_samples: int, max_order: int) -> LocalBasis:
+    """The nonzero basis functions and their derivatives up to ``max_order`` at
+    ``n_samples`` uniform ``s``.
+
+    One evaluation for the orders of the dense check: it asks for velocity,
+    acceleration and jerk of the same basis, and the span powers and classes are
+    most of the cost.
     """
     basis = basis_for(degree, n_ctrl)
-    return basis.local_values(np.linspace(0.0, basis.n_spans, n_samples), degree)
+    return basis.local_values(np.linspace(0.0, basis.n_spans, n_samples), max_order)
 
 
 @lru_cache(maxsize=64)
