@@ -75,7 +75,8 @@ def _by_table(p: FloatArray, v: FloatArray) -> FloatArray:
     """
     a, ab = v[:-1], v[1:] - v[:-1]
     length2 = np.einsum("sd,sd->s", ab, ab)
-    inverse = 1.0 / np.where(length2 > 0.0, length2, 1.0)
+    # Divided, not multiplied by a reciprocal: 1 / a subnormal squared length overflows.
+    divisor = np.where(length2 > 0.0, length2, 1.0)
     rows = max(1, _TABLE_CHUNK // a.shape[0])
     best = np.empty(p.shape[0])
     for start in range(0, p.shape[0], rows):
@@ -84,7 +85,7 @@ def _by_table(p: FloatArray, v: FloatArray) -> FloatArray:
         s = q[0] * ab[:, 0]
         for i in range(1, p.shape[1]):
             s += q[i] * ab[:, i]
-        s *= inverse
+        s /= divisor
         np.clip(s, 0.0, 1.0, out=s)
         gap2 = (q[0] - s * ab[:, 0]) ** 2
         for i in range(1, p.shape[1]):
