@@ -29,3 +29,13 @@ def test_seed_accepts_non_negative_integers() -> None:
 def test_seed_refuses_with_a_named_message(value: object, message: str) -> None:
     with pytest.raises(InputError, match=f"^{message.replace('*', '[*]')}$"):
         as_seed("seed", value)
+
+
+def test_known_keys_names_the_table_and_the_unknown_key() -> None:
+    from skyquill.validation import known_keys
+
+    assert known_keys({"a": 1}, "[t]", ("a", "b")) == {"a": 1}
+    with pytest.raises(InputError, match=r"^\[t\]: got unknown key 'c', expected one of a, b$"):
+        known_keys({"a": 1, "c": 2}, "[t]", ("a", "b"))
+    with pytest.raises(InputError, match=r"^\[t\]: got list, expected a table$"):
+        known_keys([1], "[t]", ("a",))

@@ -147,3 +147,21 @@ def as_seed(name: str, value: Any) -> int:
     if seed > MAX_SEED:
         raise InputError(f"{name}: got {seed}, expected an integer from 0 to 2**64 - 1")
     return seed
+
+
+def known_keys(table: Any, where: str, keys: tuple[str, ...]) -> dict[str, Any]:
+    """``table`` (a parsed TOML or JSON table) when every key of it is in ``keys``.
+
+    Raises
+    ------
+    InputError
+        ``table`` is not a table, or it holds a key not in ``keys`` (named with
+        ``where``, the table's place in the file, and the keys expected): a typo in
+        an optional key would otherwise be ignored silently.
+    """
+    if not isinstance(table, dict):
+        raise InputError(f"{where}: got {type(table).__name__}, expected a table")
+    for key in table:
+        if key not in keys:
+            raise InputError(f"{where}: got unknown key {key!r}, expected one of {', '.join(keys)}")
+    return table

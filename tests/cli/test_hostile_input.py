@@ -444,7 +444,7 @@ WALL_CASES = [
     ("turned middle", THREE_SEGMENTS.replace("angle = 0", "angle = 5"), "holding x = 0"),
     ("not toml", "[[segment", "malformed TOML"),
     ("binary", bytes(range(256)), "not UTF-8"),
-    ("unknown key", "colour = 1\n" + THREE_SEGMENTS, "wall.colour"),
+    ("unknown key", "colour = 1\n" + THREE_SEGMENTS, "wall: got unknown key 'colour'"),
     ("two shapes", "[cylinder]\nradius = 20\n[recess]\nfrom = 1\nto = 2\ndepth = 0.1\n",
      "exactly one"),
     ("tight cylinder", "[cylinder]\nradius = 2\n", "cylinder.radius"),

@@ -100,7 +100,7 @@ def test_read_wall_names_the_file(tmp_path: Path) -> None:
         ("[[segment]]\nfrom = -1e9\nto = 1\nangle = 0\n", r"expected a number within 1e6"),
         (
             "[[segment]]\nfrom = -1\nto = 1\nangle = 0\nslope = 3\n",
-            r"segment\[0\].slope: got an unknown key",
+            r"segment\[0\]: got unknown key 'slope'",
         ),
         ("[cylinder]\nradius = 3\n", r"cylinder.radius: got 3 m, expected \|radius\| > 4.62 m"),
         ("[cylinder]\nradius = 0\n", r"cylinder.radius: got 0 m"),
@@ -134,7 +134,7 @@ def test_read_wall_names_the_file(tmp_path: Path) -> None:
         ("extent = [-4, 4]\n" + THREE, r"extent: got it with \[\[segment\]\]"),
         ("[[segment\n", r"wall: got malformed TOML"),
         ("segment = 3\n", r"\[\[segment\]\]: got none, expected a list"),
-        ("[wall]\nangles = [0]\n", r"wall.wall: got an unknown key"),
+        ("[wall]\nangles = [0]\n", r"wall: got unknown key 'wall'"),
     ],
 )
 def test_not_a_wall(text: str, message: str) -> None:

@@ -108,3 +108,23 @@ def test_a_spent_time_limit_is_a_status(backend: str) -> None:
     lp = LinearProgram(a, -rng.uniform(0.5, 1.5, 1500), backend=backend, time_limit_s=1e-6)
     lp.update_bounds(row_lower=-np.ones(3000), row_upper=np.ones(3000))
     assert lp.solve().status == "time_limit"
+
+
+@pytest.mark.skipif(not highspy_available(), reason="highspy is not installed")
+def test_the_first_highs_model_prints_nothing_on_stdout() -> None:
+    # HiGHS prints its banner once per process, at the first instance's first call:
+    # only a fresh interpreter shows whether it reaches stdout (it did, in `cover`).
+    import subprocess
+    import sys
+
+    script = (
+        "import numpy as np, scipy.sparse as sp\n"
+        "from skyquill.solvers.lp import LinearProgram\n"
+        "lp = LinearProgram(sp.csr_array(np.eye(2)), [-1.0, -1.0], backend='highspy')\n"
+        "lp.update_bounds(row_lower=np.zeros(2), row_upper=np.ones(2))\n"
+        "lp.solve()\n"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", script], capture_output=True, text=True, timeout=120, check=True
+    )
+    assert done.stdout == ""

@@ -47,6 +47,7 @@ import numpy as np
 
 from skyquill.errors import InputError
 from skyquill.painting.wall import MAX_WALL_ANGLE_DEG, Wall
+from skyquill.validation import known_keys
 
 #: Largest wall file read, bytes (a wall of 1,000 segments is ~60 kB).
 MAX_BYTES = 200_000
@@ -83,7 +84,7 @@ def parse_wall(text: str) -> Wall:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise InputError(f"wall: got malformed TOML ({exc}), expected TOML") from None
-    _known(data, "wall", ("height", "extent", *KINDS))
+    known_keys(data, "wall", ("height", "extent", *KINDS))
     kinds = [k for k in KINDS if k in data]
     if len(kinds) != 1:
         raise InputError(
@@ -101,13 +102,13 @@ def parse_wall(text: str) -> Wall:
         return _segments(data["segment"], height)
     extent = _extent(data.get("extent", [-4.0, 4.0]))
     if kinds[0] == "cylinder":
-        table = _known(data["cylinder"], "cylinder", ("radius",))
+        table = known_keys(data["cylinder"], "cylinder", ("radius",))
         radius = _number("cylinder.radius", table.get("radius"))
         try:
             return Wall.cylinder(radius, x_range_m=extent, height_m=height)
         except InputError as exc:
             raise InputError(f"cylinder.radius: {str(exc).split(': ', 1)[1]}") from None
-    table = _known(data["recess"], "recess", ("from", "to", "depth", "side_angle"))
+    table = known_keys(data["recess"], "recess", ("from", "to", "depth", "side_angle"))
     return Wall.recess(
         _number("recess.from", table.get("from")),
         _number("recess.to", table.get("to")),
@@ -129,7 +130,7 @@ def _segments(raw: Any, height: float) -> Wall:
     angles: list[float] = []
     for i, table in enumerate(raw):
         where = f"segment[{i}]"
-        t = _known(table, where, ("from", "to", "angle"))
+        t = known_keys(table, where, ("from", "to", "angle"))
         lo, hi = _number(f"{where}.from", t.get("from")), _number(f"{where}.to", t.get("to"))
         angle = _number(f"{where}.angle", t.get("angle"))
         if abs(angle) > MAX_WALL_ANGLE_DEG:
@@ -182,18 +183,6 @@ def _extent(value: Any) -> tuple[float, float]:
             f"extent: got [{lo:g}, {hi:g}], expected x_min < 0 < x_max, within {MAX_EXTENT_M:g} m"
         )
     return lo, hi
-
-
-def _known(table: Any, where: str, keys: tuple[str, ...]) -> dict[str, Any]:
-    """``table`` as a dict whose keys are all in ``keys``; InputError naming an unknown one."""
-    if not isinstance(table, dict):
-        raise InputError(f"{where}: got {type(table).__name__}, expected a table")
-    for key in table:
-        if key not in keys:
-            raise InputError(
-                f"{where}.{key}: got an unknown key, expected one of {', '.join(keys)}"
-            )
-    return table
 
 
 def _number(where: str, value: Any, *, positive: bool = False) -> float:

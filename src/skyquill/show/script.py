@@ -22,7 +22,7 @@ from skyquill.io.numbers import EXPECTED, is_literal
 from skyquill.io.source import read_text
 from skyquill.limits import VehicleLimits
 from skyquill.show.geofence import Geofence, read_geofence
-from skyquill.validation import FloatArray, as_array, as_float, as_int
+from skyquill.validation import FloatArray, as_array, as_float, as_int, known_keys
 
 RGB = tuple[int, int, int]
 #: Most drones in one show. The separation proof looks only at neighbours (sweep and
@@ -147,17 +147,6 @@ class ShowScript:
     geofence: Geofence | None = None
 
 
-def _known(table: Any, where: str, known: tuple[str, ...]) -> dict[str, Any]:
-    if not isinstance(table, dict):
-        raise InputError(f"{where}: got {type(table).__name__}, expected a table")
-    for key in table:
-        if key not in known:
-            raise InputError(
-                f"{where}: got unknown key {key!r}, expected one of {', '.join(known)}"
-            )
-    return table
-
-
 def _color(where: str, value: Any) -> RGB:
     """``[r, g, b]`` or ``"#rrggbb"``."""
     if isinstance(value, str):
@@ -191,7 +180,7 @@ def _text(where: str, value: Any) -> str:
 
 
 def _takeoff(t: dict[str, Any], where: str) -> Takeoff:
-    _known(t, where, ("type", "altitude", "stagger"))
+    known_keys(t, where, ("type", "altitude", "stagger"))
     return Takeoff(
         _at_most(f"{where}.altitude", t.get("altitude", 3.0), MAX_ALTITUDE_M, "m"),
         _number(f"{where}.stagger", t.get("stagger", 1.0), positive=False),
@@ -199,7 +188,7 @@ def _takeoff(t: dict[str, Any], where: str) -> Takeoff:
 
 
 def _land(t: dict[str, Any], where: str) -> Land:
-    _known(t, where, ("type", "altitude", "stagger"))
+    known_keys(t, where, ("type", "altitude", "stagger"))
     return Land(
         _at_most(f"{where}.altitude", t.get("altitude", 3.0), MAX_ALTITUDE_M, "m"),
         _number(f"{where}.stagger", t.get("stagger", 1.0), positive=False),
@@ -207,7 +196,7 @@ def _land(t: dict[str, Any], where: str) -> Land:
 
 
 def _hold(t: dict[str, Any], where: str) -> Hold:
-    _known(t, where, ("type", "duration", "color"))
+    known_keys(t, where, ("type", "duration", "color"))
     color = t.get("color")
     return Hold(
         _number(f"{where}.duration", t.get("duration", 1.0)),
@@ -222,7 +211,7 @@ FORMATION_KEYS = (
 
 
 def _formation(t: dict[str, Any], where: str, base: Path) -> FormationScene:
-    _known(t, where, FORMATION_KEYS)
+    known_keys(t, where, FORMATION_KEYS)
     shape = t.get("shape")
     if not isinstance(shape, str) or shape not in SHAPES:
         raise InputError(f"{where}.shape: got {shape!r}, expected one of {', '.join(SHAPES)}")
@@ -250,7 +239,7 @@ def _formation(t: dict[str, Any], where: str, base: Path) -> FormationScene:
 
 
 def _write(t: dict[str, Any], where: str) -> WriteScene:
-    _known(t, where, ("type", "text", "color", "origin", "size", "drones", "columns", "font"))
+    known_keys(t, where, ("type", "text", "color", "origin", "size", "drones", "columns", "font"))
     if "origin" not in t:
         raise InputError(f"{where}: got no 'origin', expected [x, y, z] in m (first board)")
     drones = t.get("drones")
@@ -315,9 +304,9 @@ def parse_script(text: str, base: Path = Path()) -> ShowScript:
         raise InputError(f"show script: got the number {exc}, expected {EXPECTED}") from None
     except tomllib.TOMLDecodeError as exc:
         raise InputError(f"show script: got malformed TOML ({exc}), expected TOML") from None
-    _known(data, "show script", ("show", "limits", "scene"))
-    show = _known(data.get("show", {}), "[show]", SHOW_KEYS)
-    limits = _known(data.get("limits", {}), "[limits]", ("vmax", "amax", "jmax"))
+    known_keys(data, "show script", ("show", "limits", "scene"))
+    show = known_keys(data.get("show", {}), "[show]", SHOW_KEYS)
+    limits = known_keys(data.get("limits", {}), "[limits]", ("vmax", "amax", "jmax"))
     raw = data.get("scene", [])
     if not isinstance(raw, list) or not raw:
         raise InputError("[[scene]]: got none, expected a list of scenes, takeoff first")

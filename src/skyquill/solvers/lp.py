@@ -66,6 +66,20 @@ __all__ = [
 ]
 
 
+def _quiet_highs() -> Any:
+    """A HiGHS instance that has printed nothing.
+
+    ``highspy.Highs()`` enables its Python callbacks in its constructor, a HiGHS
+    call that prints the "Running HiGHS" banner on stdout before ``output_flag``
+    can be cleared (ERGO-Code/HiGHS#1702, #2749): it landed in the middle of
+    ``skyquill cover``'s output. The binding's base class has every method this
+    backend calls and no callbacks to enable.
+    """
+    core = getattr(_highspy, "_core", None)
+    plain = getattr(core, "_Highs", None)
+    return plain() if plain is not None else _highspy.Highs()  # type: ignore[no-untyped-call]
+
+
 def highspy_available() -> bool:
     """Whether the hot-starting highspy backend is installed."""
     return _highspy is not None
@@ -268,7 +282,7 @@ class _HighsModel:
         model.a_matrix_.start_ = csc.indptr
         model.a_matrix_.index_ = csc.indices
         model.a_matrix_.value_ = csc.data
-        self.highs: Any = _highspy.Highs()  # type: ignore[no-untyped-call]
+        self.highs: Any = _quiet_highs()
         self.highs.setOptionValue("output_flag", False)
         self.highs.setOptionValue("presolve", "off")
         self.highs.passModel(model)
