@@ -101,6 +101,9 @@ def plan_char(char: str) -> dict[str, Any]:
         "strokes": len(medians.paths),
         "points": medians.n_points,
     }
+    # Every BLAS loaded so far on one thread (threadpoolctl limits only the libraries
+    # loaded when it is called; scipy's own comes with the first plan). Not timed.
+    threadpool_limits(limits=1)
     start, cpu = time.perf_counter(), time.process_time()
     try:
         show = plan_show([typed_strokes(char)], cli_options(), **cli_show_kwargs())

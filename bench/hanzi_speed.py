@@ -66,6 +66,9 @@ def plan(char):
             "deviation_m": mission.deviation.max_m, "faithful": mission.faithful}
 
 plan("\u4e2d")  # warm-up: imports, caches
+# Again now that the planner has loaded every BLAS it uses (scipy's own among them):
+# threadpoolctl limits only the libraries loaded when it is called.
+threadpool_limits(limits=1)
 print("ready", flush=True)
 for line in sys.stdin:
     char = line.strip()

@@ -54,3 +54,14 @@ def test_memory_grows_with_the_points_and_segments_not_their_product() -> None:
     finally:
         tracemalloc.stop()
     assert peak < 100 * 2**20  # the table would take 30,000 x 60,000 x 16 B = 29 GB
+
+
+def test_the_k_d_tree_and_the_table_agree_above_and_below_the_switch() -> None:
+    """Many pairs go through the k-d tree, few through the table: the same distances."""
+    rng = np.random.default_rng(5)
+    v = np.cumsum(rng.normal(size=(120, 2)), axis=0)
+    p = v[rng.integers(0, 120, 1_000)] + rng.normal(size=(1_000, 2))  # 119,000 pairs
+    many = polyline_distance(p, v)
+    few = np.concatenate([polyline_distance(p[i : i + 50], v) for i in range(0, 1_000, 50)])
+    np.testing.assert_allclose(many, _table(p, v), rtol=1e-9, atol=1e-9)
+    np.testing.assert_allclose(few, _table(p, v), rtol=1e-9, atol=1e-9)

@@ -192,6 +192,22 @@ def test_gram_matches_quadrature(k: int, M: int) -> None:
         assert float(np.linalg.eigvalsh(V).min()) >= -1e-10 * scale
 
 
+@pytest.mark.parametrize(("k", "M"), [(k, m) for k in DEGREES for m in (4 * k + 3, 6 * k + 7)])
+def test_grams_of_a_large_basis_extended_from_the_reference_match_quadrature(
+    k: int, M: int
+) -> None:
+    """Above reference_ctrl(k) control points the Gram matrices are extended from the
+    reference basis's: the same as quadrature, and V_n = Γ_n' W_n Γ_n still holds."""
+    basis = ClampedUniformBasis(k, M)
+    for n in range(k + 1):
+        V = basis.gram(n).toarray()
+        scale = float(np.abs(V).max())
+        np.testing.assert_allclose(V, _gram_reference(k, M, n), rtol=0, atol=1e-10 * scale)
+        D = basis.derivative_map(n).toarray()
+        W = basis.reduced_gram(n).toarray()
+        np.testing.assert_allclose(D.T @ W @ D, V, rtol=0, atol=1e-10 * scale)
+
+
 @pytest.mark.parametrize("k", DEGREES)
 def test_gram_of_order_zero_sums_to_length(k: int) -> None:
     """Σ_ij V0_ij = ∫ (Σ_i N_i)^2 = L (partition of unity)."""

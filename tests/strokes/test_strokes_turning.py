@@ -164,3 +164,23 @@ def test_works_on_scaled_strokes_in_metres() -> None:
     path = s.scaled(2.0).paths[0]  # 100 units -> 2 m, the bump is 2 cm
     np.testing.assert_array_equal(turning_points(path, 0.05), [0, 2, 3])
     np.testing.assert_array_equal(turning_points(path, 0.01), [0, 1, 2, 3])
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    stroke=arrays(
+        np.float64,
+        st.tuples(st.integers(2, 64), st.just(2)),
+        elements=st.floats(-10.0, 10.0, allow_nan=False, allow_infinity=False),
+    ),
+    threshold=st.floats(1e-3, 5.0),
+)
+def test_short_strokes_in_python_match_the_vectorised_sweep(
+    stroke: np.ndarray, threshold: float
+) -> None:
+    """Strokes of at most 64 points are simplified point by point in Python: the same
+    turning points as the vectorised split and merge every longer stroke goes through."""
+    from skyquill.strokes.turning import _merge, _split
+
+    vectorised = _merge(stroke, _split(stroke, threshold), threshold)
+    np.testing.assert_array_equal(turning_points(stroke, threshold), vectorised)

@@ -108,9 +108,16 @@ def swung_tip(traj: Trajectory, t: FloatArray, brush_length_m: float) -> FloatAr
     ``P`` is the planned (untilted) tip, ``b3`` the thrust direction the
     acceleration demands, ``(a + g e_z) / |a + g e_z|``.
     """
-    thrust = traj.evaluate(t, 2) + np.array([0.0, 0.0, GRAVITY])
+    return swung_tip_of(traj.evaluate(t), traj.evaluate(t, 2), brush_length_m)
+
+
+def swung_tip_of(
+    position: FloatArray, acceleration: FloatArray, brush_length_m: float
+) -> FloatArray:
+    """:func:`swung_tip` from the planned tip's positions and accelerations (N, 3)."""
+    thrust = acceleration + np.array([0.0, 0.0, GRAVITY])
     b3 = thrust / np.linalg.norm(thrust, axis=1, keepdims=True)
-    return np.asarray(traj.evaluate(t) + brush_length_m * (np.array([0.0, 0.0, 1.0]) - b3))
+    return np.asarray(position + brush_length_m * (np.array([0.0, 0.0, 1.0]) - b3))
 
 
 def planned_ink(
@@ -203,16 +210,16 @@ def measure_deviation(
     distances (lifting off the board counts), or with ``plane`` distances in
     that board's plane (the ink's view: a pressed tip is not off the stroke).
     """
-    paths, strokes = [], []
-    for (t0, t1), stroke in zip(windows, strokes_world, strict=True):
-        t = np.linspace(t0, t1, samples_per_stroke)
-        path = swung_tip(traj, t, brush_length_m) if brush_length_m else traj.evaluate(t)
-        if plane is None:
-            paths.append(path)
-            strokes.append(stroke)
-        else:
-            paths.append(plane.to_board(path)[:, :2])
-            strokes.append(plane.to_board(stroke)[:, :2])
+    if not windows:
+        return _two_sided([], [])
+    # Every stroke's samples in one evaluation (one spline call per derivative, not per stroke).
+    t = np.concatenate([np.linspace(t0, t1, samples_per_stroke) for t0, t1 in windows])
+    path = swung_tip(traj, t, brush_length_m) if brush_length_m else traj.evaluate(t)
+    strokes = list(strokes_world)
+    if plane is not None:
+        path = plane.to_board(path)[:, :2]
+        strokes = [plane.to_board(stroke)[:, :2] for stroke in strokes]
+    paths = np.split(path, np.arange(1, len(windows)) * samples_per_stroke)
     return _two_sided(paths, strokes)
 
 

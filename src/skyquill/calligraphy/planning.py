@@ -23,7 +23,7 @@ from skyquill.calligraphy.fidelity import (
     Deviation,
     measure_deviation,
     planned_ink,
-    swung_tip,
+    swung_tip_of,
 )
 from skyquill.calligraphy.options import WritingOptions
 from skyquill.calligraphy.problem import route_problem
@@ -218,8 +218,9 @@ def _press(samples: RouteSamples, board: Board, opts: WritingOptions) -> FloatAr
 
 def _model_error(traj: Trajectory, t: FloatArray, gain: FloatArray, length: float) -> FloatArray:
     """The swung tip minus its first-order model ``P + c a`` at times ``t`` (N, 3), m."""
-    model = traj.evaluate(t) + gain * traj.evaluate(t, 2)
-    return np.asarray(swung_tip(traj, t, length) - model)
+    position, acceleration = traj.evaluate(t), traj.evaluate(t, 2)
+    model = position + gain * acceleration
+    return np.asarray(swung_tip_of(position, acceleration, length) - model)
 
 
 def _measured(

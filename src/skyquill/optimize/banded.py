@@ -108,15 +108,20 @@ def banded_closed_form(
         rows = np.concatenate(
             [_rows(problem, t, local, axes[0]) for t, local in zip(terms, locals_, strict=True)]
         )
-        band = smooth + _gram_band(first, rows, weights, M)
         F[:, axes] = -2.0 * _transpose_times(first, rows * weights[:, None], points[:, axes], M)
-        factor, info = scipy.linalg.lapack.dpbtrf(band, lower=0)
-        if info != 0:
-            return None  # not positive definite: the KKT route decides
-        pivots = factor[-1] ** 2
-        if not pivots.min() >= MIN_PIVOT_RATIO * pivots.max():
-            return None  # (nearly) singular: only the equalities determine the point
-        solved = _solve(factor, F[:, axes], E, fixed.e[:, axes])
+        # The factor depends on the rows and weights, not on the points: the same for
+        # every solve at these times (a writing plan's polish passes change the points).
+        gains = tuple(_gain(t, axes[0]) for t in terms)
+        hessian = _Hessian(smooth, first, rows, weights, E)
+        factored = cache.kept(
+            "banded factor",
+            (fixed, smooth, *locals_),
+            (problem.alpha, tuple(t.weight for t in terms), gains),
+            hessian.factored,
+        )
+        if factored is None:
+            return None  # not (safely) positive definite: the KKT route decides
+        solved = _solve(factored, F[:, axes], E, fixed.e[:, axes])
         if solved is None:
             return None
         C[:, axes], Y[:, axes] = solved
@@ -162,23 +167,66 @@ def stationarity_residual(
     return float(np.linalg.norm(stationarity)) / size
 
 
-def _solve(
-    factor: FloatArray, F: FloatArray, E: FloatArray, e: FloatArray
-) -> tuple[FloatArray, FloatArray] | None:
-    """``C`` (M, g) and ``Y`` (m, g) of ``min C'GC + F'C s.t. E C = e`` from ``G = U'U``."""
-    m = E.shape[0]
-    W, info = scipy.linalg.lapack.dpbtrs(factor, np.hstack([F, E.T]), lower=0)
+@dataclass(frozen=True)
+class _Factored:
+    """A Hessian's banded Cholesky factor ``G = U'U`` (upper band storage) and the
+    equalities' parts that depend only on it: ``W_E = (2G)^-1 E'`` (M, m) and the
+    Schur complement ``S = E W_E`` (m, m)."""
+
+    factor: FloatArray
+    W_E: FloatArray
+    S: FloatArray
+
+
+@dataclass(frozen=True)
+class _Hessian:
+    """What a group of axes' Hessian band is summed from (:func:`_gram_band`)."""
+
+    smooth: FloatArray
+    first: NDArray[np.intp]
+    rows: FloatArray
+    weights: FloatArray
+    E: FloatArray
+
+    def factored(self) -> _Factored | None:
+        """:func:`_factor` of the smoothness band plus the points' rows."""
+        M = self.smooth.shape[1]
+        return _factor(self.smooth + _gram_band(self.first, self.rows, self.weights, M), self.E)
+
+
+def _factor(band: FloatArray, E: FloatArray) -> _Factored | None:
+    """:class:`_Factored` of the Hessian ``band``; ``None`` when it is not positive
+    definite, or so nearly singular that only the equalities determine the point."""
+    factor, info = scipy.linalg.lapack.dpbtrf(band, lower=0)
     if info != 0:
         return None
-    W_F, W_E = 0.5 * W[:, : F.shape[1]], 0.5 * W[:, F.shape[1] :]  # (2G)^-1 F, (2G)^-1 E'
-    if m == 0:
+    pivots = factor[-1] ** 2
+    if not pivots.min() >= MIN_PIVOT_RATIO * pivots.max():
+        return None
+    if E.shape[0] == 0:
+        return _Factored(factor, np.zeros((band.shape[1], 0)), np.zeros((0, 0)))
+    W, info = scipy.linalg.lapack.dpbtrs(factor, E.T, lower=0)
+    if info != 0:
+        return None
+    W_E = 0.5 * W
+    return _Factored(factor, W_E, E @ W_E)
+
+
+def _solve(
+    factored: _Factored, F: FloatArray, E: FloatArray, e: FloatArray
+) -> tuple[FloatArray, FloatArray] | None:
+    """``C`` (M, g) and ``Y`` (m, g) of ``min C'GC + F'C s.t. E C = e`` from ``G = U'U``."""
+    W, info = scipy.linalg.lapack.dpbtrs(factored.factor, F, lower=0)
+    if info != 0:
+        return None
+    W_F = 0.5 * W  # (2G)^-1 F
+    if E.shape[0] == 0:
         return -W_F, np.zeros((0, F.shape[1]))
-    S = E @ W_E
     try:
-        Y = np.linalg.solve(S, -e - E @ W_F)
+        Y = np.linalg.solve(factored.S, -e - E @ W_F)
     except np.linalg.LinAlgError:
         return None  # dependent equality rows: the KKT route drops them
-    return -(W_F + W_E @ Y), np.asarray(Y, dtype=float)
+    return -(W_F + factored.W_E @ Y), np.asarray(Y, dtype=float)
 
 
 def _axis_groups(terms: list[PointDeviation], d: int) -> list[list[int]]:
@@ -190,11 +238,16 @@ def _axis_groups(terms: list[PointDeviation], d: int) -> list[list[int]]:
     return list(groups.values())
 
 
+def _gain(term: PointDeviation, axis: int) -> float:
+    """The term's acceleration gain on ``axis`` (0 without one), s^2."""
+    return 0.0 if term.accel_gain is None else float(term.accel_gain[axis])
+
+
 def _rows(
     problem: SmoothingProblem, term: PointDeviation, local: LocalBasis, axis: int
 ) -> FloatArray:
     """The term's nonzero row entries on ``axis`` (N, k + 1): ``B + c alpha^2 B''``."""
-    gain = 0.0 if term.accel_gain is None else float(term.accel_gain[axis])
+    gain = _gain(term, axis)
     if gain == 0.0:
         return np.asarray(local.values[0])
     return np.asarray(local.values[0] + gain * problem.alpha**2 * local.values[2])

@@ -9,6 +9,7 @@ the merge that gives the method its name is added here as in [2].
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
@@ -132,8 +133,64 @@ def turning_points(stroke: Any, threshold: float) -> IndexArray:
         raise InputError(f"stroke: got {pts.shape[0]} point(s), expected at least 2")
     threshold = as_float("threshold", threshold, positive=True)
 
+    if pts.shape[0] <= _SHORT:
+        return _short_turning_points(pts, threshold)
     ends = _split(pts, threshold)
     return _merge(pts, ends, threshold)
+
+
+#: Strokes of at most this many points are simplified point by point in plain Python
+#: (:func:`_short_turning_points`): a character's strokes have 5-20 points, where the
+#: vectorised sweep's array operations (a few microseconds each, dozens per level) cost
+#: ~10x the arithmetic itself.
+_SHORT = 64
+
+
+def _short_turning_points(pts: FloatArray, threshold: float) -> IndexArray:
+    """:func:`_split` then :func:`_merge` of a short stroke, on Python floats.
+
+    The same rules and the same arithmetic per distance as
+    :func:`segment_distances_pairwise` (``proj / denom`` clipped to [0, 1], then the
+    hypotenuse of the gap); the farthest point of an interval is its first one at the
+    maximum, as ``np.argmax``; the set of split points does not depend on the order
+    the intervals are visited in.
+    """
+    xy = pts.tolist()
+
+    def distances(i: int, j: int) -> list[float]:
+        (ax, ay), (bx, by) = xy[i], xy[j]
+        abx, aby = bx - ax, by - ay
+        denom = abx * abx + aby * aby
+        out = []
+        for px, py in xy[i + 1 : j]:
+            apx, apy = px - ax, py - ay
+            s = min(max((apx * abx + apy * aby) / denom, 0.0), 1.0) if denom > 0.0 else 0.0
+            out.append(math.hypot(apx - s * abx, apy - s * aby))
+        return out
+
+    last = len(xy) - 1
+    keep = {0, last}
+    stack = [(0, last)]
+    while stack:
+        i, j = stack.pop()
+        if j - i < 2:
+            continue
+        d = distances(i, j)
+        far = max(d)
+        if far > threshold:
+            k = i + 1 + d.index(far)
+            keep.add(k)
+            stack += [(i, k), (k, j)]
+    ends = sorted(keep)
+    if len(ends) <= 2:
+        return np.asarray(ends, dtype=np.intp)
+    merged, pending = [ends[0]], ends[1]
+    for nxt in ends[2:]:
+        if max(distances(merged[-1], nxt), default=0.0) > threshold:
+            merged.append(pending)
+        pending = nxt
+    merged.append(pending)
+    return np.asarray(merged, dtype=np.intp)
 
 
 #: Intervals with at least this many inner points are searched one by one on
