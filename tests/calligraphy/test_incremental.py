@@ -164,3 +164,21 @@ def test_a_flight_split_into_uploads_is_refused() -> None:
     split = plan_writing(head, Board(), dataclasses.replace(OPTIONS, target=CRAZYFLIE))
     with pytest.raises(InputError, match="mission: got a flight split into uploads"):
         append_stroke(split, rest[0])
+
+
+def test_a_join_rounded_past_the_flights_last_break_keeps_every_piece() -> None:
+    """The join at a flight's end can round a few ulps past its last break (L / alpha):
+    every piece of the flight is kept, the last one ending at the join (中 from a hover
+    met it after a change of rounding elsewhere)."""
+    from skyquill.calligraphy.incremental import _concatenated
+    from skyquill.trajectory import SplineTrajectory
+
+    rng = np.random.default_rng(4)
+    before = SplineTrajectory(rng.normal(size=(12, 3)), 5, 1.3)
+    after = SplineTrajectory(rng.normal(size=(9, 3)), 5, 0.7)
+    last = float(before.breakpoints[-1])
+    join = float(np.nextafter(np.nextafter(last, np.inf), np.inf))
+    joined = _concatenated(before, join, after)
+    assert joined.coeffs.shape[0] == 7 + 4  # every piece of both
+    t = np.linspace(0.0, 0.999 * last, 50)
+    np.testing.assert_allclose(joined.evaluate(t), before.evaluate(t), rtol=0, atol=1e-9)

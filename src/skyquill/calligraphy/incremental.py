@@ -251,8 +251,10 @@ def _pieces(traj: Trajectory) -> tuple[FloatArray, FloatArray]:
 def _concatenated(before: Trajectory, join: float, after: SplineTrajectory) -> PiecewisePolynomial:
     """``before`` on ``[0, join]``, then ``after`` from ``join``: exact pieces of both."""
     breaks, coeffs = _pieces(before)
-    # The pieces that start before the join; the last one is cut there.
-    keep = int(np.searchsorted(breaks, join, side="left"))
+    # The pieces that start before the join; the last one is cut there. A join at the
+    # flight's end can round a few ulps past its last break (the breaks are L / alpha):
+    # then every piece is kept, the last one ending at the join.
+    keep = min(int(np.searchsorted(breaks, join, side="left")), coeffs.shape[0])
     head_breaks = np.concatenate([breaks[:keep], [join]])
     tail_breaks, tail_coeffs = after.to_piecewise_polynomial()
     return PiecewisePolynomial(
