@@ -14,7 +14,6 @@ import os
 import signal
 import subprocess
 import sys
-import time
 import warnings
 from pathlib import Path
 
@@ -53,24 +52,41 @@ def test_ctrl_c_inside_a_command_is_one_line_and_130(monkeypatch: pytest.MonkeyP
 def test_ctrl_c_while_the_program_starts_is_one_line_and_130(tmp_path: Path) -> None:
     """Issue 25: Ctrl+C in the first 0.6 s (the imports) printed a traceback.
 
-    The signal is sent once the interpreter itself has started (twice the time a bare
-    ``python -c pass`` takes here): before that no Python code of anyone's runs.
+    The child says when it has imported the console script's entry module, just before
+    ``run()`` imports the program; the signal then lands in those imports (they take most
+    of a second), whatever the load.
+    (A fixed delay did not: under load a ``fit`` ended before it.)
     """
-    clock = time.perf_counter()
-    subprocess.run([sys.executable, "-c", "pass"], check=True)
-    delay_s = 2.0 * (time.perf_counter() - clock)
+    # As the console script starts: import the small entry module, then run().
+    start = "import sys; from skyquill.cli.entry import run; sys.stderr.write('started\\n'); "
     child = subprocess.Popen(
-        [sys.executable, "-c", "from skyquill.cli.entry import run; run()", "fit", SPIRAL,
-         "--out", str(tmp_path / "o")],
+        [sys.executable, "-c", start + "sys.stderr.flush(); run()", "fit",
+         SPIRAL, "--out", str(tmp_path / "o")],
         stderr=subprocess.PIPE,
         stdout=subprocess.DEVNULL,
     )  # fmt: skip
-    time.sleep(delay_s)
+    assert child.stderr is not None
+    assert child.stderr.readline() == b"started\n"
     child.send_signal(signal.SIGINT)
     _, err = child.communicate(timeout=110)
     text = err.decode()
     assert child.returncode == 130, text
     assert "Traceback" not in text and "interrupted by Ctrl+C" in _one_line(text)
+
+
+def test_ctrl_c_while_the_options_are_read_is_one_line_and_130(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # Typer itself turned this moment (it imports pydantic then) into a silent status 130.
+    from typer._click.core import Command
+
+    def interrupted(*_: object) -> None:
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(Command, "parse_args", interrupted)
+    result = runner.invoke(app, ["fit", SPIRAL, "--out", "unused"])
+    assert result.exit_code == 130
+    assert "interrupted by Ctrl+C" in _one_line(result.output)
 
 
 def test_warnings_before_an_error_are_not_printed(monkeypatch: pytest.MonkeyPatch) -> None:

@@ -216,6 +216,15 @@ class OneLineGroup(TyperGroup):
             sys.exit(code)
         return code
 
+    def make_context(self, *args: Any, **extra: Any) -> Any:
+        # Typer turns Ctrl+C while it reads the top-level options (it imports pydantic
+        # then) into a silent exit status 130: say the line here, as invoke does.
+        try:
+            return super().make_context(*args, **extra)
+        except KeyboardInterrupt:
+            error_line(INTERRUPTED_LINE)
+            raise typer.Exit(INTERRUPTED) from None
+
     def invoke(self, ctx: Any) -> Any:
         try:
             return super().invoke(ctx)
