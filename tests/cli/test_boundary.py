@@ -14,6 +14,7 @@ import os
 import signal
 import subprocess
 import sys
+import time
 import warnings
 from pathlib import Path
 
@@ -54,11 +55,16 @@ def test_ctrl_c_while_the_program_starts_is_one_line_and_130(tmp_path: Path) -> 
 
     The child says when it has imported the console script's entry module, just before
     ``run()`` imports the program; the signal then lands in those imports (they take most
-    of a second), whatever the load.
-    (A fixed delay did not: under load a ``fit`` ended before it.)
+    of a second), whatever the load (a delay from the child's start did not: under load a
+    ``fit`` ended before it).
     """
-    # As the console script starts: import the small entry module, then run().
-    start = "import sys; from skyquill.cli.entry import run; sys.stderr.write('started\\n'); "
+    # As the console script starts from a shell: Ctrl+C raises KeyboardInterrupt (a
+    # pytest-xdist worker ignores SIGINT, and its children inherit that: the signal was
+    # lost and the fit finished), the small entry module imported, then run().
+    start = (
+        "import signal, sys; signal.signal(signal.SIGINT, signal.default_int_handler); "
+        "from skyquill.cli.entry import run; sys.stderr.write('started\\n'); "
+    )
     child = subprocess.Popen(
         [sys.executable, "-c", start + "sys.stderr.flush(); run()", "fit",
          SPIRAL, "--out", str(tmp_path / "o")],
@@ -67,6 +73,7 @@ def test_ctrl_c_while_the_program_starts_is_one_line_and_130(tmp_path: Path) -> 
     )  # fmt: skip
     assert child.stderr is not None
     assert child.stderr.readline() == b"started\n"
+    time.sleep(0.2)  # past the few instructions before run(); its imports take over 0.5 s
     child.send_signal(signal.SIGINT)
     _, err = child.communicate(timeout=110)
     text = err.decode()
