@@ -371,10 +371,8 @@ def _whole_windows(  # noqa: PLR0917 - private: the slices of one chunk
     closest: _Closest,
 ) -> _Intervals:
     """One interval per candidate window of ``pair``, bounded (ends and midpoint recorded)."""
-    i, j = pairs[0][pair], pairs[1][pair]
     a, b = t[window * WINDOW], t[window * WINDOW + lengths]
-    da = np.linalg.norm(fleet.position(i, a) - fleet.position(j, a), axis=1)
-    db = np.linalg.norm(fleet.position(i, b) - fleet.position(j, b), axis=1)
+    da, db = _end_distances(fleet, pairs, pair, (a, b))
     closest.record(pair, a, da)
     closest.record(pair, b, db)
     return _bounded(fleet, pairs, pair, (a, b), (da, db), closest)
@@ -394,11 +392,22 @@ def _window_intervals(
     pair = np.repeat(pair, lengths)
     offsets = np.arange(lengths.sum()) - np.repeat(np.cumsum(lengths) - lengths, lengths)
     k = np.repeat(window * WINDOW, lengths) + offsets
+    ends = (t[k], t[k + 1])
+    return _bounded(fleet, pairs, pair, ends, _end_distances(fleet, pairs, pair, ends), closest)
+
+
+def _end_distances(
+    fleet: Fleet,
+    pairs: tuple[IntArray, IntArray],
+    pair: IntArray,
+    ends: tuple[FloatArray, FloatArray],
+) -> tuple[FloatArray, FloatArray]:
+    """The distances of the pairs ``pair`` at the times ``ends`` (each (P,), s), m."""
     i, j = pairs[0][pair], pairs[1][pair]
-    a, b = t[k], t[k + 1]
+    a, b = ends
     da = np.linalg.norm(fleet.position(i, a) - fleet.position(j, a), axis=1)
     db = np.linalg.norm(fleet.position(i, b) - fleet.position(j, b), axis=1)
-    return _bounded(fleet, pairs, pair, (a, b), (da, db), closest)
+    return da, db
 
 
 def _bounded(  # noqa: PLR0917 - private: one interval's every part
