@@ -14,10 +14,9 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from scipy import sparse
-from scipy.interpolate import BSpline, make_interp_spline
+from scipy.interpolate import BSpline
+from speed_curves import square_spiral, wiggle
 
-from skyquill.coverage.paths import contours, spiral_control_points, spiral_curve
-from skyquill.coverage.regions import region_from_vertices
 from skyquill.coverage.speed import plan_speed
 from skyquill.coverage.speed.active_rows import solve_active_rows
 from skyquill.coverage.speed.banded import BandedRows, solve_banded_lp
@@ -40,17 +39,6 @@ from skyquill.validation import FloatArray
 
 #: Relative gap of the interior point's objective to HiGHS's optimum (solved to 1e-9).
 OBJECTIVE_RTOL = 1e-7
-
-
-def _spiral() -> BSpline:
-    square = region_from_vertices([[0, 0], [10, 0], [10, 10], [0, 10]])
-    curve: BSpline = spiral_curve(spiral_control_points(contours(square, 2.0, "offset"), 1.0))
-    return curve
-
-
-def _wiggle(points: list[tuple[float, float]]) -> BSpline:
-    xy = np.cumsum(np.asarray(points, dtype=float), axis=0)
-    return make_interp_spline(np.linspace(0.0, 1.0, len(xy)), xy, k=4)
 
 
 #: One pseudo-jerk LP: the LP's sparse matrix, its row bounds, the column bounds, and the
@@ -103,14 +91,14 @@ def _check_against_highs(lp: PseudoJerkLP) -> None:
 def test_the_interior_point_equals_highs_on_the_spirals_pseudo_jerk_lp(
     sides: int | None, shrink: float
 ) -> None:
-    _check_against_highs(_pseudo_jerk_lp(_spiral(), 500, (3.0, 5.0, 3.0), sides, shrink))
+    _check_against_highs(_pseudo_jerk_lp(square_spiral(), 500, (3.0, 5.0, 3.0), sides, shrink))
 
 
 @pytest.mark.parametrize("guess", ["free", "zero"])
 def test_the_rows_that_bind_give_the_whole_lps_optimum(guess: str) -> None:
     # A guess far from the answer (the jerk-free optimum breaks most jerk rows; zero picks
     # rows at random): broken rows are added until none is, or the whole LP is solved.
-    lp = _pseudo_jerk_lp(_spiral(), 500, (3.0, 5.0, 3.0), 16, 0.8)
+    lp = _pseudo_jerk_lp(square_spiral(), 500, (3.0, 5.0, 3.0), 16, 0.8)
     _, r, ub, rows = lp
     start = ub if guess == "free" else np.zeros_like(ub)
     got, solves = solve_active_rows(rows, row_bounds(r, ub.size, 8), ub, guess=start, blocks=3,
@@ -137,7 +125,7 @@ def test_random_pseudo_jerk_lps_equal_highs(
     sides: int | None,
     shrink: float,
 ) -> None:
-    curve = _wiggle([(0.0, 0.0), *points])
+    curve = wiggle([(0.0, 0.0), *points])
     try:
         lp = _pseudo_jerk_lp(curve, 300, limits, sides, shrink)
     except InputError:  # a path with a cusp
@@ -156,7 +144,7 @@ PATHS = {
 @pytest.mark.parametrize("sides", [None, 16])
 @pytest.mark.parametrize("path", ["spiral", *PATHS])
 def test_banded_plans_equal_the_lps(path: str, sides: int | None) -> None:
-    curve = _spiral() if path == "spiral" else _wiggle(PATHS[path])
+    curve = square_spiral() if path == "spiral" else wiggle(PATHS[path])
     kw = {"n": 500, "norm_sides": sides}
     banded = plan_speed(curve, 3.0, 5.0, 3.0, method="banded", **kw)
     lp = plan_speed(curve, 3.0, 5.0, 3.0, method="lp", **kw)
@@ -167,10 +155,10 @@ def test_banded_plans_equal_the_lps(path: str, sides: int | None) -> None:
 
 
 def test_auto_takes_the_banded_method_on_fine_grids_with_a_jerk_limit() -> None:
-    assert plan_speed(_spiral(), 3.0, 5.0, 3.0, n=300).method == "lp"
+    assert plan_speed(square_spiral(), 3.0, 5.0, 3.0, n=300).method == "lp"
     assert _validate_method("auto", jerk=True, n=BANDED_FROM_POINTS - 1) == "lp"
     assert _validate_method("auto", jerk=True, n=BANDED_FROM_POINTS) == "banded"
-    assert plan_speed(_spiral(), 3.0, 5.0, None, n=300, method="banded").method == "reach"
+    assert plan_speed(square_spiral(), 3.0, 5.0, None, n=300, method="banded").method == "reach"
 
 
 #: How much longer a looser jerk-limited plan may be: the pseudo-jerk iteration stops at
@@ -188,6 +176,6 @@ def test_looser_limits_never_give_a_longer_jerk_limited_flight(
     looser: tuple[float, float, float], limits: tuple[float, float, float], sides: int | None
 ) -> None:
     kw = {"n": 300, "norm_sides": sides, "max_excess": None, "method": "banded"}
-    tight = plan_speed(_spiral(), *limits, **kw)
-    loose = plan_speed(_spiral(), *(x * k for x, k in zip(limits, looser, strict=True)), **kw)
+    tight = plan_speed(square_spiral(), *limits, **kw)
+    loose = plan_speed(square_spiral(), *(x * k for x, k in zip(limits, looser, strict=True)), **kw)
     assert loose.duration <= tight.duration * (1.0 + LOOSER_RTOL)

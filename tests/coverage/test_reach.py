@@ -12,10 +12,9 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-from scipy.interpolate import BSpline, make_interp_spline
+from scipy.interpolate import BSpline
+from speed_curves import square_spiral, wiggle
 
-from skyquill.coverage.paths import contours, spiral_control_points, spiral_curve
-from skyquill.coverage.regions import region_from_vertices
 from skyquill.coverage.speed import plan_speed
 from skyquill.coverage.speed.curve import _derivs3
 from skyquill.coverage.speed.norms import component_limits, components
@@ -29,21 +28,10 @@ from skyquill.errors import InputError
 DURATION_RTOL = 3e-4
 
 
-def _spiral() -> BSpline:
-    square = region_from_vertices([[0, 0], [10, 0], [10, 10], [0, 10]])
-    curve: BSpline = spiral_curve(spiral_control_points(contours(square, 2.0, "offset"), 1.0))
-    return curve
-
-
-def _wiggle(points: list[tuple[float, float]]) -> BSpline:
-    xy = np.cumsum(np.asarray(points, dtype=float), axis=0)
-    return make_interp_spline(np.linspace(0.0, 1.0, len(xy)), xy, k=4)
-
-
 @pytest.mark.parametrize("norm_sides", [None, 16])
 @pytest.mark.parametrize("vmax", [3.0, 100.0])
 def test_durations_equal_the_lps(norm_sides: int | None, vmax: float) -> None:
-    curve = _spiral()
+    curve = square_spiral()
     kw = {"n": 2000, "norm_sides": norm_sides, "max_excess": None}
     reach = plan_speed(curve, vmax, 5.0, None, method="reach", **kw)
     lp = plan_speed(curve, vmax, 5.0, None, method="lp", **kw)
@@ -69,7 +57,7 @@ def _rows_hold(curve: BSpline, n: int, vmax: float, amax: float, sides: int | No
 
 def test_the_passes_hold_every_row_of_the_lp() -> None:
     for sides in (None, 8, 16):
-        _rows_hold(_spiral(), 3000, 3.0, 5.0, sides)
+        _rows_hold(square_spiral(), 3000, 3.0, 5.0, sides)
 
 
 steps = st.tuples(st.floats(-3.0, 3.0), st.floats(-3.0, 3.0)).filter(
@@ -87,7 +75,7 @@ steps = st.tuples(st.floats(-3.0, 3.0), st.floats(-3.0, 3.0)).filter(
 def test_random_paths_feasible_and_as_fast_as_the_lp(
     points: list[tuple[float, float]], vmax: float, amax: float, sides: int | None
 ) -> None:
-    curve = _wiggle([(0.0, 0.0), *points])
+    curve = wiggle([(0.0, 0.0), *points])
     try:
         fast = plan_speed(curve, vmax, amax, None, n=400, norm_sides=sides, max_excess=None)
     except InputError:  # a path with a cusp: refused by both
@@ -113,7 +101,7 @@ def test_random_paths_feasible_and_as_fast_as_the_lp(
 def test_looser_limits_never_give_a_longer_flight(
     looser_v: float, looser_a: float, vmax: float, amax: float, sides: int | None
 ) -> None:
-    curve = _spiral()
+    curve = square_spiral()
     kw = {"n": 600, "norm_sides": sides, "max_excess": None}
     tight = plan_speed(curve, vmax, amax, None, **kw)
     loose = plan_speed(curve, vmax * looser_v, amax * looser_a, None, **kw)
@@ -122,13 +110,13 @@ def test_looser_limits_never_give_a_longer_flight(
 
 
 def test_a_jerk_free_plan_verifies_within_two_percent() -> None:
-    plan = plan_speed(_spiral(), 3.0, 5.0, None, n=2000, norm_sides=16)
+    plan = plan_speed(square_spiral(), 3.0, 5.0, None, n=2000, norm_sides=16)
     assert plan.method == "reach"
     assert plan.verify(2.0).max_excess <= 0.02
 
 
 def test_reach_with_a_jerk_limit_is_refused() -> None:
     with pytest.raises(InputError, match="method: got 'reach' with a jerk limit"):
-        plan_speed(_spiral(), 3.0, 5.0, 3.0, method="reach")
+        plan_speed(square_spiral(), 3.0, 5.0, 3.0, method="reach")
     with pytest.raises(InputError, match="method: got 'fast'"):
-        plan_speed(_spiral(), 3.0, 5.0, None, method="fast")
+        plan_speed(square_spiral(), 3.0, 5.0, None, method="fast")

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from scipy.interpolate import BSpline, CubicSpline, make_interp_spline
+from speed_curves import square_spiral
 
 from skyquill.coverage.speed import SpeedPlan, plan_speed
 from skyquill.errors import InputError
@@ -195,18 +196,10 @@ def test_matches_toppra_without_jerk() -> None:
     assert plan.duration == pytest.approx(float(traj.duration), rel=1e-3)  # measured ~4e-6
 
 
-def _square_spiral(delta: float) -> BSpline:
-    from skyquill.coverage.paths import contours, spiral_control_points, spiral_curve
-    from skyquill.coverage.regions import region_from_vertices
-
-    square = region_from_vertices([[0, 0], [10, 0], [10, 10], [0, 10]])
-    return spiral_curve(spiral_control_points(contours(square, 2.0, "offset"), delta))
-
-
 def test_square_spiral_within_two_percent() -> None:
     # The issue's case (paper limits). Before the local refinement: jerk excess
     # 0.82 (n=500), 0.34 (n=1000); now 0.012 at n=1000 (uniform grid).
-    plan = plan_speed(_square_spiral(1.0), 3.0, 5.0, 3.0, n=1000)
+    plan = plan_speed(square_spiral(1.0), 3.0, 5.0, 3.0, n=1000)
     ver = plan.verify()
     assert ver.max_excess <= 0.02, ver
     assert plan.excess_estimate <= 0.02
@@ -216,23 +209,23 @@ def test_square_spiral_within_two_percent() -> None:
     assert ctrl <= 0.02, ctrl
 
 
-def test_adaptive_grid_on_square_spiral() -> None:
+def test_adaptive_grid_onsquare_spiral() -> None:
     # Opt-in grid: 30.51 s at excess 0.004 (uniform: 30.69 s at 0.012).
-    plan = plan_speed(_square_spiral(1.0), 3.0, 5.0, 3.0, n=1000, grid="adaptive")
+    plan = plan_speed(square_spiral(1.0), 3.0, 5.0, 3.0, n=1000, grid="adaptive")
     ver = plan.verify()
     assert ver.max_excess <= 0.02, ver
     assert plan.grid == "adaptive"
     assert 30.0 < plan.duration < 30.9
     # Reported in the caller's parameter: u increasing on [0, 1], v = sqrt(b) |C'(u)|.
     assert plan.u[0] == 0.0 and plan.u[-1] == 1.0 and np.all(np.diff(plan.u) > 0.0)
-    speed = np.sqrt(plan.b) * np.linalg.norm(_square_spiral(1.0)(plan.u, 1), axis=1)
+    speed = np.sqrt(plan.b) * np.linalg.norm(square_spiral(1.0)(plan.u, 1), axis=1)
     assert np.max(speed) <= 3.0 * (1.0 + 1e-6)
     sp = plan.setpoints()
-    assert np.allclose(sp.p, _square_spiral(1.0)(sp.u), atol=1e-9)
+    assert np.allclose(sp.p, square_spiral(1.0)(sp.u), atol=1e-9)
 
 
 def test_refinement_lowers_excess_locally() -> None:
-    curve = _square_spiral(1.0)
+    curve = square_spiral(1.0)
     base = plan_speed(curve, 3.0, 5.0, 3.0, n=500, grid="uniform", max_excess=None)
     refined = plan_speed(curve, 3.0, 5.0, 3.0, n=500, grid="uniform", max_excess=0.02)
     assert base.refinements == 0 and refined.refinements >= 1
@@ -304,14 +297,14 @@ def test_norm_limits_on_a_circle(jmax: float | None) -> None:
 
 
 def test_norm_limits_on_a_coverage_spiral() -> None:
-    plan = plan_speed(_square_spiral(1.0), 3.0, 5.0, 3.0, n=1000, norm_sides=16)
+    plan = plan_speed(square_spiral(1.0), 3.0, 5.0, 3.0, n=1000, norm_sides=16)
     acc, jerk = _dense_norms(plan, 5.0, 3.0)
     assert acc <= 1.0 + 0.02 and jerk <= 1.0 + 0.02
     assert plan.excess_estimate <= 0.02
     assert plan.verify().max_excess <= 0.02
     assert jerk > 0.95  # the jerk norm binds
     # Per axis (as before): the same 30.69 s plan, whose jerk norm exceeds jmax.
-    box = plan_speed(_square_spiral(1.0), 3.0, 5.0, 3.0, n=1000)
+    box = plan_speed(square_spiral(1.0), 3.0, 5.0, 3.0, n=1000)
     assert 30.0 < box.duration < 31.0 < plan.duration
     assert _dense_norms(box, 5.0, 3.0)[1] > 1.2
 
