@@ -19,6 +19,7 @@ import warnings
 from pathlib import Path
 
 import pytest
+from typer._click.core import Command
 from typer.testing import CliRunner
 
 from skyquill.cli import check_cmd, fit_cmd
@@ -39,11 +40,23 @@ def _one_line(text: str) -> str:
     return lines[0]
 
 
-def test_ctrl_c_inside_a_command_is_one_line_and_130(monkeypatch: pytest.MonkeyPatch) -> None:
+@pytest.mark.parametrize(
+    ("owner", "name"),
+    [
+        (fit_cmd, "read_points_csv"),  # inside the command
+        # While the options are read: typer itself turned this moment (it imports pydantic
+        # then) into a silent status 130.
+        (Command, "parse_args"),
+    ],
+    ids=["inside a command", "while the options are read"],
+)
+def test_ctrl_c_is_one_line_and_130(
+    monkeypatch: pytest.MonkeyPatch, owner: object, name: str
+) -> None:
     def interrupted(*_: object) -> None:
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(fit_cmd, "read_points_csv", interrupted)
+    monkeypatch.setattr(owner, name, interrupted)
     result = runner.invoke(app, ["fit", SPIRAL, "--out", "unused"])
     assert result.exit_code == 130
     assert "interrupted by Ctrl+C" in _one_line(result.output)
@@ -79,21 +92,6 @@ def test_ctrl_c_while_the_program_starts_is_one_line_and_130(tmp_path: Path) -> 
     text = err.decode()
     assert child.returncode == 130, text
     assert "Traceback" not in text and "interrupted by Ctrl+C" in _one_line(text)
-
-
-def test_ctrl_c_while_the_options_are_read_is_one_line_and_130(
-    monkeypatch: pytest.MonkeyPatch,
-) -> None:
-    # Typer itself turned this moment (it imports pydantic then) into a silent status 130.
-    from typer._click.core import Command
-
-    def interrupted(*_: object) -> None:
-        raise KeyboardInterrupt
-
-    monkeypatch.setattr(Command, "parse_args", interrupted)
-    result = runner.invoke(app, ["fit", SPIRAL, "--out", "unused"])
-    assert result.exit_code == 130
-    assert "interrupted by Ctrl+C" in _one_line(result.output)
 
 
 def test_warnings_before_an_error_are_not_printed(monkeypatch: pytest.MonkeyPatch) -> None:
