@@ -176,6 +176,45 @@ class _Search:
         return None
 
 
+@dataclass
+class _Steps:
+    """The direction and first trial step of each line search (``step_rule``)."""
+
+    rule: str
+    #: The next line search's first trial step (0: :meth:`_Search.line_search` guesses).
+    trial: float = 0.0
+    #: ``"lbfgs"``: the last steps ``s`` and gradient changes ``y`` with ``s'y > 0``.
+    pairs: list[tuple[FloatArray, FloatArray]] = field(default_factory=list)
+
+    def direction(self, search: _Search, g: FloatArray) -> FloatArray | None:
+        """The search direction at gradient ``g`` (``None``: along ``-g``)."""
+        if self.rule != "lbfgs" or not self.pairs:
+            return None
+        direction = search.project(-_two_loop(g, self.pairs))
+        if not float(g @ direction) < 0.0:  # not a descent direction: the gradient's
+            self.pairs = []
+            return None
+        self.trial = 1.0  # the quasi-Newton step
+        return direction
+
+    def update(self, s_k: FloatArray, y_k: FloatArray, step: float, rejected: int) -> None:
+        """After a step ``s_k`` (the line search's ``step`` along its direction) that
+        changed the gradient by ``y_k``, with ``rejected`` trial points on the way."""
+        self.trial = 2.0 * step
+        curvature = float(s_k @ y_k)
+        if self.rule == "lbfgs":
+            if curvature > 1e-12 * float(np.linalg.norm(s_k) * np.linalg.norm(y_k)):
+                self.pairs = [*self.pairs, (s_k, y_k)][-LBFGS_MEMORY:]
+        elif self.rule == "bb":
+            if curvature > 0.0:
+                self.trial = float(s_k @ s_k) / curvature
+            if rejected:
+                # Where the feasible (or limit-free) region, not the curvature, held
+                # the step, Barzilai-Borwein overshoots it again: 5-11 rejected solves
+                # per step on a writing route (职). Twice the step that was taken.
+                self.trial = min(self.trial, 2.0 * step)
+
+
 def _start(search: _Search, t: FloatArray, initial: FitResult | None) -> tuple[_Search, FitResult]:
     """``search`` with its control-point count, and the solve at the initial times ``t``.
 
@@ -342,22 +381,15 @@ def resegment(
     g = search.gradient(t, res)
     history, durations = [F], [float(t[-1])]
     status: Status = "max_iter"
-    trial = 0.0
-    pairs: list[tuple[FloatArray, FloatArray]] = []
+    steps = _Steps(step_rule)
     while True:
         if float(np.max(np.abs(T * g), initial=0.0)) <= tol * abs(F):
             status = "converged"
             break
         if len(history) > max_iter:
             break
-        direction = None
-        if step_rule == "lbfgs" and pairs:
-            direction = search.project(-_two_loop(g, pairs))
-            if not float(g @ direction) < 0.0:  # not a descent direction: the gradient's
-                direction, pairs = None, []
-            else:
-                trial = 1.0  # the quasi-Newton step
-        found = search.line_search(T, F, g, trial, direction)
+        direction = steps.direction(search, g)
+        found = search.line_search(T, F, g, steps.trial, direction)
         if found is None:
             status = "stalled"
             break
@@ -367,21 +399,7 @@ def resegment(
         history.append(F)
         durations.append(float(t[-1]))
         g = search.gradient(t, res)
-        trial = 2.0 * step
-        if step_rule == "lbfgs":
-            s_k, y_k = T - T_old, g - g_old
-            if float(s_k @ y_k) > 1e-12 * float(np.linalg.norm(s_k) * np.linalg.norm(y_k)):
-                pairs = [*pairs, (s_k, y_k)][-LBFGS_MEMORY:]
-        if step_rule == "bb":
-            s_k, y_k = T - T_old, g - g_old
-            curvature = float(s_k @ y_k)
-            if curvature > 0.0:
-                trial = float(s_k @ s_k) / curvature
-            if search.rejected:
-                # Where the feasible (or limit-free) region, not the curvature, held
-                # the step, Barzilai-Borwein overshoots it again: 5-11 rejected solves
-                # per step on a writing route (职). Twice the step that was taken.
-                trial = min(trial, 2.0 * step)
+        steps.update(T - T_old, g - g_old, step, search.rejected)
         if decrease <= ftol * abs(F):
             status = "converged"
             break
