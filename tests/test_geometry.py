@@ -1,4 +1,4 @@
-"""polyline_distance: exact (against the table of every point and segment), in linear memory."""
+"""polyline_distance(s): exact (against the table of every point and segment), in linear memory."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
-from skyquill.geometry import polyline_distance
+from skyquill.geometry import polyline_distance, polyline_distances
 
 
 def _table(p: np.ndarray, v: np.ndarray) -> np.ndarray:
@@ -32,6 +32,27 @@ coords = st.floats(-100.0, 100.0, allow_nan=False, allow_infinity=False)
 )
 def test_the_distance_is_the_nearest_segments(v: np.ndarray, p: np.ndarray) -> None:
     np.testing.assert_allclose(polyline_distance(p, v), _table(p, v), rtol=1e-9, atol=1e-9)
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    sizes=st.lists(st.tuples(st.integers(0, 40), st.integers(2, 30)), min_size=0, max_size=8),
+    seed=st.integers(0, 2**16),
+    dim=st.sampled_from([2, 3]),
+)
+def test_many_pairs_at_once_are_each_pairs_distance_bit_for_bit(
+    sizes: list[tuple[int, int]], seed: int, dim: int
+) -> None:
+    rng = np.random.default_rng(seed)
+    pairs = [(rng.normal(size=(n, dim)), rng.normal(size=(v, dim))) for n, v in sizes]
+    # A repeated vertex (a zero-length segment) and one pair above the table's size.
+    if pairs:
+        pairs[0][1][1] = pairs[0][1][0]
+    pairs.append((rng.normal(size=(300, dim)), rng.normal(size=(120, dim))))
+    joint = polyline_distances(pairs)
+    assert len(joint) == len(pairs)
+    for (p, v), d in zip(pairs, joint, strict=True):
+        assert np.array_equal(d, polyline_distance(p, v))
 
 
 def test_three_dimensions_repeated_vertices_and_a_long_segment() -> None:
