@@ -5,10 +5,12 @@ from __future__ import annotations
 import tracemalloc
 
 import numpy as np
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
+from skyquill.errors import InputError
 from skyquill.geometry import polyline_distance, polyline_distances
 
 
@@ -86,3 +88,15 @@ def test_the_k_d_tree_and_the_table_agree_above_and_below_the_switch() -> None:
     few = np.concatenate([polyline_distance(p[i : i + 50], v) for i in range(0, 1_000, 50)])
     np.testing.assert_allclose(many, _table(p, v), rtol=1e-9, atol=1e-9)
     np.testing.assert_allclose(few, _table(p, v), rtol=1e-9, atol=1e-9)
+
+
+def test_many_pairs_refuse_what_one_pair_refuses() -> None:
+    good = (np.zeros((3, 2)), np.array([[0.0, 0.0], [1.0, 0.0]]))
+    with pytest.raises(InputError, match="points: got 1 NaN"):
+        polyline_distances([good, (np.array([[np.nan, 0.0]]), good[1])])
+    with pytest.raises(InputError, match="vertices: got an array of shape"):
+        polyline_distances([good, (good[0], np.zeros((2, 3)))])
+    with pytest.raises(InputError, match="vertices: got 1 vertex"):
+        polyline_distances([(good[0], np.zeros((1, 2)))])
+    with pytest.raises(InputError, match="pairs: got points of"):
+        polyline_distances([good, (np.zeros((2, 3)), np.zeros((2, 3)))])
