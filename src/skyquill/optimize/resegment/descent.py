@@ -191,8 +191,8 @@ class _Steps:
         if self.rule != "lbfgs" or not self.pairs:
             return None
         direction = search.project(-_two_loop(g, self.pairs))
-        if not float(g @ direction) < 0.0:  # not a descent direction: the gradient's
-            self.pairs = []
+        if not float(g @ direction) < 0.0:  # not a descent direction: the gradient's,
+            self.pairs, self.trial = [], 0.0  # from a fresh first guess (another scale)
             return None
         self.trial = 1.0  # the quasi-Newton step
         return direction
