@@ -424,7 +424,8 @@ def _refusal(
             return UntimeableLegError(
                 i, length, vmax, out.duration, argument="starts, ends", what=f"leg {i},"
             )
-    return SolverError(f"Ruckig failed on a leg of {lengths.min():.3g} m or more: {result}")
+    code = "an error code its Python binding does not know" if result is None else result
+    return SolverError(f"Ruckig failed on a leg of {lengths.min():.3g} m or more: {code}")
 
 
 def _bounds(limits: LegLimits | Sequence[LegLimits], directions: FloatArray) -> FloatArray:
