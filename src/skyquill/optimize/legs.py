@@ -119,7 +119,8 @@ class Legs:
     durations
         Phase durations of every leg in turn, shape (P,), s (zero-length phases dropped).
     coeffs
-        Power-basis coefficients of each phase in its local time, lowest first, (P, 4, d).
+        Power-basis coefficients of each phase in its local time, lowest first, (P, 4, d)
+        (a transposed view of a (4, d, P) array, as it was computed: not C-contiguous).
     leg_durations
         Each leg's duration, shape (K,), s.
     """
@@ -143,8 +144,9 @@ def legs_pieces(
     is what cost 24 us a leg when legs were timed one by one: here the objects are built
     once per thread and block size (:func:`_ruckig`) and reused, and a block of up to
     :data:`BLOCK` legs is one call. What is read back through the Python binding is
-    what dominates the cost, so as little is read as the result needs (:func:`_time_block`);
-    the phases are integrated from Ruckig's durations and jerks (:func:`_states`).
+    what dominates the cost, so as little is read as the result needs: up to
+    :data:`READ_UP_TO` legs their whole profiles (:func:`_read_block`), beyond only the
+    phase durations (:func:`_time_block`), the states integrated here (:func:`_states`).
 
     Parameters
     ----------
