@@ -58,6 +58,30 @@ def test_lbfgs_keeps_frozen_segments_and_converges_in_fewer_steps_than_bb() -> N
     assert short["lbfgs"].cost <= short["bb"].cost
 
 
+@pytest.mark.parametrize(("max_iter", "ftol"), [(4, 1e-10), (300, 1e-3)])
+def test_without_the_final_gradient_the_run_ends_at_the_same_point(
+    max_iter: int, ftol: float
+) -> None:
+    pts, times = spiral(30)
+    make = point_fit_factory(pts, 22)
+    runs = {
+        final: resegment(
+            pts, times, make, max_iter=max_iter, ftol=ftol, step_rule="lbfgs", final_gradient=final
+        )
+        for final in (True, False)
+    }
+    full, lean = runs[True], runs[False]
+    np.testing.assert_array_equal(lean.times, full.times)
+    np.testing.assert_array_equal(lean.history, full.history)
+    np.testing.assert_array_equal(
+        lean.result.trajectory.control_points, full.result.trajectory.control_points
+    )
+    assert lean.status == full.status
+    assert lean.n_solves == full.n_solves
+    assert np.isnan(lean.gradient_norm) and np.isfinite(full.gradient_norm)
+    assert lean.gradient_time_s < full.gradient_time_s
+
+
 def test_free_mode_with_penalty_converges_to_a_finite_time() -> None:
     pts, times = spiral(30)
     make = point_fit_factory(pts, 22)

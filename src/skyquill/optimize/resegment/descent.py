@@ -266,6 +266,7 @@ def resegment(
     workspace: Workspace | None = None,
     interior: bool = False,
     frozen: NDArray[np.bool_] | None = None,
+    final_gradient: bool = True,
 ) -> ResegmentResult:
     """Re-segment the point times by gradient descent (paper 000 §5.4).
 
@@ -335,6 +336,13 @@ def resegment(
         among the others only (in fixed mode their total is kept). A writing
         plan freezes its legs from and to home, timed near the speed limit:
         steps that shortened them were rejected at the limit, two in five.
+    final_gradient
+        ``False``: a run that ends on ``max_iter`` or on the ``ftol`` test does not
+        compute the gradient at its last point, which nothing but the report
+        uses (one gradient of the six to eight a writing plan's run computes):
+        ``gradient_norm`` is then ``nan``, and a run that reaches ``max_iter``
+        reports ``"max_iter"`` without the ``tol`` test at its last point. The
+        times and the solve returned are the same either way.
 
     Returns
     -------
@@ -398,6 +406,11 @@ def resegment(
         decrease, F = F - F_new, F_new
         history.append(F)
         durations.append(float(t[-1]))
+        last = decrease <= ftol * abs(F) or len(history) > max_iter
+        if last and not final_gradient:  # the gradient here would only be reported
+            g = np.full_like(g, np.nan)
+            status = "converged" if decrease <= ftol * abs(F) else "max_iter"
+            break
         g = search.gradient(t, res)
         steps.update(T - T_old, g - g_old, step, search.rejected)
         if decrease <= ftol * abs(F):

@@ -80,7 +80,9 @@ class ResegmentResult:
         below ``ftol``), ``"max_iter"``, or ``"stalled"`` (the line search
         found no decrease: the objective is flat to the solver's accuracy).
     gradient_norm
-        2-norm of the (projected, in fixed mode) gradient in ``T`` at the end.
+        2-norm of the (projected, in fixed mode) gradient in ``T`` at the end;
+        ``nan`` where :func:`resegment` was asked not to compute it
+        (``final_gradient=False``).
     n_solves
         Engine solves, line search included.
     elapsed_s
