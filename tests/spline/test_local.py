@@ -8,7 +8,7 @@ from hypothesis import strategies as st
 from scipy.interpolate import BSpline
 
 from skyquill.spline.basis import clamped_uniform_knots
-from skyquill.spline.local import local_basis, uniform_local_basis
+from skyquill.spline.local import local_basis, rows_times, uniform_local_basis
 
 
 def _reference(degree: int, n_ctrl: int, s: np.ndarray, order: int) -> np.ndarray:
@@ -55,3 +55,33 @@ def test_rows_match_scipy_everywhere(
         for got in (general, uniform):
             err = np.abs(_dense(got.first, got.values[order], n_ctrl) - ref).max()
             assert err <= 1e-10 * scale, (order, err)
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    degree=st.integers(1, 7),
+    extra=st.integers(0, 30),
+    fractions=st.lists(st.floats(0.0, 1.0), min_size=1, max_size=20),
+    dim=st.integers(1, 3),
+    seed=st.integers(0, 2**16),
+)
+def test_rows_times_is_the_design_matrix_times_the_control_points(
+    degree: int, extra: int, fractions: list[float], dim: int, seed: int
+) -> None:
+    """The curve from the local rows is the dense rows times ``C``, for one order and for
+    a stack of orders (the gradient's derivatives 0-3 at once)."""
+    n_ctrl = degree + 1 + extra
+    s = np.array(fractions) * (n_ctrl - degree)
+    basis = uniform_local_basis(degree, n_ctrl - degree, s, degree)
+    C = np.random.default_rng(seed).normal(size=(n_ctrl, dim))
+    stacked = rows_times(basis.first, basis.values, C)
+    assert stacked.shape == (degree + 1, s.size, dim)
+    for order in range(degree + 1):
+        ref = _dense(basis.first, basis.values[order], n_ctrl) @ C
+        scale = max(1.0, float(np.abs(ref).max()))
+        np.testing.assert_allclose(
+            rows_times(basis.first, basis.values[order], C), ref, atol=1e-12 * scale
+        )
+        np.testing.assert_array_equal(
+            stacked[order], rows_times(basis.first, basis.values[order], C)
+        )

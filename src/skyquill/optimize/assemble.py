@@ -36,7 +36,7 @@ from skyquill.optimize.problem import (
     SmoothingProblem,
 )
 from skyquill.spline import HullKind, basis_for
-from skyquill.spline.local import LocalBasis
+from skyquill.spline.local import LocalBasis, rows_times
 from skyquill.validation import FloatArray
 
 
@@ -455,9 +455,7 @@ def curve_at(
     local = cache.local_basis(problem, times) if cache is not None else local_basis(problem, times)
     if order >= local.values.shape[0]:
         return np.asarray(design_matrix(problem, times, order) @ C)
-    width = local.values.shape[2]
-    gathered = C[local.first[:, None] + np.arange(width)]  # (N, k + 1, d)
-    return np.asarray(np.einsum("nr,nrd->nd", local.values[order], gathered))
+    return rows_times(local.first, local.values[order], C)
 
 
 def curves_at(
@@ -468,13 +466,11 @@ def curves_at(
     cache: AssemblyCache | None = None,
 ) -> FloatArray:
     """The ``s``-derivatives ``0 .. orders - 1`` of the curve of ``C`` at ``times``:
-    (orders, N, d), from one gather of the control points (:func:`curve_at`'s)."""
+    (orders, N, d), from the same local basis rows as :func:`curve_at`."""
     local = cache.local_basis(problem, times) if cache is not None else local_basis(problem, times)
     if orders > local.values.shape[0]:
         return np.stack([curve_at(problem, times, C, n, cache) for n in range(orders)])
-    width = local.values.shape[2]
-    gathered = C[local.first[:, None] + np.arange(width)]  # (N, k + 1, d)
-    return np.asarray(np.einsum("onr,nrd->ond", local.values[:orders], gathered))
+    return rows_times(local.first, local.values[:orders], C)
 
 
 def point_model(

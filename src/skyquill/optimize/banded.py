@@ -41,7 +41,7 @@ from numpy.typing import NDArray
 
 from skyquill.optimize.assemble import AssemblyCache, _Fixed, point_model
 from skyquill.optimize.problem import PointDeviation, SmoothingProblem
-from skyquill.spline.local import LocalBasis
+from skyquill.spline.local import LocalBasis, rows_times
 from skyquill.validation import FloatArray
 
 #: Above this many equality rows the Schur complement is not "a few" (interpolated
@@ -289,8 +289,7 @@ def _deviation(
 ) -> float:
     """``sum_n w_n ||R_n C - p_n||^2`` for the rows ``R`` (N, k + 1) at ``first``, the
     points ``P`` (N, g) and the control points ``C`` (M, g)."""
-    gathered = C[first[:, None] + np.arange(rows.shape[1])]  # (N, k + 1, g)
-    residual = np.einsum("nr,nrg->ng", rows, gathered) - points
+    residual = rows_times(first, rows, C) - points
     return float(weights @ np.sum(residual**2, axis=1))
 
 
