@@ -127,7 +127,8 @@ def _positions(term_times: FloatArray, t: FloatArray) -> NDArray[np.intp] | None
     samples, corners and transits differently); its points move with theirs.
     """
     tol = 1e-12 * max(1.0, float(t[-1]))
-    idx = np.clip(np.searchsorted(t, term_times - tol), 0, t.size - 1)
+    # searchsorted's indices are >= 0: only the top needs the bound (np.clip costs ~4x more).
+    idx = np.minimum(np.searchsorted(t, term_times - tol), t.size - 1)
     if term_times.size and bool(np.all(np.abs(t[idx] - term_times) <= tol)):
         return idx
     return None
@@ -152,7 +153,11 @@ def _lagrangian_gradient(
         nonlocal g_alpha
         g_alpha += float(term_times @ g_s)
         idx = _positions(term_times, t)
-        if idx is not None:
+        if idx is None:
+            return
+        if idx.size < 2 or bool(np.all(idx[1:] > idx[:-1])):
+            grad_t[idx] += alpha * g_s  # increasing, so distinct: the same sums as np.add.at
+        else:
             np.add.at(grad_t, idx, alpha * g_s)
 
     if mult is not None:
