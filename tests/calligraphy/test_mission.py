@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import dataclasses
+import itertools
+import math
 import re
 
 import numpy as np
@@ -89,6 +91,29 @@ def test_densify_keeps_vertices_and_spacing() -> None:
     assert np.all(np.linalg.norm(np.diff(dense, axis=0), axis=1) <= 0.01 + 1e-12)
     for v in poly:
         assert np.min(np.linalg.norm(dense - v, axis=1)) < 1e-12
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    steps=st.lists(
+        st.tuples(*[st.floats(-0.05, 0.05, allow_subnormal=False)] * 3), min_size=0, max_size=25
+    ),
+    spacing=st.sampled_from([0.001, 0.01, 0.03]),
+)
+def test_densify_is_each_segment_sampled_alone(
+    steps: list[tuple[float, float, float]], spacing: float
+) -> None:
+    """All segments at once give what sampling each segment alone gives, bit for bit:
+    ``a + (j / n) (b - a)`` on a long segment, its end itself on a short or empty one."""
+    poly = np.cumsum(np.array([(0.0, 0.0, 1.0), *steps]), axis=0)
+    expected = [poly[:1]]
+    for a, b in itertools.pairwise(poly):
+        if np.linalg.norm(b - a) > spacing:
+            n = math.ceil(float(np.linalg.norm(b - a)) / spacing)
+            expected.append(a + np.outer(np.arange(1, n + 1) / n, b - a))
+        else:
+            expected.append(b[None, :])
+    np.testing.assert_array_equal(densify(poly, spacing), np.vstack(expected))
 
 
 def test_wall_board() -> None:

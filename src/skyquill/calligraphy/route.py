@@ -15,6 +15,7 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
+from numpy.typing import NDArray
 
 from skyquill.calligraphy.board import Board
 from skyquill.errors import InputError
@@ -24,6 +25,10 @@ from skyquill.validation import FloatArray
 
 #: Spacing of the samples that hold lifts and transits near their straight lines, m.
 TRANSIT_SPACING_M = 0.01
+#: Up to this many sample-corner pairs a stroke's corners are found by a table of
+#: every pair (a bundled character's strokes: a few thousand), above it by a k-d tree
+#: (memory linear in the samples: one 19,000-point SVG path).
+NEAREST_TABLE_PAIRS = 32_768
 #: Route roles of the samples that are not on a stroke (those carry the stroke's
 #: index): the brush going straight down to a stroke or up from it, and the
 #: moves between, above the board.
@@ -102,10 +107,19 @@ def densify(polyline: FloatArray, spacing: float = TRANSIT_SPACING_M) -> FloatAr
     Sparse input (a straight stroke given by its two ends) would leave the
     spline free between samples; dense samples hold it to the line.
     """
-    out = [polyline[:1]]
-    for a, b in itertools.pairwise(polyline):
-        out.append(_segment(a, b) if np.linalg.norm(b - a) > spacing else b[None, :])
-    return np.vstack(out)
+    a, b = polyline[:-1], polyline[1:]
+    step = b - a
+    length = np.sqrt(np.einsum("sd,sd->s", step, step))
+    long = length > spacing
+    # Every segment at once, as _segment samples one: a + (j / n) (b - a), j = 1 .. n;
+    # a segment no longer than the spacing contributes its end b itself.
+    n = np.where(long, np.ceil(length / spacing), 1.0).astype(np.intp)
+    segment = np.repeat(np.arange(n.size), n)
+    j = np.arange(1, segment.size + 1) - np.repeat(np.cumsum(n) - n, n)
+    inserted = a[segment] + (j / n[segment])[:, None] * step[segment]
+    ends = np.cumsum(n) - 1
+    inserted[ends[~long]] = b[~long]
+    return np.vstack([polyline[:1], inserted])
 
 
 @dataclass
@@ -211,9 +225,12 @@ def _turning_samples(
     """Indices into the route of every stroke's turning points (paper 000 §4).
 
     Densifying keeps the vertices: each corner is found among its stroke's samples
-    as the nearest one (the first of equally near ones) by a k-d tree, in memory
-    linear in the samples -- a table of every sample against every corner took
-    samples x corners x 3 floats, 8 GiB for one 19,000-point SVG path.
+    as the nearest one (the first of equally near ones) -- by a table of every
+    pair up to :data:`NEAREST_TABLE_PAIRS` (a character's strokes: building a
+    k-d tree per stroke cost more than its few hundred samples' table), else by
+    a k-d tree, in memory linear in the samples: a table of every sample against
+    every corner took samples x corners x 3 floats, 8 GiB for one 19,000-point SVG
+    path.
     """
     from scipy.spatial import cKDTree
 
@@ -221,6 +238,9 @@ def _turning_samples(
     for i, stroke in enumerate(strokes_world):
         corners = stroke[turning_points(board.to_board(stroke)[:, :2], threshold)]
         where = np.flatnonzero(roles == i)
+        if where.size * corners.shape[0] <= NEAREST_TABLE_PAIRS:
+            picked.append(where[_nearest_by_table(points[where], corners)])
+            continue
         tree = cKDTree(points[where])
         distance, nearest = tree.query(corners)
         ties = tree.query_ball_point(corners, distance * (1.0 + 1e-12) + 1e-300)
@@ -228,6 +248,15 @@ def _turning_samples(
         first = np.array([min(t) if len(t) else k for t, k in zip(ties, nearest, strict=True)])
         picked.append(where[first.astype(np.intp)])
     return np.concatenate(picked)
+
+
+def _nearest_by_table(samples: FloatArray, corners: FloatArray) -> NDArray[np.intp]:
+    """For each corner (K, 3), the first of the samples (S, 3) nearest to it (as the
+    k-d tree's query with its ties), from the table of every pair (S, K)."""
+    gap = samples[:, None, :] - corners[None, :, :]
+    distance = np.sqrt(np.einsum("skd,skd->sk", gap, gap))
+    tied = distance <= distance.min(axis=0) * (1.0 + 1e-12) + 1e-300
+    return np.asarray(np.argmax(tied, axis=0), dtype=np.intp)
 
 
 def writing_end(roles: FloatArray) -> int:
