@@ -26,9 +26,8 @@ from typing import Any
 
 import numpy as np
 from scipy.interpolate import BSpline, make_interp_spline
-from threadpoolctl import threadpool_limits
 
-from common import jsonable, machine_info
+from common import jsonable, machine_info, one_blas_thread
 from skyquill.coverage.paths import contours, spiral_control_points, spiral_curve
 from skyquill.coverage.regions import region_from_vertices
 from skyquill.coverage.speed import plan_speed
@@ -101,7 +100,7 @@ def terms(curve: BSpline, sides: int | None) -> dict[str, Any]:
 def main() -> int:
     """Run every path per axis and with the 16-gon; write the JSON and print a line each."""
     rows = []
-    with threadpool_limits(limits=1):
+    with one_blas_thread():
         for name, curve in paths().items():
             for sides in (None, 16):
                 row = {"path": name} | terms(curve, sides)
