@@ -26,7 +26,7 @@ from skyquill.cli.pictures import NoPictures, Pictures
 from skyquill.errors import InfeasibleError, InputError
 from skyquill.io.atomic import write_json
 from skyquill.io.outputs import staged_output
-from skyquill.io.plan_dir import trajectory_names, write_plan
+from skyquill.io.plan_dir import trajectory_names, with_phases, write_plan
 from skyquill.io.points import check_rows_written
 from skyquill.io.trajectory_json import PlannedTrajectory
 from skyquill.phases import MIN_ALTITUDE_M
@@ -139,6 +139,11 @@ def _write(
 ) -> dict[str, Any]:
     from skyquill.viz.light_painting import write_pictures
 
+    # Each flight's phases found once, at the floor asked for: the exports and the plan
+    # files all use them (as `skyquill export` reads them back from trajectory.json).
+    clock = time.perf_counter()
+    plan = replace(plan, drones=tuple(with_phases(d, min_altitude_m) for d in plan.drones))
+    stages["phases"] = time.perf_counter() - clock
     plans = _named(plan)
     names = [name for name, _ in plans]
     clock = time.perf_counter()

@@ -99,7 +99,7 @@ def write_plan(
         if p.trajectory.dim != 3:
             raise InputError(f"planned[{i}]: got {p.trajectory.dim} axes, expected 3 (x, y, z)")
     if min_altitude_m is not None:
-        planned = [_with_phases(p, min_altitude_m) for p in planned]
+        planned = [with_phases(p, min_altitude_m) for p in planned]
     out.mkdir(parents=True, exist_ok=True)
     drones = [
         _write_drone(out, names, p, rate, guaranteed)
@@ -123,8 +123,14 @@ def write_plan(
     return full
 
 
-def _with_phases(planned: PlannedTrajectory, min_altitude_m: float) -> PlannedTrajectory:
-    """``planned`` with its phases (found at ``min_altitude_m`` unless it has them)."""
+def with_phases(planned: PlannedTrajectory, min_altitude_m: float) -> PlannedTrajectory:
+    """``planned`` with its phases (found at ``min_altitude_m`` unless it has them).
+
+    Raises
+    ------
+    InfeasibleError
+        A mission that goes below ``min_altitude_m``.
+    """
     if planned.phases is not None:
         return planned
     return replace(planned, phases=flight_phases(planned.trajectory, min_altitude_m))
