@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import time
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Annotated, Any
 
@@ -46,11 +46,17 @@ def show(
     script: Annotated[Path, typer.Argument(metavar="SHOW", help="Show script (TOML).")],
     out: OutDir,
     workers: Annotated[
-        int | None, typer.Option(help="Processes planning the writing (default: CPUs).")
+        int | None,
+        typer.Option(
+            help="Processes planning the writing and the .skyc keyframes (default: CPUs)."
+        ),
     ] = None,
     scheduler: Annotated[
         str | None,
-        typer.Option(help="dask.distributed scheduler address (or 'local') for the writing."),
+        typer.Option(
+            help="dask.distributed scheduler address (or 'local') for the writing and the "
+            ".skyc keyframes."
+        ),
     ] = None,
     min_altitude_m: MinAltitude = MIN_ALTITUDE_M,
     force: Force = False,
@@ -77,7 +83,8 @@ def show(
         stages["check"] = time.perf_counter() - clock
         with staged_output(out, "show", force=force, inputs=[script]) as stage:
             drawn = Pictures(not no_pictures)
-            summary = _write(stage, plan, show_script, report, stages, drawn, floor)
+            where = _Where(workers, scheduler)
+            summary = _write(stage, plan, show_script, report, stages, drawn, floor, where)
     say_done(
         f"{out}: {summary['drones']} drones, {summary['duration_s']:.1f} s, no two closer than "
         f"{summary['min_separation_m']['guaranteed']:.3f} m (guaranteed; "
@@ -85,6 +92,14 @@ def show(
         f"{summary['skyc']['as_played']['verdict']} (skyc.as_played in summary.json), in "
         f"{sum(summary['planning_time_s'].values()):.1f} s"
     )
+
+
+@dataclass(frozen=True)
+class _Where:
+    """Where the per-drone work runs: ``--workers`` processes, or the ``--scheduler``."""
+
+    workers: int | None
+    scheduler: str | None
 
 
 def _plan(script: ShowScript, workers: int | None, scheduler: str | None) -> ShowPlan:
@@ -136,6 +151,7 @@ def _write(
     stages: dict[str, float],
     drawn: Pictures,
     min_altitude_m: float,
+    where: _Where,
 ) -> dict[str, Any]:
     from skyquill.viz.light_painting import write_pictures
 
@@ -147,7 +163,7 @@ def _write(
     plans = _named(plan)
     names = [name for name, _ in plans]
     clock = time.perf_counter()
-    skyc = _skyc(stage, plans, script)
+    skyc = _skyc(stage, plans, script, where)
     stages["skyc"] = time.perf_counter() - clock
     clock = time.perf_counter()
     studio = _studio_csv(stage, plans, script)
@@ -218,7 +234,7 @@ def _studio_csv(
 
 
 def _skyc(
-    stage: Path, plans: list[tuple[str, PlannedTrajectory]], script: ShowScript
+    stage: Path, plans: list[tuple[str, PlannedTrajectory]], script: ShowScript, where: _Where
 ) -> dict[str, Any]:
     """Write ``show.skyc``, load it back as the drones play it and check it again.
 
@@ -233,7 +249,8 @@ def _skyc(
     from skyquill.export.base import ALLOWED_EXCESS, ExportOptions
     from skyquill.export.skybrush.skyc_exporter import SkycExporter
 
-    exported = SkycExporter()(plans, stage / "show", ExportOptions())
+    exporter = SkycExporter(workers=where.workers, scheduler=where.scheduler)
+    exported = exporter(plans, stage / "show", ExportOptions())
     played = load_show([stage / "show.skyc"])
     allowed = max(0.0, script.safety_m - 2.0 * exported.max_error_m)
     limits = replace(check_limits(script), tolerance=ALLOWED_EXCESS[2])

@@ -256,3 +256,25 @@ def test_a_colour_per_stroke_is_in_the_zipped_csv(plans: list[NamedPlan], tmp_pa
     for (a, b), rgb in zip(plan.pen_windows_s, plan.pen_rgb, strict=True):
         rows = drone.colors[(drone.t_ms >= round(a * 1000)) & (drone.t_ms <= round(b * 1000))]
         assert rows.size and np.all(rows == rgb)
+
+
+@pytest.mark.slow
+@pytest.mark.timeout(180)
+def test_keyframes_made_in_worker_processes_or_on_dask_are_the_ones_made_here(
+    plans: list[NamedPlan], tmp_path: Path
+) -> None:
+    """The .skyc of a show whose drones' keyframes are made in a process pool (``skyquill
+    show --workers``) or on a dask cluster (``--scheduler``) is the one made in-process."""
+    from skyquill.export.skybrush.skyc_exporter import SkycExporter
+
+    pytest.importorskip("distributed")
+    here = SkycExporter()(plans, tmp_path / "here.skyc", ExportOptions())
+    for name, exporter in (
+        ("pool", SkycExporter(workers=2)),
+        ("dask", SkycExporter(scheduler="local")),
+    ):
+        there = exporter(plans, tmp_path / f"{name}.skyc", ExportOptions())
+        got, want = read_show_json(there.files[0]), read_show_json(here.files[0])
+        assert got["swarm"] == want["swarm"]
+        assert there.details == here.details
+        assert there.max_error_m == here.max_error_m

@@ -42,7 +42,7 @@ from skyquill.export.skybrush.lights import (
 )
 from skyquill.export.skybrush.pads import on_pads, takeoff_report
 from skyquill.export.skybrush.playback import played_show
-from skyquill.export.skybrush.refit import played_keyframes
+from skyquill.export.skybrush.refit import PlayedKeyframes, played_keyframes
 from skyquill.export.skybrush.skyc_file import (
     SkycDrone,
     read_show_json,
@@ -52,6 +52,7 @@ from skyquill.export.skybrush.skyc_file import (
 )
 from skyquill.export.skybrush.validation import validation_settings
 from skyquill.io.trajectory_json import PlannedTrajectory
+from skyquill.parallel import parallel_map
 
 #: Heading of the show's X+ axis, degrees clockwise from north: skyquill's x is east.
 SHOW_X_HEADING_DEG = 90.0
@@ -64,13 +65,20 @@ class SkycExporter:
     name: str = "skyc"
     suffix: str = ".skyc"
     help: str = "Skybrush show (.skyc), one drone per trajectory, lit while the pen is down"
+    #: Where each drone's keyframes are made (:func:`skyquill.parallel.parallel_map`): in
+    #: this process by default, in ``workers`` processes, or on the dask ``scheduler``.
+    workers: int | None = 1
+    scheduler: str | None = None
 
     def __call__(
         self, plans: Sequence[NamedPlan], out: Path, options: ExportOptions
     ) -> ExportReport:
         """Write the show, read it back as the drones play it, check it against the plans."""
-        plans = [(name, on_pads(plan)) for name, plan in plans]  # as Skybrush expects
-        made = [played_keyframes(name, plan) for name, plan in plans]
+        grounded = parallel_map(
+            _keyframed, list(plans), workers=self.workers, scheduler=self.scheduler
+        )
+        plans = [(name, plan) for (name, _), (plan, _) in zip(plans, grounded, strict=True)]
+        made = [keys for _, keys in grounded]
         drones = [
             SkycDrone(
                 name,
@@ -123,6 +131,13 @@ class SkycExporter:
             details=details,
             delivered=delivered,
         )
+
+
+def _keyframed(named: NamedPlan) -> tuple[PlannedTrajectory, PlayedKeyframes]:
+    """A drone's plan on its pads (as Skybrush expects) and its keyframes, played and checked."""
+    name, plan = named
+    grounded = on_pads(plan)
+    return grounded, played_keyframes(name, grounded)
 
 
 def _location_shift(show: dict[str, Any], frame: GeoFrame) -> float:
