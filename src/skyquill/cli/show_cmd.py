@@ -48,7 +48,8 @@ def show(
     workers: Annotated[
         int | None,
         typer.Option(
-            help="Processes planning the writing and the .skyc keyframes (default: CPUs)."
+            help="Processes planning the writing, the .skyc keyframes and writing the files "
+            "(default: CPUs)."
         ),
     ] = None,
     scheduler: Annotated[
@@ -96,7 +97,8 @@ def show(
 
 @dataclass(frozen=True)
 class _Where:
-    """Where the per-drone work runs: ``--workers`` processes, or the ``--scheduler``."""
+    """Where the per-drone work runs: ``--workers`` processes, or the ``--scheduler``
+    (the writing and the .skyc keyframes; the files are written by local processes)."""
 
     workers: int | None
     scheduler: str | None
@@ -211,6 +213,7 @@ def _write(
         guaranteed=True,
         summary=summary,
         min_altitude_m=min_altitude_m,
+        workers=where.workers,  # the files are written here, never on a remote cluster
     )
     full["planning_time_s"]["files"] = time.perf_counter() - clock
     write_json(stage / "summary.json", full)
