@@ -48,15 +48,15 @@ def show(
     workers: Annotated[
         int | None,
         typer.Option(
-            help="Processes planning the writing, the .skyc keyframes and writing the files "
-            "(default: CPUs)."
+            help="Processes planning the writing, making the .skyc and Skybrush CSV and writing "
+            "the files (default: CPUs)."
         ),
     ] = None,
     scheduler: Annotated[
         str | None,
         typer.Option(
-            help="dask.distributed scheduler address (or 'local') for the writing and the "
-            ".skyc keyframes."
+            help="dask.distributed scheduler address (or 'local') for the writing, the .skyc "
+            "and the Skybrush CSV."
         ),
     ] = None,
     min_altitude_m: MinAltitude = MIN_ALTITUDE_M,
@@ -98,7 +98,7 @@ def show(
 @dataclass(frozen=True)
 class _Where:
     """Where the per-drone work runs: ``--workers`` processes, or the ``--scheduler``
-    (the writing and the .skyc keyframes; the files are written by local processes)."""
+    (the writing, the .skyc and the Skybrush CSV; the files are written by local processes)."""
 
     workers: int | None
     scheduler: str | None
@@ -168,7 +168,7 @@ def _write(
     skyc = _skyc(stage, plans, script, where)
     stages["skyc"] = time.perf_counter() - clock
     clock = time.perf_counter()
-    studio = _studio_csv(stage, plans, script)
+    studio = _studio_csv(stage, plans, script, where)
     stages["skybrush_csv"] = time.perf_counter() - clock
     if drawn.drawn:
         with drawn.timing("long_exposure.png", "preview.gif"):
@@ -221,13 +221,14 @@ def _write(
 
 
 def _studio_csv(
-    stage: Path, plans: list[tuple[str, PlannedTrajectory]], script: ShowScript
+    stage: Path, plans: list[tuple[str, PlannedTrajectory]], script: ShowScript, where: _Where
 ) -> dict[str, Any]:
     """Write ``show.zip``, Skybrush Studio's per-drone CSVs, read back as Studio reads them."""
     from skyquill.export.base import ExportOptions
     from skyquill.export.skybrush.csv_exporter import SkybrushCsvExporter
 
-    exported = SkybrushCsvExporter()(plans, stage / "show", ExportOptions(script.rate_hz))
+    exporter = SkybrushCsvExporter(workers=where.workers, scheduler=where.scheduler)
+    exported = exporter(plans, stage / "show", ExportOptions(script.rate_hz))
     return {
         "file": "show.zip",
         "max_error_m": exported.max_error_m,

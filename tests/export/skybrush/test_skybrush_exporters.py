@@ -260,21 +260,34 @@ def test_a_colour_per_stroke_is_in_the_zipped_csv(plans: list[NamedPlan], tmp_pa
 
 @pytest.mark.slow
 @pytest.mark.timeout(180)
-def test_keyframes_made_in_worker_processes_or_on_dask_are_the_ones_made_here(
+def test_exports_made_in_worker_processes_or_on_dask_are_the_ones_made_here(
     plans: list[NamedPlan], tmp_path: Path
 ) -> None:
-    """The .skyc of a show whose drones' keyframes are made in a process pool (``skyquill
-    show --workers``) or on a dask cluster (``--scheduler``) is the one made in-process."""
+    """The .skyc and the zipped CSV of a show whose drones are exported in a process pool
+    (``skyquill show --workers``) or on a dask cluster (``--scheduler``) are the ones made
+    in-process."""
+    from skyquill.export.skybrush.csv_exporter import SkybrushCsvExporter
     from skyquill.export.skybrush.skyc_exporter import SkycExporter
 
     pytest.importorskip("distributed")
-    here = SkycExporter()(plans, tmp_path / "here.skyc", ExportOptions())
-    for name, exporter in (
-        ("pool", SkycExporter(workers=2)),
-        ("dask", SkycExporter(scheduler="local")),
-    ):
-        there = exporter(plans, tmp_path / f"{name}.skyc", ExportOptions())
-        got, want = read_show_json(there.files[0]), read_show_json(here.files[0])
-        assert got["swarm"] == want["swarm"]
-        assert there.details == here.details
-        assert there.max_error_m == here.max_error_m
+    skyc, csv = SkycExporter(), SkybrushCsvExporter()
+    here = [export(plans, tmp_path / "here", ExportOptions()) for export in (skyc, csv)]
+    for where in ({"workers": 2}, {"scheduler": "local"}):
+        name = "_".join(where)
+        for export, want in zip(
+            (SkycExporter(**where), SkybrushCsvExporter(**where)),  # type: ignore[arg-type]
+            here,
+            strict=True,
+        ):
+            there = export(plans, tmp_path / name, ExportOptions())
+            assert there.details == want.details
+            assert there.delivered == want.delivered
+            assert _members(there.files[0]) == _members(want.files[0])
+
+
+def _members(path: Path) -> dict[str, bytes]:
+    """A ZIP's members, name -> bytes (the archive's own bytes hold the time it was written)."""
+    import zipfile
+
+    with zipfile.ZipFile(path) as archive:
+        return {name: archive.read(name) for name in archive.namelist()}
