@@ -53,6 +53,7 @@ from skyquill.export.skybrush.skyc_file import (
 from skyquill.export.skybrush.validation import validation_settings
 from skyquill.io.trajectory_json import PlannedTrajectory
 from skyquill.parallel import parallel_map
+from skyquill.trajectory import Trajectory
 
 #: Heading of the show's X+ axis, degrees clockwise from north: skyquill's x is east.
 SHOW_X_HEADING_DEG = 90.0
@@ -104,8 +105,12 @@ class SkycExporter:
         show = read_show_json(path)
         played = [p.trajectory() for p in played_show(show)]
         delivered = tuple(
-            check_delivered(name, plan, back)
-            for (name, plan), back in zip(plans, played, strict=True)
+            parallel_map(
+                _checked,
+                [(name, plan, back) for (name, plan), back in zip(plans, played, strict=True)],
+                workers=self.workers,
+                scheduler=self.scheduler,
+            )
         )
         lights = [
             _light_mismatch(show, i, plan, options.light_rgb, back.duration)
@@ -138,6 +143,11 @@ def _keyframed(named: NamedPlan) -> tuple[PlannedTrajectory, PlayedKeyframes]:
     name, plan = named
     grounded = on_pads(plan)
     return grounded, played_keyframes(name, grounded)
+
+
+def _checked(drone: tuple[str, PlannedTrajectory, Trajectory]) -> DeliveredCheck:
+    """A drone as read back from the file, checked against its plan."""
+    return check_delivered(*drone)
 
 
 def _location_shift(show: dict[str, Any], frame: GeoFrame) -> float:
