@@ -40,9 +40,8 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from threadpoolctl import threadpool_limits
 
-from common import gc_off, jsonable, machine_info
+from common import gc_off, jsonable, machine_info, one_blas_thread
 
 ROOT = Path(__file__).resolve().parents[1]
 RESULTS = ROOT / "bench" / "results" / "calligraphy.json"
@@ -193,7 +192,7 @@ def main() -> None:
     runs = 1 if opts.quick else opts.runs
     items, note = inputs(8 if opts.quick else None, 5 if opts.quick else opts.kanjivg)
     rows = []
-    with threadpool_limits(1):
+    with one_blas_thread():
         plan_timed(strokes_of(items[0]), "tip", 1)  # warm-up: imports, caches
         for i, item in enumerate(items):
             rows.append(measure(item, runs))

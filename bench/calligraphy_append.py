@@ -30,9 +30,8 @@ from typing import Any
 
 import numpy as np
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
-from threadpoolctl import threadpool_limits
 
-from common import gc_off, jsonable, machine_info
+from common import gc_off, jsonable, machine_info, one_blas_thread
 
 ROOT = Path(__file__).resolve().parents[1]
 RESULTS = ROOT / "bench" / "results" / "calligraphy_append.json"
@@ -137,7 +136,7 @@ def main() -> None:
         "target_s": TARGET_S,
     }
     with (
-        threadpool_limits(1),
+        one_blas_thread(),
         Progress(
             TextColumn("[bold]append"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn()
         ) as bar,

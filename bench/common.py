@@ -33,6 +33,24 @@ def gc_off() -> Iterator[None]:
             gc.enable()
 
 
+def one_blas_thread() -> Any:
+    """Pin every BLAS the planners use to one thread, scipy's included.
+
+    threadpoolctl limits only the libraries loaded when it is called: numpy and scipy wheels
+    each bring their own OpenBLAS, and scipy's is loaded with ``scipy.linalg``, which skyquill
+    imports lazily. Loading it first makes the pin take effect for the whole run.
+
+    Returns
+    -------
+    threadpoolctl.threadpool_limits
+        The limit, to use as a context manager.
+    """
+    import scipy.linalg  # noqa: F401  (loads scipy's OpenBLAS, see above)
+    from threadpoolctl import threadpool_limits
+
+    return threadpool_limits(limits=1, user_api="blas")
+
+
 def jsonable(x: Any) -> Any:
     """``x`` with numpy scalars as Python numbers and non-finite floats as ``None`` (JSON)."""
     if isinstance(x, dict):

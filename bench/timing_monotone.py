@@ -30,9 +30,8 @@ from typing import Any
 
 import numpy as np
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
-from threadpoolctl import threadpool_limits
 
-from common import jsonable, machine_info
+from common import jsonable, machine_info, one_blas_thread
 
 ROOT = Path(__file__).resolve().parents[1]
 RESULTS = ROOT / "bench" / "results" / "timing_monotone.json"
@@ -127,7 +126,7 @@ def main() -> None:
     chars = characters(args.n)
     rows: dict[str, list[dict[str, Any]]] = {}
     with (
-        threadpool_limits(1),
+        one_blas_thread(),
         Progress(
             TextColumn("[bold]limits sweep"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn()
         ) as bar,

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import subprocess
+import sys
 from pathlib import Path
 
 import matplotlib
@@ -12,7 +14,13 @@ import numpy as np
 from matplotlib.ticker import FixedLocator, LogLocator
 from PIL import Image
 
-from skyquill.viz.figures import MAX_TICKS, figure_style, save_png
+from skyquill.viz.figures import (
+    MAX_TICKS,
+    figure_style,
+    new_figure,
+    save_png,
+    stack_time_panels,
+)
 
 
 def _ticks_in_view(axis: matplotlib.axis.Axis) -> int:
@@ -43,3 +51,29 @@ def test_default_ticks_are_thinned_custom_and_log_ones_kept(tmp_path: Path) -> N
     plt.close(fig)
     with Image.open(tmp_path / "f.png") as image:
         assert image.format == "PNG" and image.size == (750, 200)
+
+
+def test_stacked_panels_share_one_time_axis_labelled_once(tmp_path: Path) -> None:
+    fig = new_figure((8, 6))
+    panels = stack_time_panels(fig, (0.1, 0.1, 0.8, 0.8), 3)
+    for k, panel in enumerate(panels):
+        panel.plot(np.linspace(0.0, 10.0 * (k + 1), 20), np.arange(20.0))
+    save_png(fig, tmp_path / "s.png", dpi=50)
+    limits = {panel.get_xlim() for panel in panels}
+    assert len(limits) == 1 and max(limits)[1] >= 30.0  # one axis, spanning every panel
+    labelled = [any(t.get_visible() for t in p.get_xticklabels()) for p in panels]
+    assert labelled == [False, False, True]
+    with Image.open(tmp_path / "s.png") as image:
+        assert image.size == (400, 300)
+
+
+def test_the_short_commands_figures_draw_without_pyplot() -> None:
+    # pyplot's import, figure manager and backend resolution are a tenth of a second of a
+    # fresh `skyquill fit` / `fly` / `write`: their figures are made without it.
+    code = (
+        "import sys\n"
+        "import skyquill.viz.fit_plot, skyquill.viz.flight_plot, skyquill.viz.writing_plot\n"
+        "assert 'matplotlib.pyplot' not in sys.modules, 'pyplot imported'\n"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=False)
+    assert done.returncode == 0, done.stderr

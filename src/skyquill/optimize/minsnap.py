@@ -86,14 +86,24 @@ def min_snap(
     # Work in time units of the mean piece, where every row of the system is O(1).
     unit = (t[-1] - t[0]) / m
     T = np.diff(t) / unit
-    derivs = np.zeros((m + 1, s, d))  # derivative k at each waypoint, in the time unit
-    derivs[:, 0] = w
+    # Derivative k of axis a at waypoint i is derivs[k, a, i], in the time unit: the
+    # waypoints run along the last axis, so every array operation below is a pass over
+    # long rows (numpy's loops over a last axis of length d or s are several times slower).
+    derivs = np.empty((s, d, m + 1))
+    derivs[0] = w.T
     scale = unit ** np.arange(1, s)[:, None]
-    derivs[0, 1:], derivs[-1, 1:] = boundary[0] * scale, boundary[1] * scale
+    derivs[1:, :, 0], derivs[1:, :, -1] = boundary[0] * scale, boundary[1] * scale
     if m > 1:
-        derivs[1:-1, 1:] = _interior(derivs, T, s)
-    coeffs = _power_coefficients(derivs, T, s) / unit ** np.arange(2 * s)[None, :, None]
-    return PiecewisePolynomial(np.concatenate([[0.0], np.cumsum(T) * unit]), coeffs)
+        derivs[1:, :, 1:-1] = _interior(derivs, T, s)
+    breaks = np.empty(m + 1)
+    breaks[0] = 0.0
+    np.cumsum(T, out=breaks[1:])
+    breaks[1:] *= unit
+    coeffs = _power_coefficients(derivs, T, s, unit)
+    if not np.isfinite(coeffs).all():  # pragma: no cover - finite input, a definite system
+        raise SolverError("min_snap: the solve overflowed (waypoints too far apart?)")
+    # Checked here (increasing breaks: every step is positive), so not again.
+    return PiecewisePolynomial.trusted(breaks, coeffs)
 
 
 def _checked(
@@ -155,7 +165,7 @@ def _hermite(s: int) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
 
 
 def _interior(derivs: FloatArray, T: FloatArray, s: int) -> FloatArray:
-    """The derivatives 1 .. s-1 at the interior waypoints that minimise the cost.
+    """The derivatives 1 .. s-1 at the interior waypoints that minimise the cost, (s-1, d, M-1).
 
     Piece ``j`` costs ``T_j^(1-2s) x_j' Q x_j`` with ``x_j`` its end data scaled by
     ``T_j^r``; the cost is a quadratic in the interior derivatives whose Hessian is
@@ -163,61 +173,59 @@ def _interior(derivs: FloatArray, T: FloatArray, s: int) -> FloatArray:
     definite, so its normal equations are solved by a banded Cholesky factorisation
     (LAPACK ``pbsv``), every axis at once. (Setting that gradient to zero is the same as
     asking the derivatives s .. 2s-2 to be continuous, the Euler-Lagrange form.)
+
+    Every entry of the Hessian is ``Q[a, c] T^(a+c+3-2s)`` of the piece it comes from,
+    and every entry of the right-hand side ``Q[r, 0 or s] T^(r+2-2s)`` times a waypoint:
+    so the powers ``T^-k`` are computed once and each band row is a pass over them.
     """
     _, Q = _hermite(s)
     q = s - 1
     A, B = slice(1, s), slice(s + 1, 2 * s)  # the derivatives at a piece's start and end
-    weight = T ** (1.0 - 2 * s)  # (m,)
-    scale = T[:, None] ** np.arange(1, s)[None, :]  # (m, q): T_j^r
-    wa, wb = weight[:-1], weight[1:]  # the pieces left and right of each interior waypoint
-    sl, sr = scale[:-1], scale[1:]
-    diag = wa[:, None, None] * sl[:, :, None] * Q[B, B] * sl[:, None, :] + (
-        wb[:, None, None] * sr[:, :, None] * Q[A, A] * sr[:, None, :]
-    )
-    # Coupling of waypoint i (start of piece i) with waypoint i + 1 (its end).
-    off = weight[1:-1, None, None] * scale[1:-1, :, None] * Q[A, B] * scale[1:-1, None, :]
-    p = derivs[:, 0]
-    rhs = -(
-        (wa[:, None] * sl)[:, :, None]
-        * (Q[B, 0][None, :, None] * p[:-2, None] + Q[B, s][None, :, None] * p[1:-1, None])
-        + (wb[:, None] * sr)[:, :, None]
-        * (Q[A, 0][None, :, None] * p[1:-1, None] + Q[A, s][None, :, None] * p[2:, None])
-    )
+    inv = 1.0 / T
+    power = {1: inv}  # power[k] = T^-k, k = 1 .. 2s - 2
+    for k in range(2, 2 * s - 1):
+        power[k] = power[k - 1] * inv
+    band = np.zeros((2 * q, (T.size - 1) * q), order="F")
+    for a in range(q):
+        for c in range(a + 1):  # diagonal blocks: the piece left and the piece right
+            left_right = power[2 * s - 3 - a - c]
+            band[a - c, c::q] = Q[B, B][a, c] * left_right[:-1] + Q[A, A][a, c] * left_right[1:]
+        for c in range(q):  # block (i + 1, i) couples the two ends of piece i + 1
+            band[q + a - c, c::q][:-1] = Q[A, B][c, a] * power[2 * s - 3 - a - c][1:-1]
+    p = derivs[0]  # (d, M + 1)
+    rhs = np.empty((p.shape[0], T.size - 1, q))  # (d, interior, q): Fortran order for pbsv
+    for r in range(q):
+        left, right = power[2 * s - 2 - r][:-1], power[2 * s - 2 - r][1:]
+        rhs[:, :, r] = -(
+            left * (Q[B, 0][r] * p[:, :-2] + Q[B, s][r] * p[:, 1:-1])
+            + right * (Q[A, 0][r] * p[:, 1:-1] + Q[A, s][r] * p[:, 2:])
+        )
     # Given end derivatives (rest by default) couple with the first and last interior waypoint.
-    rhs[0] -= (weight[0] * scale[0][:, None] * Q[B, A] * scale[0][None, :]) @ derivs[0, 1:]
-    rhs[-1] -= (weight[-1] * scale[-1][:, None] * Q[A, B] * scale[-1][None, :]) @ derivs[-1, 1:]
-    n_in = T.size - 1
-    band = _lower_band(diag, off, q)
-    _, z, info = dpbsv(band, rhs.reshape(n_in * q, -1), lower=1, overwrite_ab=1, overwrite_b=1)
+    scale0, scale1 = T[0] ** np.arange(1, s), T[-1] ** np.arange(1, s)
+    w0, w1 = T[0] ** (1.0 - 2 * s), T[-1] ** (1.0 - 2 * s)
+    rhs[:, 0] -= ((w0 * scale0[:, None] * Q[B, A] * scale0[None, :]) @ derivs[1:, :, 0]).T
+    rhs[:, -1] -= ((w1 * scale1[:, None] * Q[A, B] * scale1[None, :]) @ derivs[1:, :, -1]).T
+    flat = rhs.reshape(rhs.shape[0], -1).T  # (interior * q, d), Fortran order: no copy
+    _, z, info = dpbsv(band, flat, lower=1, overwrite_ab=1, overwrite_b=1)
     if info != 0:  # pragma: no cover - the Hessian is positive definite by construction
         raise SolverError(f"min_snap: the banded Cholesky factorisation failed (info {info})")
-    return np.asarray(z).reshape(n_in, q, -1)
+    return np.asarray(z).T.reshape(rhs.shape).transpose(2, 0, 1)
 
 
-def _lower_band(diag: FloatArray, off: FloatArray, q: int) -> FloatArray:
-    """The symmetric block-tridiagonal matrix (blocks q x q) in LAPACK's lower band storage.
+def _power_coefficients(derivs: FloatArray, T: FloatArray, s: int, unit: float) -> FloatArray:
+    """Every piece's coefficients in its own time in seconds, (M, 2s, d).
 
-    Entry ``(row, col)``, ``row >= col``, goes to ``band[row - col, col]``. Within a block
-    row the band row is the same for every block and the columns step by ``q``: one
-    strided assignment per block entry.
+    ``derivs`` (s, d, M + 1) and ``T`` (M,) are in the time unit ``unit`` (s).
     """
-    n_in = diag.shape[0]
-    band = np.zeros((2 * q, n_in * q))
-    for a in range(q):
-        for c in range(a + 1):
-            band[a - c, c::q] = diag[:, a, c]
-        for c in range(q):  # block (i + 1, i) is off[i]' : entry (a, c) = off[i, c, a]
-            band[q + a - c, c::q][: n_in - 1] = off[:, c, a]
-    return band
-
-
-def _power_coefficients(derivs: FloatArray, T: FloatArray, s: int) -> FloatArray:
-    """Every piece's coefficients in its own time ``tau`` (in the time unit), (m, 2s, d)."""
     H, _ = _hermite(s)
-    m, d = T.size, derivs.shape[2]
-    powers = np.cumprod(np.column_stack([np.ones(m)] + [T] * (2 * s - 1)), axis=1)  # T^k
-    x = np.empty((2 * s, m, d))  # the end data, scaled by T^r, as columns of one product
-    x[:s] = (derivs[:-1] * powers[:, :s, None]).transpose(1, 0, 2)
-    x[s:] = (derivs[1:] * powers[:, :s, None]).transpose(1, 0, 2)
-    coeffs = (H @ x.reshape(2 * s, m * d)).reshape(2 * s, m, d).transpose(1, 0, 2)
-    return coeffs / powers[:, :, None]
+    m, d = T.size, derivs.shape[1]
+    powers = np.empty((2 * s, m))  # T^k
+    powers[0] = 1.0
+    for k in range(1, 2 * s):
+        powers[k] = powers[k - 1] * T
+    x = np.empty((2 * s, d, m))  # the end data, scaled by T^r, as columns of one product
+    x[:s] = derivs[:, :, :-1] * powers[:s, None, :]
+    x[s:] = derivs[:, :, 1:] * powers[:s, None, :]
+    coeffs = (H @ x.reshape(2 * s, d * m)).reshape(2 * s, d, m)
+    coeffs /= (powers * (unit ** np.arange(2 * s))[:, None])[:, None, :]
+    return np.ascontiguousarray(coeffs.transpose(2, 0, 1))

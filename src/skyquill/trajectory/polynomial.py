@@ -55,6 +55,23 @@ class PiecewisePolynomial:
             yaw.setflags(write=False)
             object.__setattr__(self, "yaw_coeffs", yaw)
 
+    @classmethod
+    def trusted(cls, breaks: FloatArray, coeffs: FloatArray) -> PiecewisePolynomial:
+        """The polynomial of arrays its caller has just computed, not checked again.
+
+        For planners that build many small trajectories (a stop-and-go chain of ten legs
+        costs less than checking it): ``breaks`` must already be float64, start at 0 and
+        increase strictly, ``coeffs`` be finite float64 of shape (P, K, d). Both are taken
+        as they are (no copy) and made read-only, so the caller must not keep writing them.
+        """
+        poly = object.__new__(cls)
+        breaks.setflags(write=False)
+        coeffs.setflags(write=False)
+        object.__setattr__(poly, "breaks", breaks)
+        object.__setattr__(poly, "coeffs", coeffs)
+        object.__setattr__(poly, "yaw_coeffs", None)
+        return poly
+
     @property
     def duration(self) -> float:
         """Total length, s."""

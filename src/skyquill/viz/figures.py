@@ -18,6 +18,16 @@ encoding the PNG, the rest drawing. So:
 Together ``fit``'s and ``fly``'s pictures take about 0.43 s of CPU instead of 0.59 s.
 Constrained or tight layouts and ``bbox_inches="tight"`` draw a figure twice; the
 figures here use fixed layouts instead.
+
+Issue 27, part 5, second pass (run as a user runs them, a fresh ``skyquill`` process pays
+for matplotlib's import inside the pictures' time):
+
+* :func:`new_figure`: a :class:`~matplotlib.figure.Figure` on an Agg canvas, without
+  ``matplotlib.pyplot`` (its import, its figure manager and its backend resolution: about
+  0.1 s of a fresh process);
+* :func:`stack_time_panels`: panels against the same time axis stacked and sharing it,
+  the tick labels and the axis label drawn once, on the bottom panel: every tick label
+  is a text layout, so three panels' worth of them cost three times one.
 """
 
 from __future__ import annotations
@@ -27,6 +37,8 @@ from pathlib import Path
 from typing import Any
 
 import matplotlib
+from matplotlib.axes import Axes
+from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from matplotlib.ticker import AutoLocator, MaxNLocator
 
@@ -36,6 +48,38 @@ MAX_TICKS = 5
 NICE_STEPS = (1.0, 2.0, 2.5, 5.0, 10.0)
 #: zlib level of the PNGs written (Pillow's default is 6).
 PNG_COMPRESSION = 1
+
+
+def new_figure(figsize: tuple[float, float], dpi: float = 100.0) -> Figure:
+    """A figure of ``figsize`` inches drawn by Agg, made without :mod:`matplotlib.pyplot`.
+
+    Nothing holds on to it (no pyplot figure manager): it is freed with its last
+    reference, so there is no ``close`` to call.
+    """
+    fig = Figure(figsize=figsize, dpi=dpi)
+    FigureCanvasAgg(fig)  # attaches itself as fig.canvas: savefig writes PNGs through it
+    return fig
+
+
+def stack_time_panels(
+    fig: Figure, rect: tuple[float, float, float, float], n: int, hspace: float = 0.12
+) -> list[Axes]:
+    """``n`` panels stacked in ``rect`` (left, bottom, width, height; figure fraction),
+    sharing one time axis whose tick labels only the bottom panel draws.
+
+    ``hspace``: the gap between two panels, a fraction of a panel's height (room for a
+    title above each panel needs about 0.4).
+    """
+    grid = fig.add_gridspec(
+        n, 1, left=rect[0], bottom=rect[1], right=rect[0] + rect[2], top=rect[1] + rect[3],
+        hspace=hspace,
+    )  # fmt: skip
+    panels: list[Axes] = []
+    for k in range(n):
+        panels.append(fig.add_subplot(grid[k, 0], sharex=panels[0] if panels else None))
+    for panel in panels[:-1]:
+        panel.tick_params(labelbottom=False)
+    return panels
 
 
 def figure_style() -> AbstractContextManager[None]:

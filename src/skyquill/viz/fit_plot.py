@@ -4,22 +4,21 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.axes import Axes
 
 from skyquill.limits import BoxLimit, DerivativeLimit, NormLimit
 from skyquill.optimize.fit import PointFit
-from skyquill.viz.figures import figure_style, save_png
+from skyquill.viz.figures import figure_style, new_figure, save_png, stack_time_panels
 
 AXES = "xyz"
 
 
 def plot_fit(fit: PointFit, path: str | Path, title: str = "") -> None:
-    """Save a 2x2 figure: top view, speed, acceleration and jerk with limits.
+    """Save the top view beside velocity, acceleration and jerk against time with limits.
+
+    The three derivative panels are stacked on one shared time axis (one set of time
+    tick labels, one legend): most of a panel's drawing time is its ticks and text.
 
     Parameters
     ----------
@@ -33,15 +32,16 @@ def plot_fit(fit: PointFit, path: str | Path, title: str = "") -> None:
     traj = fit.trajectory
     t = np.linspace(0.0, traj.duration, 2000)
     # A fixed layout: constrained layout draws the figure twice to measure it (half the time).
+    fig = new_figure((11, 8))
     with figure_style():
-        fig, ax = plt.subplots(2, 2, figsize=(11, 8))
-    fig.subplots_adjust(left=0.07, right=0.98, bottom=0.07, top=0.92, hspace=0.28, wspace=0.22)
+        top = fig.add_axes((0.07, 0.07, 0.4, 0.83))
+        panels = stack_time_panels(fig, (0.56, 0.07, 0.42, 0.83), 3)
     p = traj.evaluate(t)
-    ax[0, 0].plot(fit.points[:, 0], fit.points[:, 1], ".", ms=2, color="0.6", label="input")
-    ax[0, 0].plot(p[:, 0], p[:, 1], "-", lw=1.2, color="C0", label="trajectory")
-    ax[0, 0].set(xlabel="x [m]", ylabel="y [m]", aspect="equal", title="path (top view)")
-    ax[0, 0].legend(loc="upper right", fontsize=8)  # "best" tests every point of the path
-    for panel, order, unit in ((ax[0, 1], 1, "m/s"), (ax[1, 0], 2, "m/s²"), (ax[1, 1], 3, "m/s³")):
+    top.plot(fit.points[:, 0], fit.points[:, 1], ".", ms=2, color="0.6", label="input")
+    top.plot(p[:, 0], p[:, 1], "-", lw=1.2, color="C0", label="trajectory")
+    top.set(xlabel="x [m]", ylabel="y [m]", aspect="equal", title="path (top view)")
+    top.legend(loc="upper right", fontsize=8)  # "best" tests every point of the path
+    for panel, order, unit in zip(panels, (1, 2, 3), ("m/s", "m/s²", "m/s³"), strict=True):
         values = traj.evaluate(t, order)
         for i in range(values.shape[1]):
             panel.plot(t, values[:, i], lw=1, label=AXES[i])
@@ -49,15 +49,16 @@ def plot_fit(fit: PointFit, path: str | Path, title: str = "") -> None:
             if lim.order == order:
                 _draw_limit(panel, t, values, lim)
         name = {1: "velocity", 2: "acceleration", 3: "jerk"}[order]
-        panel.set(xlabel="t [s]", ylabel=f"{name} [{unit}]", title=name)
-        panel.legend(loc="upper right", fontsize=8)
+        panel.set_ylabel(f"{name} [{unit}]")
+    panels[0].set_title("derivatives against their limits (dashed)")
+    panels[0].legend(loc="upper right", fontsize=8, ncols=4)
+    panels[-1].set_xlabel("t [s]")
     check = fit.verification
     fig.suptitle(
         f"{title}  duration {traj.duration:.2f} s, max excess {check.max_excess:.1e}, "
         f"rms deviation {1e3 * fit.rms_deviation_m:.1f} mm"
     )
     save_png(fig, path, dpi=110)
-    plt.close(fig)
 
 
 def _draw_limit(panel: Axes, t: np.ndarray, values: np.ndarray, lim: DerivativeLimit) -> None:

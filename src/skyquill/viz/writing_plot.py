@@ -15,10 +15,6 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.collections import LineCollection
@@ -26,7 +22,7 @@ from matplotlib.collections import LineCollection
 from skyquill.calligraphy.mission import Mission
 from skyquill.limits import BoxLimit
 from skyquill.validation import FloatArray
-from skyquill.viz.figures import figure_style, save_png
+from skyquill.viz.figures import figure_style, new_figure, save_png, stack_time_panels
 
 #: Samples per drone of the board view and of the derivative panels.
 BOARD_SAMPLES = 4000
@@ -48,10 +44,11 @@ def plot_missions(missions: list[Mission], path: str | Path, title: str = "") ->
     title
         Figure title.
     """
+    fig = new_figure((16, 6), dpi=DPI)
     with figure_style():
-        fig = plt.figure(figsize=(16, 6), dpi=DPI)
         boards = fig.add_axes((0.04, 0.08, 0.44, 0.8))
-        panels = [fig.add_axes((0.55, 0.08 + 0.3 * k, 0.43, 0.2)) for k in (2, 1, 0)]
+        # One shared time axis: its tick labels drawn once, on the bottom panel.
+        panels = stack_time_panels(fig, (0.55, 0.08, 0.43, 0.8), 3, hspace=0.5)
     _board_view(boards, missions)
     names = ("speed [m/s]", "acceleration [m/s²]", "jerk [m/s³]")
     for ax, order, name in zip(panels, (1, 2, 3), names, strict=True):
@@ -63,7 +60,6 @@ def plot_missions(missions: list[Mission], path: str | Path, title: str = "") ->
         f"{max(m.verification.max_excess for m in missions):.1e}"
     )
     save_png(fig, path, dpi=DPI)
-    plt.close(fig)
 
 
 def _board_view(ax: Axes, missions: list[Mission]) -> None:
