@@ -30,8 +30,9 @@ from skyquill.io.plan_dir import trajectory_names, with_phases, write_plan
 from skyquill.io.points import check_rows_written
 from skyquill.io.trajectory_json import PlannedTrajectory
 from skyquill.phases import MIN_ALTITUDE_M
-from skyquill.show import ShowDrone, ShowLimits, ShowReport, check_show, load_show
+from skyquill.show import ShowDrone, ShowLimits, ShowReport, check_show
 from skyquill.show.build import ShowPlan, build_show
+from skyquill.show.load import skyc_drones
 from skyquill.show.script import ShowScript, load_script
 
 #: Relative round-off allowed over the planned limits in the independent check
@@ -254,8 +255,9 @@ def _skyc(
     from skyquill.export.skybrush.skyc_exporter import SkycExporter
 
     exporter = SkycExporter(workers=where.workers, scheduler=where.scheduler)
-    exported = exporter(plans, stage / "show", ExportOptions())
-    played = load_show([stage / "show.skyc"])
+    exported, show_json = exporter.export(plans, stage / "show", ExportOptions())
+    # as `skyquill check show.skyc` loads it, from the show.json the exporter read back
+    played = skyc_drones(show_json, "show.skyc")
     allowed = max(0.0, script.safety_m - 2.0 * exported.max_error_m)
     limits = replace(check_limits(script), tolerance=ALLOWED_EXCESS[2])
     back = check_show(played, allowed, limits)

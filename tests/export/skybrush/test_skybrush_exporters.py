@@ -291,3 +291,22 @@ def _members(path: Path) -> dict[str, bytes]:
 
     with zipfile.ZipFile(path) as archive:
         return {name: archive.read(name) for name in archive.namelist()}
+
+
+def test_the_show_read_back_by_the_export_is_the_file_as_check_loads_it(
+    plans: list[NamedPlan], tmp_path: Path
+) -> None:
+    """``skyquill show`` proves the .skyc as played from the show.json the exporter read back
+    (not reading the file a second time): the same drones ``skyquill check`` loads."""
+    from skyquill.export.skybrush.skyc_exporter import SkycExporter
+    from skyquill.show import load_show
+    from skyquill.show.load import skyc_drones
+
+    report, show = SkycExporter().export(plans, tmp_path / "yong", ExportOptions())
+    assert show == read_show_json(report.files[0])
+    loaded = load_show([report.files[0]])
+    shared = skyc_drones(show, report.files[0].name)
+    assert [(d.name, d.start_s) for d in shared] == [(d.name, d.start_s) for d in loaded]
+    for a, b in zip(shared, loaded, strict=True):
+        t = dense_times(b.trajectory.breakpoints)
+        np.testing.assert_array_equal(a.trajectory.evaluate(t), b.trajectory.evaluate(t))

@@ -75,6 +75,15 @@ class SkycExporter:
         self, plans: Sequence[NamedPlan], out: Path, options: ExportOptions
     ) -> ExportReport:
         """Write the show, read it back as the drones play it, check it against the plans."""
+        return self.export(plans, out, options)[0]
+
+    def export(
+        self, plans: Sequence[NamedPlan], out: Path, options: ExportOptions
+    ) -> tuple[ExportReport, dict[str, Any]]:
+        """As calling the exporter, and the ``show.json`` read back from the file written
+        (:func:`~skyquill.export.skybrush.skyc_file.read_show_json`), for a caller's own
+        checks of what was written (``skyquill show`` proves it apart as played) without
+        reading it again."""
         grounded = parallel_map(
             _keyframed, list(plans), workers=self.workers, scheduler=self.scheduler
         )
@@ -126,7 +135,7 @@ class SkycExporter:
         shift = 0.0 if frame is None else _location_shift(show, frame)
         if frame is not None:
             details["location"] = show["environment"]["location"] | {"shift_m": shift}
-        return ExportReport(
+        report = ExportReport(
             self.name,
             (path,),
             exact=False,
@@ -136,6 +145,7 @@ class SkycExporter:
             details=details,
             delivered=delivered,
         )
+        return report, show
 
 
 def _keyframed(named: NamedPlan) -> tuple[PlannedTrajectory, PlayedKeyframes]:
