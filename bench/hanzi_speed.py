@@ -63,7 +63,9 @@ def plan(char):
     mission = plan_show([typed_strokes(char)], options, **show).missions[0]
     return {"cpu_s": time.process_time() - cpu, "wall_s": time.perf_counter() - wall,
             "duration_s": mission.trajectory.duration, "time_scale": mission.time_scale,
-            "deviation_m": mission.deviation.max_m, "faithful": mission.faithful}
+            "deviation_m": mission.deviation.max_m, "faithful": mission.faithful,
+            "jerk_cost": sum(f.cost_terms["smoothness"] for f in mission.fits),
+            "max_excess": max(f.verification.max_excess for f in mission.fits)}
 
 plan("\u4e2d")  # warm-up: imports, caches
 # Again now that the planner has loaded every BLAS it uses (scipy's own among them):
@@ -160,6 +162,15 @@ def main() -> None:
         "new_duration_over_old": stats(
             [r["new"]["duration_s"] / r["old"]["duration_s"] for r in done]
         ),
+        # The smoothing's jerk cost (fixed total time: re-segmentation moves time only).
+        "new_jerk_cost_over_old": stats(
+            [r["new"]["jerk_cost"] / r["old"]["jerk_cost"] for r in done]
+        ),
+        "new_jerk_cost_over_old_min": min(
+            r["new"]["jerk_cost"] / r["old"]["jerk_cost"] for r in done
+        ),
+        "all_faithful": all(r[k]["faithful"] for r in done for k in ("old", "new")),
+        "max_excess": max(r[k]["max_excess"] for r in done for k in ("old", "new")),
     }
     tmp_out = RESULTS.with_suffix(".tmp")
     tmp_out.write_text(json.dumps(jsonable(result), indent=1, ensure_ascii=False) + "\n", "utf-8")
@@ -167,7 +178,8 @@ def main() -> None:
     print(
         f"old median {result['old_cpu_s']['median']:.3f} s max {result['old_cpu_s']['max']:.3f} s; "
         f"new median {result['new_cpu_s']['median']:.3f} s max {result['new_cpu_s']['max']:.3f} s; "
-        f"new/old {result['new_over_old_median']:.2f}"
+        f"new/old {result['new_over_old_median']:.2f}; durations new/old "
+        f"{result['new_duration_over_old']}; jerk cost new/old {result['new_jerk_cost_over_old']}"
     )
 
 

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 from scipy.spatial import cKDTree
 
@@ -53,6 +55,100 @@ def polyline_distance(points: FloatArray, vertices: FloatArray) -> FloatArray:
         np.minimum.at(out, point, dist)
         best[start : start + _CHUNK] = out
     return best
+
+
+def polyline_distances(
+    pairs: Sequence[tuple[FloatArray, FloatArray]],
+) -> list[FloatArray]:
+    """:func:`polyline_distance` of each ``(points, vertices)`` pair, the same numbers.
+
+    The pairs small enough for the table (a writing plan's ink runs against their
+    strokes: a few thousand point-segment pairs each) are measured in one table of
+    all their pairs, a chunk of :data:`_TABLE_CHUNK` pairs or more at a time, instead
+    of one small table per pair (the numpy calls' overhead was most of their time);
+    larger ones go to :func:`polyline_distance`.
+
+    Parameters
+    ----------
+    pairs
+        ``(points (N_i, d), vertices (V_i, d))``, ``V_i >= 2``, m, one ``d`` for all.
+
+    Returns
+    -------
+    list of numpy.ndarray, shape (N_i,) each, m
+    """
+    out: list[FloatArray | None] = [None] * len(pairs)
+    batch: list[tuple[int, FloatArray, FloatArray]] = []
+    for i, (p, v) in enumerate(_checked(pairs)):
+        if v.shape[0] < 2 or p.shape[0] * (v.shape[0] - 1) > _TABLE_PAIRS:
+            out[i] = polyline_distance(p, v)  # its own errors, or the k-d tree
+        else:
+            batch.append((i, p, v))
+    dims = {p.shape[1] for _, p, _ in batch}
+    if len(dims) > 1:
+        raise InputError(f"pairs: got points of {sorted(dims)} coordinates, expected one")
+    start = 0
+    while start < len(batch):
+        stop, size = start, 0
+        while stop < len(batch) and (size < _TABLE_CHUNK or stop == start):
+            size += batch[stop][1].shape[0] * (batch[stop][2].shape[0] - 1)
+            stop += 1
+        chunk = batch[start:stop]
+        for (i, _, _), distance in zip(chunk, _by_joint_table(chunk), strict=True):
+            out[i] = distance
+        start = stop
+    return [d for d in out if d is not None]
+
+
+def _checked(pairs: Sequence[tuple[FloatArray, FloatArray]]) -> list[tuple[FloatArray, FloatArray]]:
+    """``pairs`` validated as :func:`polyline_distance` validates each: float arrays of
+    rank 2 with one width per pair, finite (checked once for all where they already are
+    such arrays: a writing plan's fidelity measures ~70 pairs at a time)."""
+    arrays = [a for pair in pairs for a in pair]
+    plain = all(
+        isinstance(a, np.ndarray) and a.dtype == np.float64 and a.ndim == 2 for a in arrays
+    ) and all(p.shape[1] == v.shape[1] for p, v in pairs)
+    if plain and (not arrays or np.isfinite(np.concatenate([a.ravel() for a in arrays])).all()):
+        return list(pairs)
+    checked = []
+    for points, vertices in pairs:
+        p = as_array("points", points, ndim=2)
+        checked.append((p, as_array("vertices", vertices, shape=(None, p.shape[1]))))
+    return checked
+
+
+def _by_joint_table(batch: list[tuple[int, FloatArray, FloatArray]]) -> list[FloatArray]:
+    """:func:`_by_table` of several ``(_, points, vertices)`` at once: every point against
+    every segment of its own polyline, the same operations element by element."""
+    points = np.concatenate([p for _, p, _ in batch])
+    if points.shape[0] == 0:
+        return [np.zeros(0) for _ in batch]
+    a = np.concatenate([v[:-1] for _, _, v in batch])
+    ab = np.concatenate([v[1:] - v[:-1] for _, _, v in batch])
+    length2 = np.einsum("sd,sd->s", ab, ab)
+    divisor = np.where(length2 > 0.0, length2, 1.0)
+    n = np.array([p.shape[0] for _, p, _ in batch])
+    m = np.array([v.shape[0] - 1 for _, _, v in batch])
+    # Pair k: point point_of[k] against segment seg_of[k]; each point's pairs are contiguous.
+    per_point = np.repeat(m, n)
+    first_pair = np.concatenate([[0], np.cumsum(per_point)[:-1]])
+    first_seg = np.repeat(np.concatenate([[0], np.cumsum(m)[:-1]]), n)
+    point_of = np.repeat(np.arange(points.shape[0]), per_point)
+    seg_of = np.repeat(first_seg - first_pair, per_point) + np.arange(point_of.size)
+    q = [points[point_of, i] - a[seg_of, i] for i in range(points.shape[1])]
+    ab_k = [ab[seg_of, i] for i in range(points.shape[1])]
+    s = q[0] * ab_k[0]
+    for i in range(1, points.shape[1]):
+        s += q[i] * ab_k[i]
+    s /= divisor[seg_of]
+    np.clip(s, 0.0, 1.0, out=s)
+    gap2 = (q[0] - s * ab_k[0]) ** 2
+    for i in range(1, points.shape[1]):
+        gap = q[i] - s * ab_k[i]
+        gap *= gap
+        gap2 += gap
+    distance = np.sqrt(np.minimum.reduceat(gap2, first_pair))
+    return list(np.split(distance, np.cumsum(n)[:-1]))
 
 
 #: Points measured at once.

@@ -20,7 +20,7 @@ from numpy.typing import NDArray
 
 from skyquill.calligraphy.board import Board
 from skyquill.calligraphy.brush import Brush
-from skyquill.geometry import polyline_distance
+from skyquill.geometry import polyline_distances
 from skyquill.io.trajectory_json import pen_down
 from skyquill.trajectory import Trajectory
 from skyquill.validation import FloatArray
@@ -226,11 +226,12 @@ def measure_deviation(
 def _two_sided(paths: list[FloatArray], strokes: list[FloatArray]) -> Deviation:
     """Distances between each path (K, d) and its stroke (J, d), both ways."""
     forward, backward, total, count = 0.0, 0.0, 0.0, 0
-    for run, stroke in zip(paths, strokes, strict=True):
-        # A touch of one sample is a polyline of zero length.
-        path = np.vstack([run, run]) if run.shape[0] == 1 else run
-        to_input = polyline_distance(path, stroke)
-        to_path = polyline_distance(stroke, path)
+    # A touch of one sample is a polyline of zero length.
+    runs = [np.vstack([run, run]) if run.shape[0] == 1 else run for run in paths]
+    pairs = list(zip(runs, strokes, strict=True))
+    # Both ways of every stroke in one call (one table of all their pairs).
+    distances = polyline_distances(pairs + [(stroke, path) for path, stroke in pairs])
+    for to_input, to_path in zip(distances[: len(pairs)], distances[len(pairs) :], strict=True):
         forward = max(forward, float(to_input.max()))
         backward = max(backward, float(to_path.max()))
         total += float(to_input.sum())

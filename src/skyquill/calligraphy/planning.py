@@ -152,6 +152,7 @@ def resegmented(
             interior=True,  # each conic solve costs 10-50 closed forms
             ftol=RESEGMENT_FTOL,
             frozen=_legs_frozen(samples),
+            step_rule="lbfgs",  # further down step for step than Barzilai-Borwein
         )
     except InfeasibleError:
         return plan

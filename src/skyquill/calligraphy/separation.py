@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 from skyquill.trajectory import Trajectory
 from skyquill.validation import as_float
 
@@ -20,5 +22,7 @@ def check_separation(
 
     minimum = as_float("minimum_m", minimum_m, positive=True)
     as_float("rate_hz", rate_hz, positive=True)
+    if len(trajectories) < 2:
+        return math.inf  # no pair (what the proof returns, without building its motions)
     drones = [ShowDrone(tr, f"drone {i}") for i, tr in enumerate(trajectories)]
     return require_separation(drones, minimum, "separation").lower_bound_m

@@ -414,12 +414,7 @@ def problem_cost(
     residuals themselves (eq. 11, 25, 27): no cancellation of large terms.
     ``cache`` re-uses the design matrices of the assembly.
     """
-    basis, alpha = problem.basis, problem.alpha
-    smooth = 0.0
-    for order, sigma in problem.smoothness.items():
-        D = basis.derivative_map(order) @ C
-        energy = float(np.sum(D * (basis.reduced_gram(order) @ D)))
-        smooth += float(sigma * alpha ** (2 * order - 1) * energy)
+    smooth = smoothness_cost(problem, C)
     deviation = 0.0
     for term in problem.deviations:
         if isinstance(term, PointDeviation):
@@ -431,6 +426,17 @@ def problem_cost(
             diff = C[active] - w
             deviation += term.weight * float(np.sum(diff * (diff @ Q)))
     return {"smoothness": smooth, "deviation": deviation, "total": smooth + deviation}
+
+
+def smoothness_cost(problem: SmoothingProblem, C: FloatArray) -> float:
+    """The smoothness part of :func:`problem_cost` for control points ``C`` (M, d)."""
+    basis, alpha = problem.basis, problem.alpha
+    smooth = 0.0
+    for order, sigma in problem.smoothness.items():
+        D = basis.derivative_map(order) @ C
+        energy = float(np.sum(D * (basis.reduced_gram(order) @ D)))
+        smooth += float(sigma * alpha ** (2 * order - 1) * energy)
+    return smooth
 
 
 def curve_at(

@@ -69,11 +69,16 @@ class BandedSolution:
     fixed
         The problem's time-independent blocks (equality, inequality and cone
         rows), for the caller's checks of the limits.
+    deviation
+        The point deviations' cost at ``C``, ``sum_n w_n ||R_n C - p_n||^2``, from
+        the rows the solve summed (what :func:`~skyquill.optimize.assemble.problem_cost`
+        gives up to rounding, without evaluating the curve again).
     """
 
     C: FloatArray
     y: FloatArray
     fixed: _Fixed
+    deviation: float
 
 
 def banded_closed_form(
@@ -103,6 +108,7 @@ def banded_closed_form(
     first = np.concatenate([local.first for local in locals_])
     points = np.concatenate([t.points for t in terms])
     weights = np.concatenate([np.full(t.times.size, t.weight) for t in terms])
+    deviation = 0.0
     for axes in _axis_groups(terms, d):
         # Every term's rows at once (N, k + 1): one sum for the band, one per axis for F.
         rows = np.concatenate(
@@ -125,9 +131,10 @@ def banded_closed_form(
         if solved is None:
             return None
         C[:, axes], Y[:, axes] = solved
+        deviation += _deviation(first, rows, weights, points[:, axes], C[:, axes])
     if not np.all(np.isfinite(C)):
         return None
-    return BandedSolution(C, Y.ravel(), fixed)
+    return BandedSolution(C, Y.ravel(), fixed, deviation)
 
 
 def stationarity_residual(
@@ -271,6 +278,20 @@ def _pairs(k: int) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
     """The index pairs ``a <= b`` of a (k + 1)-square's upper triangle."""
     a, b = np.triu_indices(k + 1)
     return a, b
+
+
+def _deviation(
+    first: NDArray[np.intp],
+    rows: FloatArray,
+    weights: FloatArray,
+    points: FloatArray,
+    C: FloatArray,
+) -> float:
+    """``sum_n w_n ||R_n C - p_n||^2`` for the rows ``R`` (N, k + 1) at ``first``, the
+    points ``P`` (N, g) and the control points ``C`` (M, g)."""
+    gathered = C[first[:, None] + np.arange(rows.shape[1])]  # (N, k + 1, g)
+    residual = np.einsum("nr,nrg->ng", rows, gathered) - points
+    return float(weights @ np.sum(residual**2, axis=1))
 
 
 def _transpose_times(

@@ -44,7 +44,14 @@ import scipy.sparse as sp
 from numpy.typing import NDArray
 
 from skyquill.errors import InfeasibleError, InputError, SolverError
-from skyquill.optimize.assemble import Assembled, NormCones, _Fixed, assemble, problem_cost
+from skyquill.optimize.assemble import (
+    Assembled,
+    NormCones,
+    _Fixed,
+    assemble,
+    problem_cost,
+    smoothness_cost,
+)
 from skyquill.optimize.banded import banded_closed_form
 from skyquill.optimize.kkt import SingularKKTError, solve_equality_qp
 from skyquill.optimize.problem import SmoothingProblem
@@ -194,7 +201,9 @@ def solve(
     if solver not in BACKENDS:
         raise InputError(f"solver: got {solver!r}, expected one of {sorted(BACKENDS)}")
     start = time.perf_counter()
-    inside = _inside_optimum(problem, workspace) if workspace is not None else None
+    inside, deviation = (
+        _inside_optimum(problem, workspace) if workspace is not None else (None, None)
+    )
     if inside is not None:
         C, (y, z, cone_z), used, margin, asm = inside
         method: Literal["closed_form", "qp"] = "closed_form"
@@ -206,7 +215,8 @@ def solve(
         z, margin, cone_z = np.zeros(0), 0.0, None
         method = "closed_form"
     solved = (C, (y, z, cone_z), used, margin, asm)
-    return _fit_result(problem, solved, method, time.perf_counter() - start, workspace)
+    elapsed = time.perf_counter() - start
+    return _fit_result(problem, solved, method, elapsed, workspace, deviation=deviation)
 
 
 def solve_inside(problem: SmoothingProblem, workspace: Workspace) -> FitResult | None:
@@ -221,10 +231,11 @@ def solve_inside(problem: SmoothingProblem, workspace: Workspace) -> FitResult |
     if not problem.has_inequalities:
         return solve(problem, workspace=workspace)  # the closed form is the solve
     start = time.perf_counter()
-    inside = _inside_optimum(problem, workspace)
+    inside, deviation = _inside_optimum(problem, workspace)
     if inside is None:
         return None
-    return _fit_result(problem, inside, "closed_form", time.perf_counter() - start, workspace)
+    elapsed = time.perf_counter() - start
+    return _fit_result(problem, inside, "closed_form", elapsed, workspace, deviation=deviation)
 
 
 def _fit_result(
@@ -233,10 +244,18 @@ def _fit_result(
     method: Literal["closed_form", "qp"],
     elapsed: float,
     workspace: Workspace | None,
+    *,
+    deviation: float | None = None,
 ) -> FitResult:
+    """The result of ``solved``; ``deviation``: the point deviations' cost where the
+    solve already has it (the banded closed form's), else it is measured on the curve."""
     C, (y, z, cone_z), used, margin, asm = solved
     traj = SplineTrajectory(C, problem.degree, problem.duration)
-    terms = problem_cost(problem, C, workspace.assembly if workspace is not None else None)
+    if deviation is None:
+        terms = problem_cost(problem, C, workspace.assembly if workspace is not None else None)
+    else:
+        smooth = smoothness_cost(problem, C)
+        terms = {"smoothness": smooth, "deviation": deviation, "total": smooth + deviation}
     return FitResult(
         traj,
         method,
@@ -256,8 +275,11 @@ def _fit_result(
     )
 
 
-def _inside_optimum(problem: SmoothingProblem, workspace: Workspace) -> _Solved | None:
-    """The minimiser subject to the equalities, if it meets every inequality exactly.
+def _inside_optimum(
+    problem: SmoothingProblem, workspace: Workspace
+) -> tuple[_Solved | None, float | None]:
+    """The minimiser subject to the equalities, if it meets every inequality exactly,
+    and its point deviations' cost where the banded closed form found it.
 
     A relaxation's optimum that is feasible is optimal, and no inequality
     holds it, so every inequality and cone multiplier is 0. Exactly: ``G x <=
@@ -266,27 +288,28 @@ def _inside_optimum(problem: SmoothingProblem, workspace: Workspace) -> _Solved 
     equalities alone do not determine the point (the QP route decides).
     """
     if not problem.has_inequalities:
-        return None
+        return None, None
     fast = banded_closed_form(problem, workspace.assembly)
     blocks: Assembled | _Fixed
+    deviation = None
     if fast is not None:
-        C, y, used, blocks = fast.C, fast.y, BANDED, fast.fixed
+        C, y, used, blocks, deviation = fast.C, fast.y, BANDED, fast.fixed, fast.deviation
     else:
         asm = workspace.assemble(problem)
         try:
             C, y = _closed_form_kkt(asm)
         except SingularKKTError:
-            return None
+            return None, None
         used, blocks = "sparse-lu", asm
     x = C.ravel()
     if not np.all(np.isfinite(x)) or np.any(blocks.G_ineq @ x > blocks.h_ineq):
-        return None
+        return None, None
     cone_z = None
     if blocks.cones is not None:
         if np.any(blocks.cones.norms(x) > blocks.cones.radius):
-            return None
+            return None, None
         cone_z = np.zeros(blocks.cones.radius.size * (problem.dim + 1))
-    return C, (y, np.zeros(blocks.G_ineq.shape[0]), cone_z), used, 0.0, blocks
+    return (C, (y, np.zeros(blocks.G_ineq.shape[0]), cone_z), used, 0.0, blocks), deviation
 
 
 def _equality_optimum(

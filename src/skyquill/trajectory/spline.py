@@ -86,9 +86,16 @@ class SplineTrajectory:
         return self.knot_times
 
     @cached_property
-    def _splines(self) -> tuple[BSpline, ...]:
-        base = BSpline(self.basis.knots / self.alpha, self.control_points, self.degree)
-        return (base, *(base.derivative(n) for n in range(1, self.degree + 1)))
+    def _splines(self) -> dict[int, BSpline]:
+        """The curve (key 0) and the derivatives asked for so far (:meth:`_spline`)."""
+        return {0: BSpline(self.basis.knots / self.alpha, self.control_points, self.degree)}
+
+    def _spline(self, order: int) -> BSpline:
+        """The ``order``-th derivative as a BSpline, built on first use: the fidelity
+        checks of a writing plan ask for positions and accelerations only."""
+        if order not in self._splines:
+            self._splines[order] = self._splines[0].derivative(order)
+        return self._splines[order]
 
     def evaluate(self, t: FloatArray, order: int = 0) -> FloatArray:
         """The ``order``-th time derivative at times ``t``.
@@ -108,7 +115,7 @@ class SplineTrajectory:
         as_int("order", order, low=0)
         if order > self.degree:
             return np.zeros((times.size, self.dim))
-        return np.asarray(self._splines[order](times), dtype=float).reshape(times.size, self.dim)
+        return np.asarray(self._spline(order)(times), dtype=float).reshape(times.size, self.dim)
 
     def sample(self, rate: float) -> Samples:
         """Samples at ``rate`` Hz (position to jerk), including both ends."""
@@ -169,6 +176,6 @@ class SplineTrajectory:
         breaks = self.knot_times
         left = breaks[:-1]
         coeffs = np.stack(
-            [self._splines[j](left) / math.factorial(j) for j in range(self.degree + 1)], axis=1
+            [self._spline(j)(left) / math.factorial(j) for j in range(self.degree + 1)], axis=1
         )
         return breaks, np.asarray(coeffs, dtype=float)

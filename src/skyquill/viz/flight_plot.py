@@ -55,6 +55,8 @@ def _draw(fig: Figure, flight: Flight, title: str) -> None:
         panel.plot(t, flight.p_ref[:, i], "--", lw=1.2, color="0.45", label="reference")
         panel.plot(t, flight.p[:, i], "-", lw=1.0, color="C0", label="flown")
         panel.set_ylabel(f"{axis} [m]")
+        # A hover at 1 m would read "+1" above ticks of 0.0000..0.0006: show the heights.
+        panel.ticklabel_format(axis="y", useOffset=False)
     axes[0].set_title("position and error against time")
     axes[0].legend(loc="upper right", fontsize=8, ncols=2)
 
