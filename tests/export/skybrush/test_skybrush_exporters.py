@@ -310,3 +310,29 @@ def test_the_show_read_back_by_the_export_is_the_file_as_check_loads_it(
     for a, b in zip(shared, loaded, strict=True):
         t = dense_times(b.trajectory.breakpoints)
         np.testing.assert_array_equal(a.trajectory.evaluate(t), b.trajectory.evaluate(t))
+
+
+def test_the_check_of_the_file_is_the_check_of_what_it_plays(
+    plans: list[NamedPlan], tmp_path: Path
+) -> None:
+    """The exporter takes the check made before writing only where the file plays the very
+    same polynomials; it equals checking the file's trajectories again, and a drone whose
+    file plays anything else is checked again."""
+    from skyquill.export.base import check_delivered
+    from skyquill.export.skybrush import skyc_exporter
+    from skyquill.export.skybrush.playback import played_show
+    from skyquill.export.skybrush.refit import played_keyframes
+
+    report, show = skyc_exporter.SkycExporter().export(plans, tmp_path / "yong", ExportOptions())
+    back = [p.trajectory() for p in played_show(show)]
+    made = [played_keyframes(name, plan) for name, plan in plans]
+    assert all(skyc_exporter._same(m.played, b) for m, b in zip(made, back, strict=True))
+    again = [check_delivered(n, p, b) for (n, p), b in zip(plans, back, strict=True)]
+    assert list(report.delivered) == again
+    # a file that plays 1 mm off on the first drone: that drone is checked on what it plays
+    coeffs = back[0].coeffs.copy()
+    coeffs[:, 0, 0] += 1e-3
+    moved = type(back[0])(back[0].breaks, coeffs)
+    checks = skyc_exporter._delivered(plans, made, [moved, back[1]], 1, None)
+    assert checks[0] == check_delivered(plans[0][0], plans[0][1], moved) != again[0]
+    assert checks[1] == again[1]
