@@ -178,3 +178,34 @@ def test_the_fast_reader_reads_what_the_row_by_row_reader_reads(
         t, positions, colors = fast
         assert np.array_equal(t, checked.t_ms) and np.array_equal(colors, checked.colors)
         assert np.array_equal(positions, checked.positions)
+
+
+@given(
+    st.lists(
+        st.tuples(
+            st.integers(-(2**53), 2**53),
+            st.floats(-1e5, 1e5),
+            st.floats(-1e5, 1e5),
+            st.floats(-1e5, 1e5),
+            st.integers(0, 255),
+            st.integers(0, 255),
+            st.integers(0, 255),
+        ),
+        min_size=1,
+        max_size=20,
+    )
+)
+@settings(max_examples=100, deadline=None)
+def test_the_rows_formatted_at_once_are_the_rows_formatted_one_by_one(
+    rows: list[tuple[int, float, float, float, int, int, int]],
+) -> None:
+    """One ``%`` call for all rows writes what formatting each row with an f-string writes."""
+    table = np.array(rows, dtype=object)
+    one = CsvDrone(
+        "d",
+        table[:, 0].astype(np.int64),
+        table[:, 1:4].astype(float),
+        table[:, 4:].astype(np.int64),
+    )
+    by_row = "".join(f"{t},{x:.6f},{y:.6f},{z:.6f},{r},{g},{b}\n" for t, x, y, z, r, g, b in rows)
+    assert skybrush_csv._csv_text(one) == ",".join(HEADER) + "\n" + by_row
