@@ -14,11 +14,11 @@ velocity ``D1``, acceleration ``D2`` and jerk ``D3`` on the grid) rounded down, 
 more either way, which moves its end point by a few units where the curve must be held back
 (a 200 ms segment at ``amax = 1`` needs a second difference of 6.67 units: 6, and the end
 two units behind, which the next segment takes up). Every combination of the three axes is
-tried at once (the norms couple them). Of those inside the limits the one nearest the curve
-wins, with the velocity and acceleration steps at its joins counted like distances (so the
-joins stay as close to C2 as the grid allows). A segment for which no combination is inside
-is left at its least excess and reported (``unresolved``): the exporter then refits
-(:mod:`.refit`).
+tried (the norms couple them): the :data:`NEAREST` cheapest first, then all at once. Of those
+inside the limits the one nearest the curve wins, with the velocity and acceleration steps
+at its joins counted like distances (so the joins stay as close to C2 as the grid allows).
+A segment for which no combination is inside is left at its least excess and reported
+(``unresolved``): the exporter then refits (:mod:`.refit`).
 """
 
 from __future__ import annotations
@@ -46,6 +46,9 @@ TARGETS = (tuple(0.8 * ALLOWED_EXCESS[n] for n in (1, 2, 3)),)
 #: Tried in this order: second and third differences down or up (12 options per axis), then
 #: one more either way (48).
 SEARCH_STEPS = (((-1.0, 0.0, 1.0), (0.0, 1.0)), ((-1.0, 0.0, 1.0), (-1.0, 0.0, 1.0, 2.0)))
+#: How many of the cheapest combinations are evaluated first (of up to 8,000 in the first
+#: step, 512,000 in the second): the cheapest inside is usually among them.
+NEAREST = 64
 
 
 @dataclass(frozen=True)
@@ -134,35 +137,75 @@ class _Grid:
 
         Each axis' options are its forward differences ``D1, D2, D3`` (the start velocity,
         acceleration and jerk on the grid) near the exact ones; what they cost (distance,
-        join steps) adds over the axes, and the limits are evaluated on every combination of
-        the three axes by broadcasting, so 48^3 combinations cost a few milliseconds.
+        join steps) adds over the axes. The cheapest combination inside the limits is looked
+        for among the :data:`NEAREST` cheapest first (and every combination as cheap as
+        they), then among all of them; the limits are evaluated by broadcasting, so 48^3
+        combinations cost a few milliseconds.
         """
-        tried: dict[int, tuple[list[_AxisOptions], FloatArray]] = {}
+        tried: dict[int, list[_AxisOptions]] = {}
+        options: list[_AxisOptions] = []
         for target in self.targets:
             for i, steps in enumerate(SEARCH_STEPS):  # a few options first, then all of them
                 if i not in tried:
-                    options = [self._axis_options(k, ax, *steps) for ax in range(3)]
-                    tried[i] = (options, self._combined_excess(options, self.h[k]))
-                options, excess = tried[i]
-                worst = (excess - target).max(axis=-1)
-                if (worst <= 0).any():
-                    self._take(k, options, worst)
+                    tried[i] = [self._axis_options(k, ax, *steps) for ax in range(3)]
+                options = tried[i]
+                flat = self._cheapest_inside(options, self.h[k], target)
+                if flat is not None:
+                    self._set(k, options, flat)
                     return True
-        self._take(k, options, worst)
+        # none inside: the least excess
+        worst = (self._combined_excess(options, self.h[k]) - self.targets[-1]).max(axis=-1)
+        self._set(k, options, int(np.argmin(worst.ravel())))
         return False
 
-    def _take(self, k: int, options: list[_AxisOptions], worst: FloatArray) -> None:
-        """Set segment ``k`` to the cheapest combination inside (``worst <= 0``), else to the
-        one with the least excess."""
-        cost = sum(
-            o.cost.reshape([-1 if a == ax else 1 for a in range(3)]) for ax, o in enumerate(options)
-        )
-        inside = (worst <= 0).ravel()
-        if inside.any():
-            flat = int(np.flatnonzero(inside)[np.argmin(np.asarray(cost).ravel()[inside])])
-        else:
-            flat = int(np.argmin(worst.ravel()))
-        pick = np.unravel_index(flat, worst.shape)
+    def _cheapest_inside(
+        self, options: list[_AxisOptions], h: float, target: FloatArray
+    ) -> int | None:
+        """The flat ("ij") index of the cheapest combination inside ``target`` (the first of
+        equal costs), or ``None``.
+
+        Looked for first among the combinations that cost at most the :data:`NEAREST`-th
+        cheapest: every combination outside costs more than each inside, so if one there is
+        inside, the cheapest inside overall is among them (the same pick as evaluating all).
+        """
+        cost = np.asarray(
+            sum(
+                o.cost.reshape([-1 if a == ax else 1 for a in range(3)])
+                for ax, o in enumerate(options)
+            )
+        ).ravel()
+        if cost.size > NEAREST:
+            near = np.flatnonzero(cost <= np.partition(cost, NEAREST - 1)[NEAREST - 1])
+            flat = self._first_inside(options, h, target, near, cost)
+            if flat is not None:
+                return flat
+        return self._first_inside(options, h, target, np.arange(cost.size), cost)
+
+    def _first_inside(
+        self,
+        options: list[_AxisOptions],
+        h: float,
+        target: FloatArray,
+        flat: NDArray[np.intp],
+        cost: FloatArray,
+    ) -> int | None:
+        """Of the combinations ``flat`` (increasing flat indices), the cheapest inside."""
+        pick = np.unravel_index(flat, [len(o.points) for o in options])
+        parts = [
+            hull_points(o.points[pick[ax], :, None] * self.unit_m, np.full(flat.size, h))
+            for ax, o in enumerate(options)
+        ]
+        worst = np.full((flat.size, 4), -np.inf)
+        for lim in self.limits:
+            comps = [parts[ax][lim.order][..., 0] for ax in range(3)]
+            order = worst[..., lim.order]
+            worst[..., lim.order] = np.maximum(order, _limit_excess(lim, comps))
+        inside = flat[(worst - target).max(axis=-1) <= 0]
+        return int(inside[np.argmin(cost[inside])]) if inside.size else None
+
+    def _set(self, k: int, options: list[_AxisOptions], flat: int) -> None:
+        """Set segment ``k`` to the combination of flat ("ij") index ``flat``."""
+        pick = np.unravel_index(flat, [len(o.points) for o in options])
         for ax, o in enumerate(options):
             self.units[k, :, ax] = o.points[pick[ax]]
         if k + 1 < self.h.size:
