@@ -268,7 +268,8 @@ def _gram_band(
     k = rows.shape[1] - 1
     a, b = _pairs(k)
     products = weights[:, None] * rows[:, a] * rows[:, b]
-    where = (k + a - b) * M + (first[:, None] + b)
+    # Each pair's flat offset computed once (k + 1 choose 2 entries), then one add per row.
+    where = first[:, None] + ((k + a - b) * M + b)
     sums = np.bincount(where.ravel(), weights=products.ravel(), minlength=(k + 1) * M)
     return np.asarray(sums.reshape(k + 1, M))
 
