@@ -104,7 +104,7 @@ def banded_closed_form(
     F = np.zeros((M, d))
     C = np.zeros((M, d))
     Y = np.zeros((fixed.E.shape[0], d))
-    E = fixed.E.toarray()
+    E = cache.kept("dense equality rows", (fixed,), (), fixed.E.toarray)  # per route, not solve
     first = np.concatenate([local.first for local in locals_])
     points = np.concatenate([t.points for t in terms])
     weights = np.concatenate([np.full(t.times.size, t.weight) for t in terms])
