@@ -102,3 +102,11 @@ def test_the_phases_are_recorded_and_a_mission_below_the_minimum_altitude_refuse
     assert planned.phases is not None and planned.phases.as_dict() == drone["phases"]
     with pytest.raises(InfeasibleError, match=r"min_altitude_m: got a plan that never rests"):
         _write(tmp_path / "low", min_altitude_m=1.5)
+
+
+def test_files_written_by_worker_processes_are_the_ones_written_here(tmp_path: Path) -> None:
+    here = _write(tmp_path / "here", n=5)
+    there = _write(tmp_path / "there", n=5, workers=2)
+    assert there == here
+    for name in sorted(p.name for p in (tmp_path / "here").iterdir()):
+        assert (tmp_path / "there" / name).read_bytes() == (tmp_path / "here" / name).read_bytes()

@@ -5,6 +5,7 @@ from __future__ import annotations
 import os
 import tempfile
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -203,3 +204,60 @@ def test_random_text_gives_input_error_or_a_table(
         path = Path(tmp) / "r.csv"
         path.write_bytes("\n".join([header, *rows]).encode(encoding, errors="surrogatepass"))
         check_outcome(path)
+
+
+PLAIN_CELL = st.one_of(
+    st.text(alphabet="0123456789eE.+- \t", max_size=8),
+    st.floats(allow_nan=False, allow_infinity=False).map(repr),
+    st.floats(allow_nan=False, allow_infinity=False).map(lambda v: f"{v:.9g}"),
+    st.sampled_from(["1e400", "-1e999", "", " ", "1,", "\r"]),
+)
+
+
+@settings(max_examples=300, deadline=None)
+@given(
+    header=st.sampled_from(["x,y", "y,x,t", "X, Y ,T,note", "x,x,y", "a", '"x",y']),
+    rows=st.lists(st.lists(PLAIN_CELL, min_size=1, max_size=5).map(",".join), max_size=6),
+    end=st.sampled_from(["", "\n", "\n\n"]),
+)
+def test_the_one_call_reading_is_the_row_by_row_reading(
+    header: str, rows: list[str], end: str
+) -> None:
+    """A file the one NumPy call reads gives the table the row-by-row reader gives, bit for
+    bit, or the same refusal (the one call leaves everything else to the row reader)."""
+    lines = ("\n".join([header, *rows]) + end).splitlines(keepends=True)
+    wanted = table_module._Wanted(("x", "y"), ("t",), "ignore")
+
+    def outcome(read: Any) -> Any:
+        try:
+            return read()
+        except InputError as exc:
+            return str(exc)
+
+    plain = outcome(lambda: table_module._parse_plain("r.csv", lines, wanted, 0))
+    if plain is None:
+        return
+    rows_read = outcome(lambda: table_module._parse_rows("r.csv", iter(lines), wanted, 0, 10))
+    if isinstance(plain, str):
+        assert plain == rows_read
+        return
+    assert rows_read.columns == plain.columns
+    assert rows_read.data.tobytes() == plain.data.tobytes()
+    np.testing.assert_array_equal(rows_read.lines, plain.lines)
+    assert not plain.data.flags.writeable
+
+
+def test_a_plain_file_is_read_in_one_call_and_anything_else_row_by_row(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    calls: list[str] = []
+    rows = table_module._parse_rows
+    monkeypatch.setattr(table_module, "_parse_rows", lambda *a: calls.append("rows") or rows(*a))
+    plain = write(tmp_path, "t,x,y\n0,1.5,-2e-3\n0.1, 2 ,\t3\n", "plain.csv")
+    table = read_table(plain, required=("x", "y"), optional=("t",))
+    np.testing.assert_array_equal(table.data, [[1.5, -2e-3, 0.0], [2.0, 3.0, 0.1]])
+    np.testing.assert_array_equal(table.lines, [2, 3])
+    assert calls == []
+    for text in ("t,x,y\n0,1,2\n\n0,1,2\n", 't,x,y\n0,"1",2\n', "t,x,y\r\n0,1,2\r\n"):
+        read_table(write(tmp_path, text, "other.csv"), required=("x", "y"))
+    assert calls == ["rows"] * 3

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import time
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Annotated, Any
 
@@ -26,12 +26,13 @@ from skyquill.cli.pictures import NoPictures, Pictures
 from skyquill.errors import InfeasibleError, InputError
 from skyquill.io.atomic import write_json
 from skyquill.io.outputs import staged_output
-from skyquill.io.plan_dir import trajectory_names, write_plan
+from skyquill.io.plan_dir import trajectory_names, with_phases, write_plan
 from skyquill.io.points import check_rows_written
 from skyquill.io.trajectory_json import PlannedTrajectory
 from skyquill.phases import MIN_ALTITUDE_M
-from skyquill.show import ShowDrone, ShowLimits, ShowReport, check_show, load_show
+from skyquill.show import ShowDrone, ShowLimits, ShowReport, check_show
 from skyquill.show.build import ShowPlan, build_show
+from skyquill.show.load import skyc_drones
 from skyquill.show.script import ShowScript, load_script
 
 #: Relative round-off allowed over the planned limits in the independent check
@@ -46,11 +47,18 @@ def show(
     script: Annotated[Path, typer.Argument(metavar="SHOW", help="Show script (TOML).")],
     out: OutDir,
     workers: Annotated[
-        int | None, typer.Option(help="Processes planning the writing (default: CPUs).")
+        int | None,
+        typer.Option(
+            help="Processes planning the writing, making the .skyc and Skybrush CSV and writing "
+            "the files (default: CPUs)."
+        ),
     ] = None,
     scheduler: Annotated[
         str | None,
-        typer.Option(help="dask.distributed scheduler address (or 'local') for the writing."),
+        typer.Option(
+            help="dask.distributed scheduler address (or 'local') for the writing, the .skyc "
+            "and the Skybrush CSV."
+        ),
     ] = None,
     min_altitude_m: MinAltitude = MIN_ALTITUDE_M,
     force: Force = False,
@@ -77,7 +85,8 @@ def show(
         stages["check"] = time.perf_counter() - clock
         with staged_output(out, "show", force=force, inputs=[script]) as stage:
             drawn = Pictures(not no_pictures)
-            summary = _write(stage, plan, show_script, report, stages, drawn, floor)
+            where = _Where(workers, scheduler)
+            summary = _write(stage, plan, show_script, report, stages, drawn, floor, where)
     say_done(
         f"{out}: {summary['drones']} drones, {summary['duration_s']:.1f} s, no two closer than "
         f"{summary['min_separation_m']['guaranteed']:.3f} m (guaranteed; "
@@ -85,6 +94,15 @@ def show(
         f"{summary['skyc']['as_played']['verdict']} (skyc.as_played in summary.json), in "
         f"{sum(summary['planning_time_s'].values()):.1f} s"
     )
+
+
+@dataclass(frozen=True)
+class _Where:
+    """Where the per-drone work runs: ``--workers`` processes, or the ``--scheduler``
+    (the writing, the .skyc and the Skybrush CSV; the files are written by local processes)."""
+
+    workers: int | None
+    scheduler: str | None
 
 
 def _plan(script: ShowScript, workers: int | None, scheduler: str | None) -> ShowPlan:
@@ -136,16 +154,22 @@ def _write(
     stages: dict[str, float],
     drawn: Pictures,
     min_altitude_m: float,
+    where: _Where,
 ) -> dict[str, Any]:
     from skyquill.viz.light_painting import write_pictures
 
+    # Each flight's phases found once, at the floor asked for: the exports and the plan
+    # files all use them (as `skyquill export` reads them back from trajectory.json).
+    clock = time.perf_counter()
+    plan = replace(plan, drones=tuple(with_phases(d, min_altitude_m) for d in plan.drones))
+    stages["phases"] = time.perf_counter() - clock
     plans = _named(plan)
     names = [name for name, _ in plans]
     clock = time.perf_counter()
-    skyc = _skyc(stage, plans, script)
+    skyc = _skyc(stage, plans, script, where)
     stages["skyc"] = time.perf_counter() - clock
     clock = time.perf_counter()
-    studio = _studio_csv(stage, plans, script)
+    studio = _studio_csv(stage, plans, script, where)
     stages["skybrush_csv"] = time.perf_counter() - clock
     if drawn.drawn:
         with drawn.timing("long_exposure.png", "preview.gif"):
@@ -190,6 +214,7 @@ def _write(
         guaranteed=True,
         summary=summary,
         min_altitude_m=min_altitude_m,
+        workers=where.workers,  # the files are written here, never on a remote cluster
     )
     full["planning_time_s"]["files"] = time.perf_counter() - clock
     write_json(stage / "summary.json", full)
@@ -197,13 +222,14 @@ def _write(
 
 
 def _studio_csv(
-    stage: Path, plans: list[tuple[str, PlannedTrajectory]], script: ShowScript
+    stage: Path, plans: list[tuple[str, PlannedTrajectory]], script: ShowScript, where: _Where
 ) -> dict[str, Any]:
     """Write ``show.zip``, Skybrush Studio's per-drone CSVs, read back as Studio reads them."""
     from skyquill.export.base import ExportOptions
     from skyquill.export.skybrush.csv_exporter import SkybrushCsvExporter
 
-    exported = SkybrushCsvExporter()(plans, stage / "show", ExportOptions(script.rate_hz))
+    exporter = SkybrushCsvExporter(workers=where.workers, scheduler=where.scheduler)
+    exported = exporter(plans, stage / "show", ExportOptions(script.rate_hz))
     return {
         "file": "show.zip",
         "max_error_m": exported.max_error_m,
@@ -213,7 +239,7 @@ def _studio_csv(
 
 
 def _skyc(
-    stage: Path, plans: list[tuple[str, PlannedTrajectory]], script: ShowScript
+    stage: Path, plans: list[tuple[str, PlannedTrajectory]], script: ShowScript, where: _Where
 ) -> dict[str, Any]:
     """Write ``show.skyc``, load it back as the drones play it and check it again.
 
@@ -228,8 +254,10 @@ def _skyc(
     from skyquill.export.base import ALLOWED_EXCESS, ExportOptions
     from skyquill.export.skybrush.skyc_exporter import SkycExporter
 
-    exported = SkycExporter()(plans, stage / "show", ExportOptions())
-    played = load_show([stage / "show.skyc"])
+    exporter = SkycExporter(workers=where.workers, scheduler=where.scheduler)
+    exported, show_json = exporter.export(plans, stage / "show", ExportOptions())
+    # as `skyquill check show.skyc` loads it, from the show.json the exporter read back
+    played = skyc_drones(show_json, "show.skyc")
     allowed = max(0.0, script.safety_m - 2.0 * exported.max_error_m)
     limits = replace(check_limits(script), tolerance=ALLOWED_EXCESS[2])
     back = check_show(played, allowed, limits)

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import replace
+from functools import partial
 from pathlib import Path
 from typing import Any
 
@@ -37,6 +38,7 @@ from skyquill.io.trajectory_json import (
     read_trajectory_json,
     write_trajectory_json,
 )
+from skyquill.parallel import parallel_map
 from skyquill.phases import MIN_ALTITUDE_M, flight_phases
 from skyquill.trajectory import SampledTrajectory, Trajectory, sample
 from skyquill.verify import verify
@@ -63,6 +65,7 @@ def write_plan(
     summary: dict[str, Any],
     plot: Callable[[Path], None] | None = None,
     min_altitude_m: float | None = MIN_ALTITUDE_M,
+    workers: int | None = 1,
 ) -> dict[str, Any]:
     """Write the plan directory ``out`` and return the ``summary.json`` written.
 
@@ -99,12 +102,13 @@ def write_plan(
         if p.trajectory.dim != 3:
             raise InputError(f"planned[{i}]: got {p.trajectory.dim} axes, expected 3 (x, y, z)")
     if min_altitude_m is not None:
-        planned = [_with_phases(p, min_altitude_m) for p in planned]
+        planned = [with_phases(p, min_altitude_m) for p in planned]
     out.mkdir(parents=True, exist_ok=True)
-    drones = [
-        _write_drone(out, names, p, rate, guaranteed)
-        for names, p in zip(trajectory_names(len(planned)), planned, strict=True)
-    ]
+    drones = parallel_map(
+        partial(_write_drone, out, rate=rate, guaranteed=guaranteed),
+        list(zip(trajectory_names(len(planned)), planned, strict=True)),
+        workers=workers,
+    )
     if plot is not None:
         with atomic_path(out / "plot.png") as tmp:
             plot(tmp)
@@ -123,8 +127,14 @@ def write_plan(
     return full
 
 
-def _with_phases(planned: PlannedTrajectory, min_altitude_m: float) -> PlannedTrajectory:
-    """``planned`` with its phases (found at ``min_altitude_m`` unless it has them)."""
+def with_phases(planned: PlannedTrajectory, min_altitude_m: float) -> PlannedTrajectory:
+    """``planned`` with its phases (found at ``min_altitude_m`` unless it has them).
+
+    Raises
+    ------
+    InfeasibleError
+        A mission that goes below ``min_altitude_m``.
+    """
     if planned.phases is not None:
         return planned
     return replace(planned, phases=flight_phases(planned.trajectory, min_altitude_m))
@@ -132,12 +142,13 @@ def _with_phases(planned: PlannedTrajectory, min_altitude_m: float) -> PlannedTr
 
 def _write_drone(
     out: Path,
-    names: tuple[str, str],
-    planned: PlannedTrajectory,
+    drone: tuple[tuple[str, str], PlannedTrajectory],
+    *,
     rate: float,
     guaranteed: bool,
 ) -> dict[str, Any]:
-    csv_name, json_name = names
+    """Write one drone's ``(csv, json)`` files, read them back and check what was written."""
+    (csv_name, json_name), planned = drone
     check_rows_written(planned.trajectory.duration, rate)  # its read-back would refuse more
     write_trajectory_json(out / json_name, planned)
     s = sample(planned.trajectory, rate)

@@ -21,9 +21,12 @@ character or row too many is read, so a huge file is never read whole).
 from __future__ import annotations
 
 import csv
+import io
+import re
 from array import array
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
+from itertools import chain, islice
 from pathlib import Path
 from typing import Any, Literal, TextIO
 
@@ -31,7 +34,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from skyquill.errors import InputError
-from skyquill.io.numbers import parse_number
+from skyquill.io.numbers import MAX_CHARS, parse_number
 from skyquill.io.source import open_text
 from skyquill.validation import FloatArray
 
@@ -175,6 +178,67 @@ class _Wanted:
 
 def _parse(name: str, text: Iterator[str], wanted: _Wanted, min_rows: int, max_rows: int) -> Table:
     """Header, then the rows; stops at the first refusal."""
+    # At most a header and max_rows lines are held at once: a longer file is read row by row
+    # and refused at its first row too many.
+    head = list(islice(text, max_rows + 2))
+    plain = None if len(head) > max_rows + 1 else _parse_plain(name, head, wanted, min_rows)
+    if plain is not None:
+        return plain
+    return _parse_rows(name, chain(head, text), wanted, min_rows, max_rows)
+
+
+#: Everything a plain numeric table may hold: a character outside this set sends the file
+#: through the row-by-row reader (which names what is wrong, or reads quoted cells).
+_NOT_PLAIN = re.compile(r"[^0-9eE.+\-, \t\n]", re.ASCII)
+
+
+def _parse_plain(name: str, lines: list[str], wanted: _Wanted, min_rows: int) -> Table | None:
+    """The table of a plain file in one NumPy call, or ``None`` to read it row by row.
+
+    A plain file (what skyquill writes: a header on line 1, then rows of numbers with
+    one cell per header column, no quotes, blank lines or carriage returns, every line
+    shorter than a literal may be) is read by :func:`numpy.loadtxt`, whose C parser takes
+    Python's own decimal conversion: the same floats as :func:`_parse_rows`, bit for bit.
+    Within the characters allowed here (digits, ``eE.+-``, spaces and tabs) a cell that
+    converts is exactly a literal of :mod:`skyquill.io.numbers` (there is no ``_``, ``inf``
+    or ``nan`` to spell); a cell that does not, a ragged row or a value that overflows
+    sends the file to :func:`_parse_rows`, which refuses it by name.
+    """
+    if len(lines) < 2 or '"' in lines[0] or not lines[0].strip():
+        return None
+    header = [h.strip().lower() for h in next(csv.reader(lines[:1]))]
+    data = lines[1:]
+    if len(data) < min_rows:
+        return None
+    body = "".join(data)
+    commas = len(header) - 1
+    plain = _NOT_PLAIN.search(body) is None and all(
+        len(line) <= MAX_CHARS and line.count(",") == commas and line.strip() for line in data
+    )
+    if not plain:
+        return None
+    columns = _check_header(name, header, wanted)
+    try:
+        values = np.loadtxt(
+            io.StringIO(body),
+            delimiter=",",
+            comments=None,
+            usecols=[header.index(c) for c in columns],
+            ndmin=2,
+            dtype=float,
+        )
+    except ValueError:
+        return None
+    if not np.isfinite(values).all():
+        return None
+    values.setflags(write=False)
+    return Table(name, columns, values, _frozen(array("q", range(2, len(data) + 2))))
+
+
+def _parse_rows(
+    name: str, text: Iterator[str], wanted: _Wanted, min_rows: int, max_rows: int
+) -> Table:
+    """Header, then the rows one by one (any CSV); stops at the first refusal."""
     reader = csv.reader(text)
     values: array[float] = array("d")
     lines: array[int] = array("q")

@@ -101,16 +101,24 @@ def _read(path: Path, room: int | None = None) -> list[ShowDrone]:
 def _read_skyc(path: Path, room: int | None = None) -> list[ShowDrone]:
     """The drones of a ``.skyc`` as their firmware plays them, on the show's clock."""
     show = read_show_json(path)
-    drones: list[Any] = show["swarm"]["drones"]
-    if room is not None and len(drones) > room:
+    count = len(show["swarm"]["drones"])
+    if room is not None and count > room:
         raise InputError(
-            f"PATH: got {path.name} of {len(drones):,} drones, expected at most {room:,} more "
+            f"PATH: got {path.name} of {count:,} drones, expected at most {room:,} more "
             "in one check (check the show in parts of fewer drones)"
         )
+    return skyc_drones(show, path.name)
+
+
+def skyc_drones(show: dict[str, Any], file_name: str) -> list[ShowDrone]:
+    """The drones of a ``.skyc``'s validated ``show.json`` (read by
+    :func:`~skyquill.export.skybrush.skyc_file.read_show_json`) as their firmware plays
+    them, on the show's clock; named ``<file_name>/<drone>``."""
+    drones: list[Any] = show["swarm"]["drones"]
     starts = [_firmware_zero(d["settings"]["trajectory"]) for d in drones]
     first = min(starts)  # a takeoff before the first keyframe moves the show's 0 earlier
     return [
-        ShowDrone(traj, f"{path.name}/{_name(i, d)}", start - first)
+        ShowDrone(traj, f"{file_name}/{_name(i, d)}", start - first)
         for i, (traj, d, start) in enumerate(
             zip(show_trajectories(show), drones, starts, strict=True)
         )

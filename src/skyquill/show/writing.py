@@ -16,10 +16,11 @@ from typing import cast
 import numpy as np
 
 from skyquill.calligraphy.board import Board, sky_board
-from skyquill.calligraphy.mission import WritingOptions
+from skyquill.calligraphy.mission import WritingOptions, check_reach, offset_trajectory
 from skyquill.calligraphy.show import Job, Progress, plan_jobs
 from skyquill.errors import InputError
 from skyquill.show.script import ShowScript, WriteScene
+from skyquill.strokes import Strokes
 from skyquill.trajectory import Trajectory
 from skyquill.validation import FloatArray
 
@@ -101,13 +102,50 @@ def plan_writing_scene(
     parts = typed_parts(scene.text, count, scene.font)
     options = WritingOptions(size_m=scene.size_m, limits=script.limits)
     boards = writing_boards(count, scene, script.safety_m)
+    first = first_alike(parts, boards)
+    for board in boards:
+        check_reach(board, options)  # as plan_writing would for each board planned
+    planned = sorted(set(first))
     # home=None: each flight starts and ends hovering at its board (plan_writing takes
     # it; calligraphy.show.Job's annotation says FloatArray).
-    jobs = [cast(Job, (p, b, options, None)) for p, b in zip(parts, boards, strict=True)]
-    missions = plan_jobs(jobs, workers, scheduler, progress)
-    flights = tuple(m.vehicle_trajectory() for m in missions)
+    jobs = [cast(Job, (parts[k], boards[k], options, None)) for k in planned]
+    missions = dict(zip(planned, plan_jobs(jobs, workers, scheduler, progress), strict=True))
+    flights = tuple(
+        offset_trajectory(missions[k].vehicle_trajectory(), board.origin - boards[k].origin)
+        if k != i
+        else missions[k].vehicle_trajectory()
+        for i, (k, board) in enumerate(zip(first, boards, strict=True))
+    )
     return Writing(
         flights,
-        tuple(m.pen_windows for m in missions),
+        tuple(missions[k].pen_windows for k in first),
         np.array([f.evaluate(np.zeros(1))[0] for f in flights]),
     )
+
+
+def first_alike(parts: list[Strokes], boards: list[Board]) -> list[int]:
+    """For each writer, the first writer whose flight is the same up to a translation.
+
+    Two writers write the same flight, moved, when they write the same strokes (the same
+    points, timestamps and layout box: the same glyph at the one scale of the scene) on
+    boards of the same kind, pose and lift (sky boards differ only in ``origin``). The
+    planner works in world coordinates, so its flight for the second writer is the first
+    one's moved by the difference of the origins to floating-point round-off (limits,
+    timing and fidelity do not depend on where a board is); the show's check then proves
+    the moved flights like any other. SKY QUILL's letters repeat: 40 writers write 20
+    distinct letters.
+    """
+    seen: dict[tuple[object, ...], int] = {}
+    first = []
+    for i, (part, board) in enumerate(zip(parts, boards, strict=True)):
+        key = (
+            tuple(p.tobytes() for p in part.paths),
+            None if part.times is None else tuple(t.tobytes() for t in part.times),
+            None if part.box is None else np.asarray(part.box).tobytes(),
+            board.kind,
+            board.lift_m,
+            board.yaw_deg,
+            board.tilt_deg,
+        )
+        first.append(seen.setdefault(key, i))
+    return first

@@ -340,7 +340,11 @@ def _trail_pixels(
 
 def _palette(colors: FloatArray) -> Image.Image:
     """A P-mode image whose palette holds black, dark, the stamp and every light colour."""
-    lights = np.unique(np.clip(np.round(255 * colors.reshape(-1, 3)), 0, 255), axis=0)
+    # unique colours as packed 24-bit integers (a 1-D unique: np.unique(axis=0) sorts rows
+    # of the whole show's samples one by one, 4 s at 250 drones); same rows, same order
+    rgb = np.clip(np.round(255 * colors.reshape(-1, 3)), 0, 255).astype(np.int64)
+    packed = np.unique((rgb[:, 0] << 16) | (rgb[:, 1] << 8) | rgb[:, 2])
+    lights = np.column_stack([packed >> 16, (packed >> 8) & 255, packed & 255]).astype(float)
     fixed = np.array([(0, 0, 0), [round(255 * c) for c in DARK], STAMP], dtype=float)
     every = np.unique(np.concatenate([fixed, lights]), axis=0)[:256].astype(np.uint8)
     flat = np.zeros(768, dtype=np.uint8)

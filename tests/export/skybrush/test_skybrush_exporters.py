@@ -256,3 +256,57 @@ def test_a_colour_per_stroke_is_in_the_zipped_csv(plans: list[NamedPlan], tmp_pa
     for (a, b), rgb in zip(plan.pen_windows_s, plan.pen_rgb, strict=True):
         rows = drone.colors[(drone.t_ms >= round(a * 1000)) & (drone.t_ms <= round(b * 1000))]
         assert rows.size and np.all(rows == rgb)
+
+
+@pytest.mark.slow
+@pytest.mark.timeout(180)
+def test_exports_made_in_worker_processes_or_on_dask_are_the_ones_made_here(
+    plans: list[NamedPlan], tmp_path: Path
+) -> None:
+    """The .skyc and the zipped CSV of a show whose drones are exported in a process pool
+    (``skyquill show --workers``) or on a dask cluster (``--scheduler``) are the ones made
+    in-process."""
+    from skyquill.export.skybrush.csv_exporter import SkybrushCsvExporter
+    from skyquill.export.skybrush.skyc_exporter import SkycExporter
+
+    pytest.importorskip("distributed")
+    skyc, csv = SkycExporter(), SkybrushCsvExporter()
+    here = [export(plans, tmp_path / "here", ExportOptions()) for export in (skyc, csv)]
+    for where in ({"workers": 2}, {"scheduler": "local"}):
+        name = "_".join(where)
+        for export, want in zip(
+            (SkycExporter(**where), SkybrushCsvExporter(**where)),  # type: ignore[arg-type]
+            here,
+            strict=True,
+        ):
+            there = export(plans, tmp_path / name, ExportOptions())
+            assert there.details == want.details
+            assert there.delivered == want.delivered
+            assert _members(there.files[0]) == _members(want.files[0])
+
+
+def _members(path: Path) -> dict[str, bytes]:
+    """A ZIP's members, name -> bytes (the archive's own bytes hold the time it was written)."""
+    import zipfile
+
+    with zipfile.ZipFile(path) as archive:
+        return {name: archive.read(name) for name in archive.namelist()}
+
+
+def test_the_show_read_back_by_the_export_is_the_file_as_check_loads_it(
+    plans: list[NamedPlan], tmp_path: Path
+) -> None:
+    """``skyquill show`` proves the .skyc as played from the show.json the exporter read back
+    (not reading the file a second time): the same drones ``skyquill check`` loads."""
+    from skyquill.export.skybrush.skyc_exporter import SkycExporter
+    from skyquill.show import load_show
+    from skyquill.show.load import skyc_drones
+
+    report, show = SkycExporter().export(plans, tmp_path / "yong", ExportOptions())
+    assert show == read_show_json(report.files[0])
+    loaded = load_show([report.files[0]])
+    shared = skyc_drones(show, report.files[0].name)
+    assert [(d.name, d.start_s) for d in shared] == [(d.name, d.start_s) for d in loaded]
+    for a, b in zip(shared, loaded, strict=True):
+        t = dense_times(b.trajectory.breakpoints)
+        np.testing.assert_array_equal(a.trajectory.evaluate(t), b.trajectory.evaluate(t))

@@ -14,6 +14,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from functools import partial
 from pathlib import Path
 from typing import Any
 
@@ -21,10 +22,17 @@ import numpy as np
 from numpy.typing import NDArray
 
 from skyquill.colors import RGB
-from skyquill.export.base import ExportOptions, ExportReport, NamedPlan, check_delivered
+from skyquill.export.base import (
+    DeliveredCheck,
+    ExportOptions,
+    ExportReport,
+    NamedPlan,
+    check_delivered,
+)
 from skyquill.export.skybrush.csv_file import CsvDrone, read_csv_zip, write_csv_zip
 from skyquill.export.skybrush.pads import on_pads
 from skyquill.io.trajectory_json import PlannedTrajectory, light_at
+from skyquill.parallel import parallel_map
 
 
 def _ms_windows(windows_s: Sequence[tuple[float, float]]) -> list[tuple[int, int]]:
@@ -55,6 +63,20 @@ def _lights_exact(back: CsvDrone, plan: PlannedTrajectory, rgb: RGB) -> bool:
     return bool(np.array_equal(back.colors, _ms_light(plan, back.t_ms, rgb)))
 
 
+def _rows(rate_hz: float, rgb: RGB, named: NamedPlan) -> tuple[PlannedTrajectory, CsvDrone]:
+    """A drone's plan on its pads (as Skybrush expects) and its rows."""
+    name, plan = named
+    grounded = on_pads(plan)
+    return grounded, csv_drone(name, grounded, rate_hz, rgb)
+
+
+def _speed_check(drone: tuple[str, PlannedTrajectory, CsvDrone]) -> DeliveredCheck:
+    """A drone's rows as read back, checked against its plan: linear between rows, so only
+    the speed means something."""
+    name, plan, back = drone
+    return check_delivered(name, plan, back.trajectory(), orders=(1,))
+
+
 @dataclass(frozen=True)
 class SkybrushCsvExporter:
     """One ZIP of per-drone CSVs, as Skybrush Studio exports and imports them."""
@@ -62,19 +84,33 @@ class SkybrushCsvExporter:
     name: str = "skybrush-csv"
     suffix: str = ".zip"
     help: str = "Skybrush Studio zipped CSV (Time_msec,x_m,y_m,z_m,Red,Green,Blue), one per drone"
+    #: Where each drone's rows are made and checked (:func:`skyquill.parallel.parallel_map`):
+    #: in this process by default, in ``workers`` processes, or on the dask ``scheduler``.
+    workers: int | None = 1
+    scheduler: str | None = None
 
     def __call__(
         self, plans: Sequence[NamedPlan], out: Path, options: ExportOptions
     ) -> ExportReport:
         """Write the rows, read the archive back as Studio does, check each drone."""
         rgb = options.light_rgb
-        plans = [(name, on_pads(plan)) for name, plan in plans]  # as Skybrush expects
-        rows = [csv_drone(name, plan, options.rate_hz, rgb) for name, plan in plans]
+        made = parallel_map(
+            partial(_rows, options.rate_hz, rgb),
+            list(plans),
+            workers=self.workers,
+            scheduler=self.scheduler,
+        )
+        plans = [(name, plan) for (name, _), (plan, _) in zip(plans, made, strict=True)]
+        rows = [row for _, row in made]
         path = write_csv_zip(rows, out.with_suffix(self.suffix))
         back = {d.name: d for d in read_csv_zip(path)}
-        delivered = tuple(  # linear between rows: only the speed means something
-            check_delivered(name, plan, back[name].trajectory(), orders=(1,))
-            for name, plan in plans
+        delivered = tuple(
+            parallel_map(
+                _speed_check,
+                [(n, p, back[n]) for n, p in plans],
+                workers=self.workers,
+                scheduler=self.scheduler,
+            )
         )
         details: dict[str, Any] = {
             "rows": sum(d.t_ms.size for d in rows),

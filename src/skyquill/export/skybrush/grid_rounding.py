@@ -23,6 +23,7 @@ is left at its least excess and reported (``unresolved``): the exporter then ref
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -171,25 +172,25 @@ class _Grid:
         self, k: int, ax: int, d1_steps: tuple[float, ...], d23_steps: tuple[float, ...]
     ) -> _AxisOptions:
         """Segment ``k``'s candidate points on axis ``ax`` and what each costs on its own."""
-        start = self.units[k, 0, ax]
+        start = float(self.units[k, 0, ax])
         exact = self.exact[k, :, ax]
-        d1, d2, d3 = (float(np.diff(exact, n)[0]) for n in (1, 2, 3))
+        d1, d2, d3 = _differences(exact.tolist())
         # Where the previous segments left the start off the curve (``drift`` units), the
         # first difference takes a third of it back (3 D1 is the velocity's share of the end).
         drift = start - exact[0]
-        grid = np.stack(
-            np.meshgrid(
-                # with the drift taken back, or left (where taking it back is too fast: the
-                # first difference rounded towards zero, whichever its sign)
-                np.unique(
-                    [*(np.rint(d1 - drift / 3.0) + np.array(d1_steps)), np.floor(d1), np.ceil(d1)]
-                ),
-                np.floor(d2) + np.array(d23_steps),
-                np.floor(d3) + np.array(d23_steps),
-                indexing="ij",
-            ),
-            -1,
-        ).reshape(-1, 3)
+        # with the drift taken back, or left (where taking it back is too fast: the first
+        # difference rounded towards zero, whichever its sign); sorted and unique
+        back = float(np.rint(d1 - drift / 3.0))
+        first = np.array(
+            sorted({*(back + step for step in d1_steps), math.floor(d1), math.ceil(d1)})
+        )
+        second = math.floor(d2) + np.array(d23_steps)
+        third = math.floor(d3) + np.array(d23_steps)
+        combos = np.empty((first.size, second.size, third.size, 3))  # every one, "ij" order
+        combos[..., 0] = first[:, None, None]
+        combos[..., 1] = second[None, :, None]
+        combos[..., 2] = third[None, None, :]
+        grid = combos.reshape(-1, 3)
         p1 = start + grid[:, 0]
         p2 = start + 2 * grid[:, 0] + grid[:, 1]
         p3 = start + 3 * grid[:, 0] + 3 * grid[:, 1] + grid[:, 2]
@@ -263,6 +264,13 @@ def _limit_excess(lim: DerivativeLimit, comps: list[FloatArray]) -> FloatArray:
         down = (lim.lower[ax] - comps[ax].min(axis=-1)) / abs(lim.lower[ax])
         out = np.maximum(out, np.maximum(up, down))
     return np.asarray(out, dtype=float)
+
+
+def _differences(x: list[float]) -> tuple[float, float, float]:
+    """The first forward differences of orders 1, 2, 3 of four numbers (as ``np.diff``)."""
+    a0, a1, a2 = x[1] - x[0], x[2] - x[1], x[3] - x[2]
+    b0, b1 = a1 - a0, a2 - a1
+    return a0, b0, b1 - b0
 
 
 def _steps(left: FloatArray, hl: float, right: FloatArray, hr: float, h: float) -> FloatArray:

@@ -42,7 +42,7 @@ from skyquill.export.skybrush.lights import (
 )
 from skyquill.export.skybrush.pads import on_pads, takeoff_report
 from skyquill.export.skybrush.playback import played_show
-from skyquill.export.skybrush.refit import played_keyframes
+from skyquill.export.skybrush.refit import PlayedKeyframes, played_keyframes
 from skyquill.export.skybrush.skyc_file import (
     SkycDrone,
     read_show_json,
@@ -52,6 +52,8 @@ from skyquill.export.skybrush.skyc_file import (
 )
 from skyquill.export.skybrush.validation import validation_settings
 from skyquill.io.trajectory_json import PlannedTrajectory
+from skyquill.parallel import parallel_map
+from skyquill.trajectory import Trajectory
 
 #: Heading of the show's X+ axis, degrees clockwise from north: skyquill's x is east.
 SHOW_X_HEADING_DEG = 90.0
@@ -64,13 +66,29 @@ class SkycExporter:
     name: str = "skyc"
     suffix: str = ".skyc"
     help: str = "Skybrush show (.skyc), one drone per trajectory, lit while the pen is down"
+    #: Where each drone's keyframes are made (:func:`skyquill.parallel.parallel_map`): in
+    #: this process by default, in ``workers`` processes, or on the dask ``scheduler``.
+    workers: int | None = 1
+    scheduler: str | None = None
 
     def __call__(
         self, plans: Sequence[NamedPlan], out: Path, options: ExportOptions
     ) -> ExportReport:
         """Write the show, read it back as the drones play it, check it against the plans."""
-        plans = [(name, on_pads(plan)) for name, plan in plans]  # as Skybrush expects
-        made = [played_keyframes(name, plan) for name, plan in plans]
+        return self.export(plans, out, options)[0]
+
+    def export(
+        self, plans: Sequence[NamedPlan], out: Path, options: ExportOptions
+    ) -> tuple[ExportReport, dict[str, Any]]:
+        """As calling the exporter, and the ``show.json`` read back from the file written
+        (:func:`~skyquill.export.skybrush.skyc_file.read_show_json`), for a caller's own
+        checks of what was written (``skyquill show`` proves it apart as played) without
+        reading it again."""
+        grounded = parallel_map(
+            _keyframed, list(plans), workers=self.workers, scheduler=self.scheduler
+        )
+        plans = [(name, plan) for (name, _), (plan, _) in zip(plans, grounded, strict=True)]
+        made = [keys for _, keys in grounded]
         drones = [
             SkycDrone(
                 name,
@@ -96,8 +114,12 @@ class SkycExporter:
         show = read_show_json(path)
         played = [p.trajectory() for p in played_show(show)]
         delivered = tuple(
-            check_delivered(name, plan, back)
-            for (name, plan), back in zip(plans, played, strict=True)
+            parallel_map(
+                _checked,
+                [(name, plan, back) for (name, plan), back in zip(plans, played, strict=True)],
+                workers=self.workers,
+                scheduler=self.scheduler,
+            )
         )
         lights = [
             _light_mismatch(show, i, plan, options.light_rgb, back.duration)
@@ -113,7 +135,7 @@ class SkycExporter:
         shift = 0.0 if frame is None else _location_shift(show, frame)
         if frame is not None:
             details["location"] = show["environment"]["location"] | {"shift_m": shift}
-        return ExportReport(
+        report = ExportReport(
             self.name,
             (path,),
             exact=False,
@@ -123,6 +145,19 @@ class SkycExporter:
             details=details,
             delivered=delivered,
         )
+        return report, show
+
+
+def _keyframed(named: NamedPlan) -> tuple[PlannedTrajectory, PlayedKeyframes]:
+    """A drone's plan on its pads (as Skybrush expects) and its keyframes, played and checked."""
+    name, plan = named
+    grounded = on_pads(plan)
+    return grounded, played_keyframes(name, grounded)
+
+
+def _checked(drone: tuple[str, PlannedTrajectory, Trajectory]) -> DeliveredCheck:
+    """A drone as read back from the file, checked against its plan."""
+    return check_delivered(*drone)
 
 
 def _location_shift(show: dict[str, Any], frame: GeoFrame) -> float:

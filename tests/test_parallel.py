@@ -1,0 +1,37 @@
+"""parallel_map: the same results, in order, here, in a process pool and on a dask cluster."""
+
+from __future__ import annotations
+
+import pytest
+
+from skyquill.errors import InfeasibleError, InputError
+from skyquill.parallel import parallel_map
+
+
+def square_or_refuse(x: int) -> int:
+    if x < 0:
+        raise InfeasibleError(f"x: got {x}, expected at least 0", ("x",))
+    return x * x
+
+
+def test_the_pool_gives_the_results_in_order_and_its_errors_as_raised() -> None:
+    items = list(range(37))
+    assert parallel_map(square_or_refuse, items, workers=2) == [x * x for x in items]
+    assert parallel_map(square_or_refuse, items) == [x * x for x in items]
+    assert parallel_map(square_or_refuse, []) == []
+    with pytest.raises(InfeasibleError, match="x: got -1, expected at least 0"):
+        parallel_map(square_or_refuse, [1, -1, 2], workers=2)
+
+
+@pytest.mark.slow
+@pytest.mark.timeout(120)
+def test_a_local_dask_cluster_gives_the_same_results() -> None:
+    pytest.importorskip("distributed")
+    items = list(range(23))
+    assert parallel_map(square_or_refuse, items, scheduler="local") == [x * x for x in items]
+
+
+def test_a_scheduler_that_does_not_answer_is_named() -> None:
+    pytest.importorskip("distributed")
+    with pytest.raises(InputError, match=r"scheduler: got 'tcp://127.0.0.1:9', which did not"):
+        parallel_map(square_or_refuse, [1], scheduler="tcp://127.0.0.1:9")
