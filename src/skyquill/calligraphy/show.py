@@ -17,11 +17,9 @@ needs ``pip install 'skyquill[dask]'``); the missions are the same.
 
 from __future__ import annotations
 
-import os
 from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass, replace
-from types import ModuleType
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -36,6 +34,7 @@ from skyquill.calligraphy.mission import (
     plan_writing,
 )
 from skyquill.errors import InputError
+from skyquill.parallel import dask_client
 from skyquill.phases import MIN_ALTITUDE_M, check_min_altitude
 from skyquill.strokes import Strokes
 from skyquill.validation import FloatArray, as_float, as_int
@@ -57,9 +56,6 @@ MAX_SHOW_STROKES = 3_000
 #: Lift between strokes when none is given: a brush clears a contact board by
 #: 5 cm; on a sky board the light is off and the transits stay in the plane.
 DEFAULT_LIFT_M = {"horizontal": 0.05, "wall": 0.05, "sky": 0.0}
-
-#: How long to wait for a ``dask.distributed`` scheduler to answer, s.
-SCHEDULER_TIMEOUT_S = 5.0
 
 #: One drone's planning job: the arguments of :func:`plan_writing`.
 Job = tuple[Strokes, Board, WritingOptions, FloatArray]
@@ -234,7 +230,8 @@ def plan_show(
     InputError
         Separation not positive, a show above the ceilings
         (:func:`check_show_size`), ``places`` not one per part, dask not
-        installed, or the scheduler not reachable within :data:`SCHEDULER_TIMEOUT_S`.
+        installed, or the scheduler not reachable within
+        :data:`skyquill.parallel.SCHEDULER_TIMEOUT_S`.
     InfeasibleError
         A drone cannot be planned, or two drones come closer than ``separation_m``.
     """
@@ -366,39 +363,7 @@ def _plan_on_cluster(jobs: list[Job], scheduler: str, steps: _Steps) -> list[Mis
     """Plan the jobs on the ``dask.distributed`` scheduler ``scheduler`` (or a local one)."""
     if not isinstance(scheduler, str) or not scheduler:
         raise InputError(f"scheduler: expected an address or 'local', got {scheduler!r}")
-    distributed = _import_distributed()
-    if scheduler != "local":
-        return _plan_with_client(distributed, scheduler, jobs, steps)
-    # Worker processes, not threads: planning holds the GIL for much of its time (20 sky
-    # drones: 21.5 s of planning on two threads, 5.5 s on two processes after a 2 s start).
-    with distributed.LocalCluster(
-        n_workers=os.cpu_count() or 1, threads_per_worker=1, processes=True, dashboard_address=None
-    ) as cluster:
-        return _plan_with_client(distributed, cluster.scheduler_address, jobs, steps)
-
-
-def _import_distributed() -> ModuleType:
-    try:
-        import distributed
-    except ImportError as exc:
-        raise InputError(
-            "scheduler: dask.distributed is not installed; pip install 'skyquill[dask]'"
-        ) from exc
-    return distributed
-
-
-def _plan_with_client(
-    distributed: ModuleType, address: str, jobs: list[Job], steps: _Steps
-) -> list[Mission]:
-    """Submit one task per job to the scheduler at ``address`` and gather the missions."""
-    try:
-        client = distributed.Client(address, timeout=SCHEDULER_TIMEOUT_S, set_as_default=False)
-    except (OSError, TimeoutError, ValueError) as exc:
-        raise InputError(
-            f"scheduler: got {address!r}, which did not answer within {SCHEDULER_TIMEOUT_S:g} s "
-            f"({exc}), expected the address of a running dask scheduler"
-        ) from None
-    with client:
+    with dask_client(scheduler) as (distributed, client):
         futures: list[Any] = client.map(_plan, jobs, pure=False)
         arrivals = distributed.as_completed(futures, loop=client.loop)
         return _collect(futures, arrivals, steps)

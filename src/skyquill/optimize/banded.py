@@ -104,7 +104,7 @@ def banded_closed_form(
     F = np.zeros((M, d))
     C = np.zeros((M, d))
     Y = np.zeros((fixed.E.shape[0], d))
-    E = fixed.E.toarray()
+    E = cache.kept("dense equality rows", (fixed,), (), fixed.E.toarray)  # per route, not solve
     first = np.concatenate([local.first for local in locals_])
     points = np.concatenate([t.points for t in terms])
     weights = np.concatenate([np.full(t.times.size, t.weight) for t in terms])
@@ -268,7 +268,8 @@ def _gram_band(
     k = rows.shape[1] - 1
     a, b = _pairs(k)
     products = weights[:, None] * rows[:, a] * rows[:, b]
-    where = (k + a - b) * M + (first[:, None] + b)
+    # Each pair's flat offset computed once (k + 1 choose 2 entries), then one add per row.
+    where = first[:, None] + ((k + a - b) * M + b)
     sums = np.bincount(where.ravel(), weights=products.ravel(), minlength=(k + 1) * M)
     return np.asarray(sums.reshape(k + 1, M))
 

@@ -57,10 +57,12 @@ def rows_times(first: IntArray, rows: FloatArray, C: FloatArray) -> FloatArray:
     One product per basis function (``k + 1`` of them) on (N, d) slices: 2-3x less
     CPU at a writing route's thousands of samples than an ``einsum`` over the
     gathered (N, k + 1, d) control points, and the same sum in the same order.
+    The rows of ``C`` are gathered by ``take`` (the same values as ``C[first + r]``,
+    1.5-3x faster than fancy indexing on a few columns).
     """
-    out = rows[..., 0, None] * C[first]
+    out = rows[..., 0, None] * C.take(first, axis=0)
     for r in range(1, rows.shape[-1]):
-        out += rows[..., r, None] * C[first + r]
+        out += rows[..., r, None] * C.take(first + r, axis=0)
     return np.asarray(out)
 
 
