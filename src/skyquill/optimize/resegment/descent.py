@@ -114,15 +114,8 @@ class _Search:
         g = time_gradient(
             t, self.make_problem, self.solver, res, workspace=self.workspace
         ).grad_segments
-        g = g + self.rho
         self.grad_time += time.perf_counter() - tic
-        if self.frozen is None:
-            return g - g.mean() if self.mode == "fixed" else g
-        free = ~self.frozen
-        g = np.where(free, g, 0.0)
-        if self.mode == "fixed" and free.any():  # the projection on sum(dT) = 0 among them
-            g[free] -= g[free].mean()
-        return g
+        return self.project(g + self.rho)
 
     def project(self, v: FloatArray) -> FloatArray:
         """``v`` with the frozen segments' entries 0 and, in fixed mode, the free ones
