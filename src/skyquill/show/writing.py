@@ -10,7 +10,7 @@ from, and who holds, is the show's business (:mod:`skyquill.show.build`).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 from typing import cast
 
 import numpy as np
@@ -142,10 +142,8 @@ def first_alike(parts: list[Strokes], boards: list[Board]) -> list[int]:
             tuple(p.tobytes() for p in part.paths),
             None if part.times is None else tuple(t.tobytes() for t in part.times),
             None if part.box is None else np.asarray(part.box).tobytes(),
-            board.kind,
-            board.lift_m,
-            board.yaw_deg,
-            board.tilt_deg,
+            # every field of the board but where it is (a field added later counts too)
+            *(getattr(board, f.name) for f in fields(board) if f.name != "origin"),
         )
         first.append(seen.setdefault(key, i))
     return first
