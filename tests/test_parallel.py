@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from skyquill.errors import InfeasibleError, InputError
-from skyquill.parallel import parallel_map
+from skyquill.parallel import HERE, Where, parallel_map
 
 
 def square_or_refuse(x: int) -> int:
@@ -35,3 +35,14 @@ def test_a_scheduler_that_does_not_answer_is_named() -> None:
     pytest.importorskip("distributed")
     with pytest.raises(InputError, match=r"scheduler: got 'tcp://127.0.0.1:9', which did not"):
         parallel_map(square_or_refuse, [1], scheduler="tcp://127.0.0.1:9")
+
+
+def test_where_says_where_the_work_runs_in_a_persons_words() -> None:
+    assert HERE.here and HERE.describe() == "this process"
+    assert HERE.map(square_or_refuse, [2, 3]) == [4, 9]
+    assert not Where(workers=2).here and Where(workers=2).describe() == "2 processes"
+    assert Where(workers=None).describe().endswith(("processes", "this process"))
+    assert Where(scheduler="local").describe() == "a local dask cluster"
+    assert Where(scheduler="tcp://10.0.0.5:8786").describe() == (
+        "the dask cluster at tcp://10.0.0.5:8786"
+    )

@@ -16,6 +16,7 @@ import os
 from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import ProcessPoolExecutor
 from contextlib import contextmanager
+from dataclasses import dataclass
 from functools import partial
 from types import ModuleType
 from typing import Any, TypeVar
@@ -30,6 +31,44 @@ TASKS_PER_WORKER = 4
 
 T = TypeVar("T")
 R = TypeVar("R")
+
+
+@dataclass(frozen=True)
+class Where:
+    """Where independent work runs: in this process, a local pool, or a dask cluster.
+
+    Attributes
+    ----------
+    workers : int or None
+        Processes of the local pool; ``None``: one per CPU; 1: in this process.
+    scheduler : str or None
+        A ``dask.distributed`` scheduler's address, or ``"local"`` (see :func:`parallel_map`).
+    """
+
+    workers: int | None = 1
+    scheduler: str | None = None
+
+    @property
+    def here(self) -> bool:
+        """Whether the work runs in this process, one item after the other."""
+        return self.scheduler is None and self.workers == 1
+
+    def map(self, fn: Callable[[T], R], items: Sequence[T]) -> list[R]:
+        """:func:`parallel_map` of ``fn`` over ``items`` here."""
+        return parallel_map(fn, items, workers=self.workers, scheduler=self.scheduler)
+
+    def describe(self) -> str:
+        """Where, in a person's words: "2 processes", "the dask cluster at ..."."""
+        if self.scheduler == "local":
+            return "a local dask cluster"
+        if self.scheduler is not None:
+            return f"the dask cluster at {self.scheduler}"
+        count = self.workers or os.cpu_count() or 1
+        return "this process" if count == 1 else f"{count} processes"
+
+
+#: In this process, one item after the other.
+HERE = Where()
 
 
 def parallel_map(

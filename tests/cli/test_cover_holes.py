@@ -97,3 +97,22 @@ def test_bad_holes_exit_2_naming_the_problem(
     assert result.exit_code == 2
     assert message in " ".join(result.output.split())
     assert "Traceback" not in result.output
+
+
+@pytest.mark.parametrize(
+    ("option", "value", "message"),
+    [
+        ("--workers", "0", "--workers: got 0, expected 1 to 256"),
+        ("--scheduler", "not an address", "--scheduler: got 'not an address', expected 'local'"),
+    ],
+)
+def test_where_the_pieces_are_planned_is_checked_first(
+    tmp_path: Path, option: str, value: str, message: str
+) -> None:
+    region = tmp_path / "holed.geojson"
+    region.write_text(json.dumps({"type": "Polygon", "coordinates": [SHELL, HOLE]}))
+    args = ["cover", str(region), "--crs", "local", "--out", str(tmp_path / "o"), option, value]
+    result = CliRunner().invoke(app, args)
+    assert result.exit_code == 2
+    assert message in " ".join(result.output.split())
+    assert not (tmp_path / "o").exists()

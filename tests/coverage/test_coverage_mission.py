@@ -197,3 +197,35 @@ def test_every_hole_gets_a_headland_lap_unless_it_would_leave_the_field() -> Non
     # The lap sweeps the band round the hole that the gated pieces miss.
     band = Polygon(inner.interiors[0]).buffer(1.0).difference(Polygon(inner.interiors[0]))
     assert band.difference(with_lap.mission.swept).area < 0.05 * band.area  # type: ignore[union-attr]
+
+
+L_WITH_HOLE = (
+    "POLYGON ((0 0, 20 0, 20 8, 8 8, 8 20, 0 20, 0 0), (12 2.5, 15 2.5, 15 5.5, 12 5.5, 12 2.5))"
+)
+
+
+def _same_flight(a: CoveragePlan, b: CoveragePlan) -> None:
+    assert b.duration == a.duration
+    t = np.linspace(0.0, a.duration, 2001)
+    np.testing.assert_array_equal(b.trajectory.evaluate(t), a.trajectory.evaluate(t))
+    assert b.pen_windows_s == a.pen_windows_s and b.coverage == a.coverage
+
+
+def test_pieces_planned_at_once_in_a_pool_give_the_same_flight() -> None:
+    from skyquill.parallel import Where
+
+    region = load_region(L_WITH_HOLE)
+    options = CoverageOptions(pattern="spiral")
+    here = plan_tuned(region, options, 0.95)
+    pooled = plan_tuned(region, options, 0.95, where=Where(workers=2))
+    _same_flight(here, pooled)
+    _assert_safe(pooled)
+
+
+@pytest.mark.slow
+def test_pieces_planned_on_a_dask_cluster_give_the_same_flight() -> None:
+    from skyquill.parallel import Where
+
+    region = region_from_vertices(SQUARE, holes=[_round(8, 8, 2.0)])
+    here = plan_coverage(region, ZIGZAG)
+    _same_flight(here, plan_coverage(region, ZIGZAG, where=Where(scheduler="local")))

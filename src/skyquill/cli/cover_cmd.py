@@ -22,13 +22,16 @@ from skyquill.cli.main import (
     positive_rate,
     progress_bar,
     say_done,
+    scheduler_address,
     upload_target,
     user_errors,
+    worker_count,
 )
 from skyquill.cli.pictures import NoPictures, Pictures
 from skyquill.coverage import DEFAULT_MIN_COVERAGE
 from skyquill.errors import InputError
 from skyquill.limits import VehicleLimits
+from skyquill.parallel import Where
 from skyquill.phases import MIN_ALTITUDE_M, check_altitude
 
 if TYPE_CHECKING:
@@ -129,6 +132,17 @@ def cover(
         ),
     ] = None,
     target: Target = None,
+    workers: Annotated[
+        int | None,
+        typer.Option(
+            help="Processes planning the pieces of a field with keep-outs (or of several "
+            "fields) at once (default: CPUs; 1: one after the other)."
+        ),
+    ] = None,
+    scheduler: Annotated[
+        str | None,
+        typer.Option(help="dask.distributed scheduler address (or 'local') planning the pieces."),
+    ] = None,
     min_altitude_m: MinAltitude = MIN_ALTITUDE_M,
     force: Force = False,
     no_pictures: NoPictures = False,
@@ -162,6 +176,7 @@ def cover(
         rate = positive_rate(rate)
         in_range("--delta", delta, *DELTA_RANGE_M, "m", open_low=True)
         in_range("--time-limit", time_limit, *TIME_LIMIT_RANGE_S, "s", open_low=True)
+        where = Where(worker_count(workers), scheduler_address(scheduler))
         geo = load_geo_region(region, crs, origin_alt)
         shape = geo.region
         options = CoverageOptions(
@@ -185,9 +200,9 @@ def cover(
             )
         with _BudgetBar() as bar:
             if min_coverage == 0.0:
-                plan = plan_coverage(shape, options, progress=bar.update)
+                plan = plan_coverage(shape, options, progress=bar.update, where=where)
             else:
-                plan = plan_tuned(shape, options, min_coverage, progress=bar.update)
+                plan = plan_tuned(shape, options, min_coverage, progress=bar.update, where=where)
         # The spray is on along the whole path, or (holes, several fields) off on the
         # transits and wherever the swath would reach into a hole.
         planned = PlannedTrajectory(

@@ -257,6 +257,17 @@ def parse_vector3(option: str, text: str, unit: str) -> FloatArray:
     return np.array(values)
 
 
+#: Most ``--workers`` (processes): more than any machine's cores is a typo.
+MAX_WORKERS = 256
+
+
+def worker_count(workers: int | None) -> int | None:
+    """``--workers``: 1 to :data:`MAX_WORKERS` processes, or None (one per CPU)."""
+    if workers is not None and not 1 <= workers <= MAX_WORKERS:
+        raise InputError(f"--workers: got {workers}, expected 1 to {MAX_WORKERS}")
+    return workers
+
+
 #: A dask.distributed scheduler address: ``local``, ``tcp://host:port`` (or tls, ws, wss,
 #: ucx, inproc) or ``host:port``.
 _SCHEDULER = re.compile(

@@ -16,6 +16,7 @@ on a dense sampling: a plan that fails is refused, never returned.
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -36,6 +37,7 @@ from skyquill.coverage.regions import Region, fields, holes, swept
 from skyquill.coverage.transit import transit_route
 from skyquill.errors import InfeasibleError
 from skyquill.optimize.legs import LegLimits, stop_and_go
+from skyquill.parallel import HERE, Where
 from skyquill.trajectory import Trajectory, concatenate
 from skyquill.validation import FloatArray
 
@@ -131,6 +133,7 @@ def fly_mission(
     deadline: Deadline,
     plan_piece: PiecePlanner,
     convex: bool = False,
+    where: Where = HERE,
 ) -> Mission:
     """Plan every piece of ``region``, order and join them, gate the spray, check the holes.
 
@@ -148,13 +151,17 @@ def fly_mission(
     deadline
         The plan's budget; checked between pieces.
     plan_piece
-        Plans one hole-free piece.
+        Plans one hole-free piece (a module-level function or a partial of one, when
+        ``where`` is not here: it is sent to the workers).
     convex
         Split the pieces further into convex parts
         (:func:`~skyquill.coverage.partition.convex_parts`), each planned on
         its own: for spirals, whose joined multi-spiral over a concave piece
         is often too tight to time and then flown part by part anyway, after
         a long search (a notched half-square: 19 s against 2 s).
+    where
+        Where the pieces are planned: one after the other here (the default), or at once
+        in a process pool or on a dask cluster (each within the budget left then).
 
     Raises
     ------
@@ -163,15 +170,15 @@ def fly_mission(
         a piece cannot be timed, or the deadline is spent.
     """
     keepouts = holes(region)
-    flown = []
     pieces = hole_free_pieces(region, width)
     if convex:
         pieces = [part for piece in pieces for part in _convex(piece, width)]
-    for k, piece in enumerate(pieces):
-        deadline.check(f"piece {k + 1} of the region")
-        one = _fly_piece(
-            piece, width, legs=legs, altitude=altitude, deadline=deadline, plan_piece=plan_piece
-        )
+    room = [_has_room(piece, width) for piece in pieces]
+    wide = [piece for piece, fits in zip(pieces, room, strict=True) if fits]
+    planned = iter(_planned(wide, plan_piece, deadline, where))
+    flown = []
+    for piece, fits in zip(pieces, room, strict=True):  # in the pieces' order
+        one = next(planned) if fits else _narrow(piece, width, legs, altitude)
         if one is not None:
             flown.append(one)
     pieces_flown = len(flown)
@@ -217,19 +224,36 @@ def fly_mission(
     )
 
 
-def _fly_piece(
-    piece: Polygon,
-    width: float,
-    *,
-    legs: LegLimits,
-    altitude: float,
-    deadline: Deadline,
-    plan_piece: PiecePlanner,
-) -> _Piece | None:
-    """The piece planned; a piece narrower than the swath along its spine; a point: None."""
-    if not piece.buffer(-0.5 * width).is_empty:
-        trajectory, waypoints = plan_piece(piece, deadline)
-        return _Piece(trajectory, waypoints)
+def _has_room(piece: Polygon, width: float) -> bool:
+    """Whether the swath fits in ``piece`` (it is planned; else flown along its spine)."""
+    return not piece.buffer(-0.5 * width).is_empty
+
+
+def _planned(
+    pieces: list[Polygon], plan_piece: PiecePlanner, deadline: Deadline, where: Where
+) -> list[_Piece]:
+    """Each piece planned by ``plan_piece``: one after the other here, or all at once
+    ``where`` asks (each within the budget left when they start)."""
+    if where.here:
+        here = []
+        for k, piece in enumerate(pieces):
+            deadline.check(f"piece {k + 1} of {len(pieces)}")
+            here.append(_Piece(*plan_piece(piece, deadline)))
+        return here
+    deadline.check(f"{len(pieces)} pieces, planned at once in {where.describe()}")
+    alone = functools.partial(_planned_alone, plan_piece=plan_piece, budget=deadline.remaining())
+    return [_Piece(*flight) for flight in where.map(alone, pieces)]
+
+
+def _planned_alone(
+    piece: Polygon, *, plan_piece: PiecePlanner, budget: float
+) -> tuple[Trajectory, FloatArray]:
+    """``piece`` planned within ``budget`` seconds from now (in a worker process)."""
+    return plan_piece(piece, Deadline(budget))
+
+
+def _narrow(piece: Polygon, width: float, legs: LegLimits, altitude: float) -> _Piece | None:
+    """A piece narrower than the swath, flown along its spine; None: no room to fly."""
     spine = _spine(piece, width)
     if len(spine) < 2 or _length(spine) <= 1e-6 * width:
         return None  # no room to fly: its area is reported as missed

@@ -4,6 +4,7 @@ own.
 
 from __future__ import annotations
 
+import functools
 import logging
 import time
 from collections.abc import Callable
@@ -14,7 +15,7 @@ from shapely.geometry import Polygon
 
 from skyquill.coverage.deadline import Deadline
 from skyquill.coverage.missed import missed_area
-from skyquill.coverage.mission import PiecePlanner, fly_mission
+from skyquill.coverage.mission import fly_mission
 from skyquill.coverage.plan.covering import is_convex
 from skyquill.coverage.plan.options import CoverageOptions
 from skyquill.coverage.plan.result import CoveragePlan, limits_report
@@ -25,6 +26,7 @@ from skyquill.coverage.regions import (
 )
 from skyquill.errors import InfeasibleError
 from skyquill.optimize.legs import LegLimits
+from skyquill.parallel import HERE, Where
 from skyquill.trajectory import Trajectory
 
 FloatArray = NDArray[np.float64]
@@ -48,16 +50,21 @@ def plan_mission(
     plan_piece: PlanPiece,
     *,
     zigzag: PlanPiece,
+    where: Where = HERE,
 ) -> CoveragePlan:
     """The mission over ``region``'s hole-free pieces, each planned by ``plan_piece``.
 
     A spiral piece that cannot be timed within its share of the budget is
-    planned by ``zigzag`` instead (see :func:`_spiral_or_zigzag`).
+    planned by ``zigzag`` instead (see :func:`spiral_or_zigzag`). ``where``: the
+    pieces one after the other here, or at once in a pool or on a dask cluster (then
+    ``plan_piece`` and ``zigzag`` must pickle: module-level functions or their partials).
     """
     start = time.perf_counter()
     legs = LegLimits(opts.vmax, opts.amax, opts.jmax, per_axis=opts.per_axis)
-    flight = _flight_of(
-        plan_piece if opts.pattern != "spiral" else _spiral_or_zigzag(plan_piece, zigzag)
+    planner = (
+        plan_piece
+        if opts.pattern != "spiral"
+        else functools.partial(spiral_or_zigzag, spiral=plan_piece, zigzag=zigzag)
     )
     mission = fly_mission(
         region,
@@ -65,8 +72,9 @@ def plan_mission(
         legs=legs,
         altitude=opts.altitude,
         deadline=deadline,
-        plan_piece=flight,
+        plan_piece=functools.partial(_flight, plan_piece=planner),
         convex=opts.pattern in {"spiral", "zigzag-jerk"},
+        where=where,
     )
     check = within_limits(mission.trajectory, opts, "mission", deadline)
     return CoveragePlan(
@@ -88,32 +96,28 @@ def plan_mission(
 SPIRAL_SHARE = 0.25
 
 
-def _spiral_or_zigzag(plan_piece: PlanPiece, zigzag: PlanPiece) -> PlanPiece:
-    """``plan_piece``, but a piece whose spiral takes over :data:`SPIRAL_SHARE` of the
-    remaining budget (or cannot be timed) is zigzagged instead.
+def spiral_or_zigzag(
+    piece: Polygon, deadline: Deadline, *, spiral: PlanPiece, zigzag: PlanPiece
+) -> CoveragePlan:
+    """``piece`` planned by ``spiral``, or by ``zigzag`` where its spiral takes over
+    :data:`SPIRAL_SHARE` of the remaining budget (or cannot be timed).
 
     The speed LP of some convex parts stalls (a pentagon of 114 m² next to a
     round hole: no plan in 60 s, its mirror image in 3 s); one such part must
     not spend the whole mission's budget.
     """
-
-    def plan(piece: Polygon, deadline: Deadline) -> CoveragePlan:
-        share = Deadline(SPIRAL_SHARE * deadline.remaining())
-        try:
-            return plan_piece(piece, share)
-        except InfeasibleError as exc:
-            deadline.check("a zigzag for a piece whose spiral failed")
-            _log.warning("piece of %.3g m²: spiral failed (%s), zigzag instead", piece.area, exc)
-            return zigzag(piece, deadline)
-
-    return plan
+    share = Deadline(SPIRAL_SHARE * deadline.remaining())
+    try:
+        return spiral(piece, share)
+    except InfeasibleError as exc:
+        deadline.check("a zigzag for a piece whose spiral failed")
+        _log.warning("piece of %.3g m²: spiral failed (%s), zigzag instead", piece.area, exc)
+        return zigzag(piece, deadline)
 
 
-def _flight_of(plan_piece: PlanPiece) -> PiecePlanner:
-    """A piece planner for :func:`fly_mission`: the plan's trajectory and waypoints."""
-
-    def flight(piece: Polygon, deadline: Deadline) -> tuple[Trajectory, FloatArray]:
-        plan = plan_piece(piece, deadline)
-        return plan.trajectory, plan.waypoints
-
-    return flight
+def _flight(
+    piece: Polygon, deadline: Deadline, *, plan_piece: PlanPiece
+) -> tuple[Trajectory, FloatArray]:
+    """For :func:`fly_mission`: the piece's planned trajectory and waypoints."""
+    plan = plan_piece(piece, deadline)
+    return plan.trajectory, plan.waypoints

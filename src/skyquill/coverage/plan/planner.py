@@ -23,6 +23,7 @@ from skyquill.coverage.plan.result import CoveragePlan, coverage_limits, limits_
 from skyquill.coverage.plan.timing import stop_between_parts, timed_path
 from skyquill.coverage.regions import Region
 from skyquill.errors import InfeasibleError
+from skyquill.parallel import HERE, Where
 from skyquill.verify import verify
 
 
@@ -31,6 +32,7 @@ def plan_coverage(
     options: CoverageOptions | None = None,
     *,
     progress: Progress | None = None,
+    where: Where = HERE,
 ) -> CoveragePlan:
     """Plan a coverage flight of ``region``: path, speed, setpoints, coverage, limits.
 
@@ -45,6 +47,9 @@ def plan_coverage(
         :class:`CoverageOptions` (defaults: the paper's §4 limits, spiral).
     progress
         Told ``(step, elapsed_s, time_limit_s)`` at every step (a CLI's bar).
+    where
+        Where a mission's pieces are planned: one after the other here (the default), or
+        at once in a process pool or on a dask cluster.
 
     Raises
     ------
@@ -67,11 +72,13 @@ def plan_coverage(
     """
     start = time.perf_counter()
     opts = options or CoverageOptions()
-    plan = plan_within(region, opts, Deadline(opts.time_limit, progress))
+    plan = plan_within(region, opts, Deadline(opts.time_limit, progress), where)
     return replace(plan, planning_time=time.perf_counter() - start)  # the whole planning
 
 
-def plan_within(region: Region, opts: CoverageOptions, deadline: Deadline) -> CoveragePlan:
+def plan_within(
+    region: Region, opts: CoverageOptions, deadline: Deadline, where: Where = HERE
+) -> CoveragePlan:
     """:func:`plan_coverage` within ``deadline``."""
     if in_pieces(region, opts):
         check_region(region, opts)  # refuses what is no (Multi)Polygon
@@ -79,8 +86,9 @@ def plan_within(region: Region, opts: CoverageOptions, deadline: Deadline) -> Co
             region,
             opts,
             deadline,
-            lambda piece, dl: plan_within(piece, opts, dl),
+            functools.partial(_piece, options=opts),
             zigzag=functools.partial(zigzag_piece, options=opts),
+            where=where,
         )
     if opts.target is not None:
         check_region(region, opts)
@@ -120,6 +128,11 @@ def plan_within(region: Region, opts: CoverageOptions, deadline: Deadline) -> Co
         speed_plan=speed_plan,
         missed=missed,
     )
+
+
+def _piece(piece: Polygon, deadline: Deadline, *, options: CoverageOptions) -> CoveragePlan:
+    """One hole-free piece of a mission, planned with the mission's ``options``."""
+    return plan_within(piece, options, deadline)
 
 
 def zigzag_piece(piece: Polygon, deadline: Deadline, *, options: CoverageOptions) -> CoveragePlan:

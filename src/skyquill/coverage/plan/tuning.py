@@ -32,6 +32,7 @@ from skyquill.coverage.regions import (
 )
 from skyquill.coverage.speed import plan_speed
 from skyquill.errors import InfeasibleError, InputError
+from skyquill.parallel import HERE, Where
 from skyquill.validation import as_float
 
 FloatArray = NDArray[np.float64]
@@ -81,6 +82,7 @@ def plan_tuned(
     target: float = DEFAULT_MIN_COVERAGE,
     *,
     progress: Progress | None = None,
+    where: Where = HERE,
 ) -> CoveragePlan:
     """The fastest plan whose path covers ``target`` of the region.
 
@@ -95,7 +97,8 @@ def plan_tuned(
     :data:`TUNED_FULL_PLANS` are planned in full and the shortest flight wins.
 
     All trials share one ``options.time_limit``; ``progress`` is told every
-    step (see :class:`~skyquill.coverage.deadline.Deadline`).
+    step (see :class:`~skyquill.coverage.deadline.Deadline`). ``where``: where a
+    mission's pieces are tuned (see :func:`~skyquill.coverage.plan.plan_coverage`).
 
     Raises
     ------
@@ -113,20 +116,24 @@ def plan_tuned(
     deadline = Deadline(options.time_limit, progress)
     if options.target is not None:
         # Trials are compared as planned; only the winner is re-fitted for the target.
-        untargeted = _tuned(region, replace(options, target=None), goal, deadline)
+        untargeted = _tuned(region, replace(options, target=None), goal, deadline, where)
         plan = for_target(untargeted, replace(untargeted.options, target=options.target), deadline)
     else:
-        plan = _tuned(region, options, goal, deadline)
+        plan = _tuned(region, options, goal, deadline, where)
     # The whole planning: every candidate and estimate, not only the winner's own plan.
     return replace(plan, planning_time=time.perf_counter() - start)
 
 
 def _tuned(
-    region: Region, options: CoverageOptions, goal: float, deadline: Deadline
+    region: Region,
+    options: CoverageOptions,
+    goal: float,
+    deadline: Deadline,
+    where: Where = HERE,
 ) -> CoveragePlan:
     """:func:`plan_tuned` after its checks, within ``deadline``."""
     if in_pieces(region, options):
-        return _tuned_mission(region, options, goal, deadline)
+        return _tuned_mission(region, options, goal, deadline, where)
     if options.pattern == "zigzag-jerk":
         return plan_jerk(region, options, deadline, goal)
     deltas = (options.delta,) if options.pattern == "zigzag-stop" else TUNING_DELTAS
@@ -196,7 +203,7 @@ def _fitting_epsilons(region: Polygon, options: CoverageOptions) -> list[float]:
 
 
 def _tuned_mission(
-    region: Region, options: CoverageOptions, goal: float, deadline: Deadline
+    region: Region, options: CoverageOptions, goal: float, deadline: Deadline, where: Where
 ) -> CoveragePlan:
     """The mission with each hole-free piece tuned to leave :data:`MISSION_MISS_SHARE` of
     the miss ``goal`` allows.
@@ -215,7 +222,12 @@ def _tuned_mission(
     piece_goal = 1.0 - MISSION_MISS_SHARE * (1.0 - goal)
     tune = functools.partial(_tuned_piece, options=options, goal=piece_goal)
     plan = plan_mission(
-        region, options, deadline, tune, zigzag=functools.partial(zigzag_piece, options=options)
+        region,
+        options,
+        deadline,
+        tune,
+        zigzag=functools.partial(zigzag_piece, options=options),
+        where=where,
     )
     if plan.coverage < goal:
         raise InfeasibleError(
