@@ -20,6 +20,7 @@ import numpy as np
 
 from skyquill.limits import DerivativeLimit
 from skyquill.trajectory.base import Trajectory, dense_times
+from skyquill.trajectory.polynomial import PiecewisePolynomial
 from skyquill.validation import FloatArray
 
 #: Samples evaluated at once: bounds the check's memory on long trajectories
@@ -167,13 +168,36 @@ def verify(
         peaks.add(t, traj.dense_derivatives(orders))
     else:
         t = dense_times(traj.breakpoints)
+        flat = _constant_per_piece(traj, orders)
+        per_piece = {} if not flat else _evaluated(traj, traj.breakpoints[:-1], flat)
+        sampled = [n for n in orders if n not in flat]
         for start in range(0, t.size, CHUNK):
             chunk = t[start : start + CHUNK]
-            if isinstance(traj, ManyOrders):
-                peaks.add(chunk, traj.evaluate_orders(chunk, orders))
-            else:
-                peaks.add(chunk, {n: traj.evaluate(chunk, n) for n in orders})
+            peaks.add(chunk, _evaluated(traj, chunk, sampled) | per_piece)
     return peaks.result(int(t.size), guaranteed)
+
+
+def _constant_per_piece(traj: Trajectory, orders: Sequence[int]) -> list[int]:
+    """The ``orders`` (>= 1) whose dense samples take one value per piece of ``traj``.
+
+    A piecewise polynomial's derivatives of its degree and above are constant on each
+    piece, and every piece holds dense samples (:func:`dense_times`: >= 20 per span; the
+    last sample, at the end, lies in the last piece): their values are exactly the values
+    at the pieces' starts, so every maximum over them is the same, bit for bit, at one
+    evaluation per piece instead of 20 or more (all of a linear interpolation's, such as a
+    Skybrush CSV read back; a cubic's jerk). Position (order 0) stays sampled: the corridors
+    are checked at the times of its samples.
+    """
+    if not isinstance(traj, PiecewisePolynomial):
+        return []
+    return [n for n in orders if n >= max(1, traj.degree)]
+
+
+def _evaluated(traj: Trajectory, t: FloatArray, orders: Sequence[int]) -> dict[int, FloatArray]:
+    """``{n: traj.evaluate(t, n)}``, at once where the trajectory can (:class:`ManyOrders`)."""
+    if isinstance(traj, ManyOrders):
+        return traj.evaluate_orders(t, orders)
+    return {n: traj.evaluate(t, n) for n in orders}
 
 
 class _Peaks:
