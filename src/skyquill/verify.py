@@ -19,7 +19,7 @@ from typing import Any, Protocol, runtime_checkable
 import numpy as np
 
 from skyquill.limits import DerivativeLimit
-from skyquill.trajectory.base import Trajectory, dense_times
+from skyquill.trajectory.base import Trajectory, dense_times, derivatives
 from skyquill.trajectory.polynomial import PiecewisePolynomial
 from skyquill.validation import FloatArray
 
@@ -51,14 +51,6 @@ class FastDense(Protocol):
     def dense_times(self) -> FloatArray: ...
 
     def dense_derivatives(self, orders: Sequence[int]) -> dict[int, FloatArray]: ...
-
-
-@runtime_checkable
-class ManyOrders(Protocol):
-    """A trajectory that evaluates several derivative orders at once (the piecewise
-    polynomial: its pieces looked up once for all of them)."""
-
-    def evaluate_orders(self, t: FloatArray, orders: Sequence[int]) -> dict[int, FloatArray]: ...
 
 
 @dataclass(frozen=True)
@@ -169,11 +161,11 @@ def verify(
     else:
         t = dense_times(traj.breakpoints)
         flat = _constant_per_piece(traj, orders)
-        per_piece = {} if not flat else _evaluated(traj, traj.breakpoints[:-1], flat)
+        per_piece = {} if not flat else derivatives(traj, traj.breakpoints[:-1], flat)
         sampled = [n for n in orders if n not in flat]
         for start in range(0, t.size, CHUNK):
             chunk = t[start : start + CHUNK]
-            peaks.add(chunk, _evaluated(traj, chunk, sampled) | per_piece)
+            peaks.add(chunk, derivatives(traj, chunk, sampled) | per_piece)
     return peaks.result(int(t.size), guaranteed)
 
 
@@ -191,13 +183,6 @@ def _constant_per_piece(traj: Trajectory, orders: Sequence[int]) -> list[int]:
     if not isinstance(traj, PiecewisePolynomial):
         return []
     return [n for n in orders if n >= max(1, traj.degree)]
-
-
-def _evaluated(traj: Trajectory, t: FloatArray, orders: Sequence[int]) -> dict[int, FloatArray]:
-    """``{n: traj.evaluate(t, n)}``, at once where the trajectory can (:class:`ManyOrders`)."""
-    if isinstance(traj, ManyOrders):
-        return traj.evaluate_orders(t, orders)
-    return {n: traj.evaluate(t, n) for n in orders}
 
 
 class _Peaks:
