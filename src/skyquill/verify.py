@@ -165,7 +165,9 @@ def verify(
         sampled = [n for n in orders if n not in flat]
         for start in range(0, t.size, CHUNK):
             chunk = t[start : start + CHUNK]
-            peaks.add(chunk, derivatives(traj, chunk, sampled) | per_piece)
+            # (a linear interpolation has no order left to sample: no pieces looked up)
+            values = derivatives(traj, chunk, sampled) if sampled else {}
+            peaks.add(chunk, values | per_piece)
     return peaks.result(int(t.size), guaranteed)
 
 

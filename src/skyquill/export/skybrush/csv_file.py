@@ -32,6 +32,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from skyquill.errors import InputError
+from skyquill.export.skybrush import DEFLATE_LEVEL
 from skyquill.io.atomic import atomic_path
 from skyquill.io.numbers import parse_number
 from skyquill.io.source import open_binary
@@ -109,7 +110,10 @@ def write_csv_zip(drones: Sequence[CsvDrone], path: str | Path) -> Path:
     if len(set(names)) != len(names):
         raise InputError(f"drones: got repeated names in {names[:10]}, expected unique names")
     target = Path(path)
-    with atomic_path(target) as tmp, zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as archive:
+    with (
+        atomic_path(target) as tmp,
+        zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED, compresslevel=DEFLATE_LEVEL) as archive,
+    ):
         for drone in drones:
             archive.writestr(f"{drone.name}.csv", _csv_text(drone))
     return target

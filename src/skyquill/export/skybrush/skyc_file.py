@@ -51,6 +51,7 @@ from pathlib import Path
 from typing import Any
 
 from skyquill.errors import InputError
+from skyquill.export.skybrush import DEFLATE_LEVEL
 from skyquill.export.skybrush.keyframes import Keyframes
 from skyquill.export.skybrush.lights import lights_json, program_bytes
 from skyquill.export.skybrush.playback import MAX_SEGMENT_S, played_show
@@ -167,7 +168,10 @@ def write_skyc(
         show["settings"] = {"validation": dict(validation)}
     validate_show(show)  # what we write must pass our own reader
     file = Path(path)
-    with atomic_path(file) as tmp, zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as archive:
+    with (
+        atomic_path(file) as tmp,
+        zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED, compresslevel=DEFLATE_LEVEL) as archive,
+    ):
         archive.writestr("show.json", json.dumps(show, allow_nan=False))
     return file
 
