@@ -109,12 +109,13 @@ class Keyframes:
 
     def points(self) -> list[list[Any]]:
         """The ``points`` list of ``show.json``: ``[t, [x, y, z], [[c1], [c2]]]``, s and m."""
-        values = encode(self.units, self.scale)
-        times = self.times_ms / 1000.0
-        out: list[list[Any]] = [[float(times[0]), values[0, 0].tolist(), []]]
-        for i in range(values.shape[0]):
-            out.append([float(times[i + 1]), values[i, 3].tolist(), values[i, 1:3].tolist()])
-        return out
+        # one tolist of all the numbers, then lists of its lists: not three per segment
+        values = encode(self.units, self.scale).tolist()
+        times = (self.times_ms / 1000.0).tolist()
+        first: list[Any] = [times[0], values[0][0], []]
+        return [first] + [
+            [t, segment[3], segment[1:3]] for t, segment in zip(times[1:], values, strict=True)
+        ]
 
 
 def encode(units: NDArray[np.int64], scale: int) -> FloatArray:
