@@ -55,6 +55,8 @@ class Fleet:
         self._owner = np.repeat(np.arange(len(motions)), counts)
         self._keys = self.start + self._owner * self._span
         self._whole = self._within(self.start, self.end, np.arange(self.start.size))
+        # with a 0 past the last row, for reduceat (made once: a played show has millions)
+        self._whole_padded = np.append(self._whole, 0.0)
 
     def __len__(self) -> int:
         return int(self.jump.size)
@@ -141,9 +143,8 @@ class Fleet:
         out = np.zeros(begin.size)
         nonempty = stop > begin
         if nonempty.any():
-            whole = np.append(self._whole, 0.0)  # reduceat needs an index past the last row
             edges = np.column_stack([begin[nonempty], stop[nonempty]]).ravel()
-            out[nonempty] = np.maximum.reduceat(whole, edges)[::2]
+            out[nonempty] = np.maximum.reduceat(self._whole_padded, edges)[::2]
         return out
 
 
