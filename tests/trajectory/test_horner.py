@@ -32,16 +32,15 @@ def test_horner_on_scalar_pieces() -> None:
 
 @settings(max_examples=60, deadline=None)
 @given(
-    pieces=st.integers(1, 40),
-    n_coef=st.integers(1, 8),
-    axes=st.sampled_from([(), (1,), (3,)]),
+    table=st.tuples(st.integers(1, 40), st.integers(1, 8), st.sampled_from([(), (1,), (3,)])),
     samples=st.integers(0, 120),
     order=st.integers(0, 9),
     seed=st.integers(0, 2**32 - 1),
 )
 def test_horner_at_is_horner_of_the_gathered_pieces_bit_for_bit(
-    pieces: int, n_coef: int, axes: tuple[int, ...], samples: int, order: int, seed: int
+    table: tuple[int, int, tuple[int, ...]], samples: int, order: int, seed: int
 ) -> None:
+    pieces, n_coef, axes = table
     rng = np.random.default_rng(seed)
     coeffs = rng.normal(size=(pieces, n_coef, *axes)) * 10.0 ** rng.integers(-3, 4)
     idx = rng.integers(0, pieces, samples).astype(np.intp)

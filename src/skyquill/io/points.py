@@ -125,4 +125,5 @@ def table_text(table: FloatArray, header: str) -> str:
     rows, cells = table.shape
     row = ",".join([CELL_FORMAT] * cells) + "\n"
     head = header + "\n" if header else ""  # savetxt writes no line for an empty header
-    return head + (row * rows) % tuple(np.asarray(table, dtype=float).ravel().tolist())
+    body: str = (row * rows) % tuple(np.asarray(table, dtype=float).ravel().tolist())
+    return head + body

@@ -20,7 +20,7 @@ def _scaled(coeffs: FloatArray, order: int) -> FloatArray:
         return coeffs
     # d^n/dtau^n tau^j = j! / (j - n)! tau^(j - n)
     scale = np.array([math.perm(j, order) for j in range(order, coeffs.shape[1])], dtype=float)
-    return coeffs[:, order:] * scale.reshape((1, -1) + (1,) * (coeffs.ndim - 2))
+    return np.asarray(coeffs[:, order:] * scale.reshape((1, -1) + (1,) * (coeffs.ndim - 2)))
 
 
 def horner(coeffs: FloatArray, tau: FloatArray, order: int = 0) -> FloatArray:
@@ -68,7 +68,7 @@ def horner_columns(columns: FloatArray, idx: NDArray[np.intp], tau: FloatArray) 
     out = columns[-1].take(idx, axis=0)
     for m in range(columns.shape[0] - 2, -1, -1):
         out = out * tau_b + columns[m].take(idx, axis=0)
-    return out
+    return np.asarray(out)
 
 
 def horner_at(
