@@ -6,12 +6,14 @@ from dataclasses import dataclass
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from numpy.typing import NDArray
 from scipy.interpolate import make_lsq_spline
 
-from skyquill.limits import BoxLimit, CylinderLimit
-from skyquill.trajectory import SplineTrajectory
-from skyquill.verify import Verification, verify
+from skyquill.limits import BoxLimit, CylinderLimit, NormLimit
+from skyquill.trajectory import PiecewisePolynomial, SplineTrajectory, dense_times
+from skyquill.verify import Verification, _Peaks, verify
 
 FloatArray = NDArray[np.float64]
 
@@ -162,3 +164,29 @@ def test_as_dict_is_plain() -> None:
     assert d["max_speed"] == pytest.approx(np.sqrt(2.0))
     assert d["checks"][0]["label"] == "speed box"
     assert set(d) >= {"n_samples", "max_speed", "checks", "corridor_excess_m", "max_excess"}
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    pieces=st.integers(1, 30),
+    n_coef=st.integers(1, 6),
+    seed=st.integers(0, 2**32 - 1),
+)
+def test_piecewise_polynomial_checked_per_piece_where_constant_is_checked_at_every_sample(
+    pieces: int, n_coef: int, seed: int
+) -> None:
+    # Orders at and above the degree are evaluated once per piece: the report must be the
+    # one of evaluating every order at every dense sample, bit for bit.
+    rng = np.random.default_rng(seed)
+    breaks = np.concatenate([[0.0], np.cumsum(rng.uniform(0.01, 3.0, pieces))])
+    traj = PiecewisePolynomial(breaks, rng.normal(size=(pieces, n_coef, 3)))
+    limits = [
+        NormLimit(1, 1.5),
+        CylinderLimit(2, 1.0, z_lower=-0.5, z_upper=0.7),
+        BoxLimit(3, -np.ones(3), np.ones(3)),
+        NormLimit(4, 2.0),
+    ]
+    t = dense_times(breaks)
+    every = _Peaks(limits, (), 3)
+    every.add(t, {n: traj.evaluate(t, n) for n in (1, 2, 3, 4)})
+    assert verify(traj, limits, guaranteed=False) == every.result(t.size, False)

@@ -19,7 +19,8 @@ from typing import Any, Protocol, runtime_checkable
 import numpy as np
 
 from skyquill.limits import DerivativeLimit
-from skyquill.trajectory.base import Trajectory, dense_times
+from skyquill.trajectory.base import Trajectory, dense_times, derivatives
+from skyquill.trajectory.polynomial import PiecewisePolynomial
 from skyquill.validation import FloatArray
 
 #: Samples evaluated at once: bounds the check's memory on long trajectories
@@ -159,10 +160,31 @@ def verify(
         peaks.add(t, traj.dense_derivatives(orders))
     else:
         t = dense_times(traj.breakpoints)
+        flat = _constant_per_piece(traj, orders)
+        per_piece = {} if not flat else derivatives(traj, traj.breakpoints[:-1], flat)
+        sampled = [n for n in orders if n not in flat]
         for start in range(0, t.size, CHUNK):
             chunk = t[start : start + CHUNK]
-            peaks.add(chunk, {n: traj.evaluate(chunk, n) for n in orders})
+            # (a linear interpolation has no order left to sample: no pieces looked up)
+            values = derivatives(traj, chunk, sampled) if sampled else {}
+            peaks.add(chunk, values | per_piece)
     return peaks.result(int(t.size), guaranteed)
+
+
+def _constant_per_piece(traj: Trajectory, orders: Sequence[int]) -> list[int]:
+    """The ``orders`` (>= 1) whose dense samples take one value per piece of ``traj``.
+
+    A piecewise polynomial's derivatives of its degree and above are constant on each
+    piece, and every piece holds dense samples (:func:`dense_times`: >= 20 per span; the
+    last sample, at the end, lies in the last piece): their values are exactly the values
+    at the pieces' starts, so every maximum over them is the same, bit for bit, at one
+    evaluation per piece instead of 20 or more (all of a linear interpolation's, such as a
+    Skybrush CSV read back; a cubic's jerk). Position (order 0) stays sampled: the corridors
+    are checked at the times of its samples.
+    """
+    if not isinstance(traj, PiecewisePolynomial):
+        return []
+    return [n for n in orders if n >= max(1, traj.degree)]
 
 
 class _Peaks:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import gc
 import json
 from pathlib import Path
 
@@ -10,6 +11,7 @@ import pytest
 from typer.testing import CliRunner
 
 from skyquill.cli.main import app
+from skyquill.cli.show_cmd import _out_of_collectors_sight
 from skyquill.export.skybrush.csv_file import read_csv_zip
 from skyquill.export.skybrush.lights import light_colors, light_slices, program_bytes
 from skyquill.export.skybrush.skyc_file import read_show_json
@@ -161,3 +163,13 @@ def test_a_geofence_in_the_script(tmp_path: Path, fence: str, status: int, messa
     result = runner.invoke(app, ["show", str(script), "--out", str(tmp_path / "out")])
     assert result.exit_code == status, result.output
     assert message in " ".join(result.output.split())
+
+
+def test_the_plan_is_frozen_out_of_the_collectors_sight_only_while_writing() -> None:
+    kept = [[k] for k in range(100)]  # objects alive while the files are written
+    with _out_of_collectors_sight():
+        assert gc.get_freeze_count() >= len(kept)
+    assert gc.get_freeze_count() == 0
+    with pytest.raises(RuntimeError), _out_of_collectors_sight():
+        raise RuntimeError("a refused export")
+    assert gc.get_freeze_count() == 0

@@ -12,7 +12,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from skyquill.errors import InputError
-from skyquill.io.json_read import MAX_DEPTH, parse_json, read_json_file
+from skyquill.io.json_read import MAX_DEPTH, _may_refuse, check_depth, parse_json, read_json_file
 
 WHAT = "a test document"
 
@@ -115,3 +115,53 @@ def test_random_bytes_give_a_document_or_an_input_error(raw: bytes) -> None:
             read_json_file(path, WHAT)
         except InputError as exc:
             assert "raw.json" in str(exc)
+
+
+# Numbers written as JSON literals, huge ones included (Python reads 1e400 as infinity).
+_literal = st.one_of(
+    st.floats(allow_nan=False, allow_infinity=False).map(repr),
+    st.integers(-(10**400), 10**400).map(str),
+    st.builds(
+        lambda digits, exponent: f"{digits}e{exponent}",
+        st.integers(0, 10**120),
+        st.integers(-400, 400).map(lambda e: f"{e:+d}" if e % 2 else str(e)),
+    ),
+    st.text(alphabet='[]{}"\\,:ab', max_size=6).map(json.dumps),  # brackets inside strings
+)
+
+
+def _nested(leaves: st.SearchStrategy[str]) -> st.SearchStrategy[str]:
+    """JSON texts of ``leaves`` nested in arrays and objects, sometimes very deep."""
+    shallow = st.recursive(
+        leaves,
+        lambda inner: st.one_of(
+            st.lists(inner, max_size=3).map(lambda items: "[" + ",".join(items) + "]"),
+            st.lists(inner, max_size=3).map(
+                lambda items: "{" + ",".join(f'"k{i}": {v}' for i, v in enumerate(items)) + "}"
+            ),
+        ),
+        max_leaves=12,
+    )
+    return st.builds(
+        lambda depth, doc: "[" * depth + doc + "]" * depth, st.integers(0, MAX_DEPTH + 2), shallow
+    )
+
+
+@settings(max_examples=300, deadline=None)
+@given(text=_nested(_literal))
+def test_the_text_scan_finds_every_document_the_walk_refuses(text: str) -> None:
+    # parse_json walks the document (check_depth) only where the scan of its text says
+    # the walk could refuse it: the refusals must be the walk's, as before.
+    try:
+        data = json.loads(text)
+    except RecursionError:
+        return  # too deep for Python's parser: refused before the walk
+    try:
+        check_depth(data, "doc.json", WHAT)
+    except InputError as exc:
+        assert _may_refuse(text.encode())
+        with pytest.raises(InputError) as refused:
+            parse_json(text.encode(), "doc.json", WHAT)
+        assert str(refused.value) == str(exc)
+    else:
+        assert json.dumps(parse_json(text.encode(), "doc.json", WHAT)) == json.dumps(data)

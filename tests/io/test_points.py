@@ -3,17 +3,20 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from hypothesis.extra import numpy as hnp
 
 from skyquill.errors import InputError
 from skyquill.io.atomic import write_json
 from skyquill.io.points import (
     TRAJECTORY_COLUMNS,
     read_points_csv,
+    table_text,
     trajectory_table,
     write_trajectory_csv,
 )
@@ -110,3 +113,18 @@ def test_the_refusal_names_where_the_rate_came_from() -> None:
 
     with pytest.raises(InputError, match=r"^\[show\]\.rate: got 100 Hz over a 20000 s flight"):
         check_rows_written(20_000.0, 100.0, "[show].rate")
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    table=hnp.arrays(
+        float,
+        hnp.array_shapes(min_dims=2, max_dims=2, min_side=0, max_side=12),
+        elements=st.floats(allow_nan=True, allow_infinity=True, width=64),
+    ),
+)
+def test_table_text_is_what_savetxt_writes(table: np.ndarray, tmp_path_factory: Any) -> None:
+    path = tmp_path_factory.mktemp("savetxt") / "t.csv"
+    header = ",".join(f"c{i}" for i in range(table.shape[1]))
+    np.savetxt(path, table, delimiter=",", header=header, comments="", fmt="%.9g")
+    assert table_text(table, header).encode("latin-1") == path.read_bytes()

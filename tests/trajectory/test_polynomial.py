@@ -37,3 +37,16 @@ def test_validation() -> None:
     traj = PiecewisePolynomial(np.array([0.0, 1.0]), np.zeros((1, 2, 3)))
     with pytest.raises(InputError, match=r"t: got times in \[2, 2\] s"):
         traj.evaluate(np.array([2.0]))
+
+
+def test_evaluate_orders_is_evaluate_order_by_order() -> None:
+    rng = np.random.default_rng(3)
+    breaks = np.concatenate([[0.0], np.cumsum(rng.uniform(0.1, 2.0, 30))])
+    traj = PiecewisePolynomial(breaks, rng.normal(size=(30, 6, 3)))
+    t = np.sort(rng.uniform(0.0, traj.duration, 500))
+    got = traj.evaluate_orders(t, (0, 1, 3, 7))
+    assert list(got) == [0, 1, 3, 7]
+    for n, values in got.items():
+        np.testing.assert_array_equal(values, traj.evaluate(t, n))
+    with pytest.raises(InputError, match="order"):
+        traj.evaluate_orders(t, (-1,))

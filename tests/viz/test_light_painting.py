@@ -16,7 +16,15 @@ from skyquill.errors import InputError
 from skyquill.io.trajectory_json import PlannedTrajectory
 from skyquill.trajectory import PiecewisePolynomial
 from skyquill.viz.camera import Camera
-from skyquill.viz.light_painting import View, animate_show, long_exposure, write_pictures
+from skyquill.viz.light_painting import (
+    DARK,
+    STAMP,
+    View,
+    _palette,
+    animate_show,
+    long_exposure,
+    write_pictures,
+)
 
 RED, BLUE = (255, 0, 0), (0, 0, 255)
 
@@ -121,3 +129,27 @@ def test_any_view_gives_a_picture_or_an_input_error(
         exposure = long_exposure(drones, camera, Path(tmp) / "p.png")
         assert Image.open(exposure.path).size == (160, 90)
     assert camera.project(points)[1].all()
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    drones=st.integers(1, 6),
+    samples=st.integers(1, 40),
+    seed=st.integers(0, 2**32 - 1),
+)
+def test_palette_has_the_colours_of_every_sample(drones: int, samples: int, seed: int) -> None:
+    # Rounding only the samples where the colour changes keeps every colour: the palette
+    # is the one of rounding every sample.
+    rng = np.random.default_rng(seed)
+    choices = rng.integers(0, 256, (4, 3)) / 255.0
+    choices[0] = 0.0
+    colors = choices[rng.integers(0, 4, (drones, samples))] + rng.choice(
+        [0.0, 1e-4], (drones, samples, 1)
+    )
+    rgb = np.clip(np.round(255 * colors.reshape(-1, 3)), 0, 255).astype(np.int64)
+    lights = np.unique(rgb, axis=0).astype(float)
+    fixed = np.array([(0, 0, 0), [round(255 * c) for c in DARK], STAMP], dtype=float)
+    every = np.unique(np.concatenate([fixed, lights]), axis=0)[:256].astype(np.uint8)
+    expected = np.zeros(768, dtype=np.uint8)
+    expected[: every.size] = every.ravel()
+    assert _palette(colors).getpalette() == expected.tolist()

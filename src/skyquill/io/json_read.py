@@ -14,10 +14,16 @@ conversion never meet a structure deep enough to overflow the stack).
 
 from __future__ import annotations
 
+import gc
 import json
 import math
+import re
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
+
+import numpy as np
 
 from skyquill.errors import InputError
 from skyquill.io.source import decode_text, read_bytes
@@ -77,7 +83,8 @@ def parse_json(raw: bytes, name: str, what: str) -> Any:
     """
     text = decode_text(raw, name, what)
     try:
-        data = json.loads(text, object_pairs_hook=_unique_keys, parse_constant=_no_constant)
+        with collector_paused():
+            data = json.loads(text, object_pairs_hook=_unique_keys, parse_constant=_no_constant)
     except _RefusedError as exc:
         raise InputError(f"{name}: got {exc.got}, expected {what} ({exc.rule})") from None
     except json.JSONDecodeError as exc:
@@ -91,8 +98,57 @@ def parse_json(raw: bytes, name: str, what: str) -> Any:
         ) from None
     except ValueError as exc:  # an integer literal beyond Python's digit limit
         raise InputError(f"{name}: got an unreadable number ({exc}), expected {what}") from None
-    check_depth(data, name, what)
+    if _may_refuse(raw):
+        check_depth(data, name, what)
     return data
+
+
+@contextmanager
+def collector_paused() -> Iterator[None]:
+    """Python's cyclic garbage collector paused (and resumed if it ran), for building or
+    parsing a large JSON document.
+
+    Such a document allocates a list or dict per array or object and none of them can
+    form a cycle, but each allocation counts towards a collection that walks every object
+    alive: a 40 MB ``show.json`` (1,000 drones' keyframes) parsed in 1.5 s instead of 5.6 s.
+    """
+    running = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if running:
+            gc.enable()
+
+
+#: A string of the JSON text, escapes included (UTF-8 bytes: no byte of a multi-byte
+#: character is a quote or a backslash).
+_STRING = re.compile(rb'"[^"\\]*(?:\\.[^"\\]*)*"')
+#: An exponent of 100 or more.
+_LARGE_EXPONENT = re.compile(rb"[eE]\+?0*[1-9]\d\d")
+#: Digits to ``0``, every other byte to a space: a run of digits is a run of ``0``.
+_DIGITS = bytes(ord("0") if ord("0") <= c <= ord("9") else ord(" ") for c in range(256))
+#: Every byte but a bracket (deleted before counting them).
+_NOT_BRACKETS = bytes(c for c in range(256) if chr(c) not in "[]{}")
+
+
+def _may_refuse(raw: bytes) -> bool:
+    """Whether :func:`check_depth` could refuse the document parsed from ``raw``.
+
+    Read off the text by C-speed scans (0.6 s on a 40 MB ``show.json``) instead of
+    walking every value (3 s): outside its strings, a document nested no deeper than
+    :data:`MAX_DEPTH` brackets, without a run of 100 digits or an exponent of 100 or
+    more, holds no number beyond 1e200 and nothing else the walk refuses. Otherwise the
+    walk runs and refuses as it always has.
+    """
+    bare = _STRING.sub(b"", raw)
+    if _LARGE_EXPONENT.search(bare) or bare.translate(_DIGITS).find(b"0" * 100) >= 0:
+        return True
+    brackets = np.frombuffer(bare.translate(None, _NOT_BRACKETS), dtype=np.uint8)
+    if not brackets.size:
+        return False
+    step = np.where((brackets == ord("[")) | (brackets == ord("{")), 1, -1)
+    return int(np.cumsum(step).max()) > MAX_DEPTH
 
 
 def _unique_keys(pairs: list[tuple[str, Any]]) -> dict[str, Any]:

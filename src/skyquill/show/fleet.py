@@ -22,7 +22,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from skyquill.show.motion import LocalMotion, Motion, taylor_bound
-from skyquill.trajectory.horner import horner
+from skyquill.trajectory.horner import horner_columns, power_columns
 from skyquill.validation import FloatArray
 
 IntArray = NDArray[np.intp]
@@ -45,6 +45,8 @@ class Fleet:
         self.start = np.concatenate([m.breaks[:-1] for m in motions])
         self.end = np.concatenate([m.breaks[1:] for m in motions])
         self.coeffs = np.concatenate([_padded(m.coeffs, self.order) for m in motions])
+        # Each derivative's coefficients, one block per power, made once for the many lookups.
+        self._columns = [power_columns(self.coeffs, q) for q in range(self.order)]
         self.jump = np.array([m.jump_m for m in motions])
         self.horizon = max(m.horizon for m in motions)
         # Each drone's pieces shifted to their own stretch of one sorted axis; the
@@ -53,6 +55,8 @@ class Fleet:
         self._owner = np.repeat(np.arange(len(motions)), counts)
         self._keys = self.start + self._owner * self._span
         self._whole = self._within(self.start, self.end, np.arange(self.start.size))
+        # with a 0 past the last row, for reduceat (made once: a played show has millions)
+        self._whole_padded = np.append(self._whole, 0.0)
 
     def __len__(self) -> int:
         return int(self.jump.size)
@@ -84,16 +88,19 @@ class Fleet:
     def position(self, who: IntArray, t: FloatArray) -> FloatArray:
         """Positions of drones ``who`` (K,) at times ``t`` (K,), shape (K, 3), m."""
         idx = self.piece(who, t)
-        return horner(self.coeffs[idx], t - self.start[idx], 0).reshape(t.size, 3)
+        return horner_columns(self._columns[0], idx, t - self.start[idx]).reshape(t.size, 3)
 
     def _derivatives(self, t: FloatArray, idx: IntArray) -> FloatArray:
         """Orders 1 to ``K - 1`` of pieces ``idx`` at ``t``, shape (M, K - 1, 3)."""
         tau = t - self.start[idx]
-        coeffs = self.coeffs[idx]
         if self.order < 2:
             return np.zeros((t.size, 0, 3))
         return np.stack(
-            [horner(coeffs, tau, q).reshape(t.size, 3) for q in range(1, self.order)], axis=1
+            [
+                horner_columns(self._columns[q], idx, tau).reshape(t.size, 3)
+                for q in range(1, self.order)
+            ],
+            axis=1,
         )
 
     def _within(self, a: FloatArray, b: FloatArray, idx: IntArray) -> FloatArray:
@@ -136,9 +143,8 @@ class Fleet:
         out = np.zeros(begin.size)
         nonempty = stop > begin
         if nonempty.any():
-            whole = np.append(self._whole, 0.0)  # reduceat needs an index past the last row
             edges = np.column_stack([begin[nonempty], stop[nonempty]]).ravel()
-            out[nonempty] = np.maximum.reduceat(whole, edges)[::2]
+            out[nonempty] = np.maximum.reduceat(self._whole_padded, edges)[::2]
         return out
 
 

@@ -18,7 +18,7 @@ from skyquill.errors import InputError
 from skyquill.show.geofence import Geofence
 from skyquill.show.load import ShowDrone
 from skyquill.show.report import Measured, Violation
-from skyquill.trajectory import dense_times
+from skyquill.trajectory import dense_times, derivatives
 from skyquill.validation import FloatArray, as_float
 
 #: Largest relative excess over the speed and acceleration limits a check may allow.
@@ -160,8 +160,8 @@ def check_limits(
 def _sampled(drone: ShowDrone) -> _Series:
     traj = drone.trajectory
     t = dense_times(np.asarray(traj.breakpoints, dtype=float))
-    p, v, a = (traj.evaluate(t, order) for order in range(3))
-    return _Series(drone.name, t + drone.start_s, p, v, a)
+    d = derivatives(traj, t, (0, 1, 2))
+    return _Series(drone.name, t + drone.start_s, d[0], d[1], d[2])
 
 
 def _checks(limits: ShowLimits) -> list[tuple[str, float | None, _ValueOf, float, float]]:

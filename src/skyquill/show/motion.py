@@ -47,7 +47,7 @@ from skyquill.trajectory import (
     SplineTrajectory,
     Trajectory,
 )
-from skyquill.trajectory.horner import horner
+from skyquill.trajectory.horner import horner, horner_at
 from skyquill.validation import FloatArray
 
 #: Largest position jump accepted where pieces meet, m. Exported files are not exactly
@@ -129,13 +129,14 @@ class Motion:
     def position(self, t: FloatArray) -> FloatArray:
         """Positions at times ``t`` (N,) in ``[0, horizon]``, shape (N, 3), m."""
         idx = self._piece(t, "right")
-        return horner(self.coeffs[idx], t - self.breaks[idx], 0).reshape(t.size, 3)
+        return horner_at(self.coeffs, idx, t - self.breaks[idx], 0).reshape(t.size, 3)
 
     def derivatives_at(self, t: FloatArray, idx: NDArray[np.intp]) -> FloatArray:
         """Orders 1 to ``K - 1`` of piece ``idx`` (N,) at ``t`` (N,), shape (N, K - 1, 3)."""
         tau = t - self.breaks[idx]
-        coeffs = self.coeffs[idx]
-        orders = [horner(coeffs, tau, q).reshape(t.size, 3) for q in range(1, self.order)]
+        orders = [
+            horner_at(self.coeffs, idx, tau, q).reshape(t.size, 3) for q in range(1, self.order)
+        ]
         if not orders:
             return np.zeros((t.size, 0, 3))
         return np.stack(orders, axis=1)

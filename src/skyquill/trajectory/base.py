@@ -7,6 +7,7 @@ the protocol; the simulator, the verifier and every exporter take any of them.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Protocol, runtime_checkable
 
@@ -69,6 +70,22 @@ class Trajectory(Protocol):
     def sample(self, rate: float) -> Samples:
         """Samples at ``rate`` Hz from 0 to ``duration`` inclusive."""
         ...
+
+
+@runtime_checkable
+class ManyOrders(Protocol):
+    """A trajectory that evaluates several derivative orders at once (the piecewise
+    polynomial: its pieces looked up once for all of them)."""
+
+    def evaluate_orders(self, t: FloatArray, orders: Sequence[int]) -> dict[int, FloatArray]: ...
+
+
+def derivatives(traj: Trajectory, t: FloatArray, orders: Sequence[int]) -> dict[int, FloatArray]:
+    """``{n: traj.evaluate(t, n)}`` for each of ``orders``, at once where the kind can
+    (:class:`ManyOrders`); shape (N, d) each."""
+    if isinstance(traj, ManyOrders):
+        return traj.evaluate_orders(t, orders)
+    return {n: traj.evaluate(t, n) for n in orders}
 
 
 def evaluation_times(t: object, duration: float) -> FloatArray:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -10,7 +11,7 @@ from numpy.typing import NDArray
 
 from skyquill.errors import InputError
 from skyquill.trajectory.base import Samples, check_breakpoints, evaluation_times, sample
-from skyquill.trajectory.horner import horner
+from skyquill.trajectory.horner import horner_at
 from skyquill.validation import FloatArray, as_array, as_int
 
 
@@ -119,7 +120,16 @@ class PiecewisePolynomial:
         """
         order = as_int("order", order, low=0)
         tau, idx = self._locate(t)
-        return horner(self.coeffs[idx], tau, order).reshape(tau.size, self.dim)
+        return horner_at(self.coeffs, idx, tau, order).reshape(tau.size, self.dim)
+
+    def evaluate_orders(self, t: FloatArray, orders: Sequence[int]) -> dict[int, FloatArray]:
+        """``{n: self.evaluate(t, n)}`` for each of ``orders``, the pieces looked up once.
+
+        The same arrays as :meth:`evaluate` order by order, bit for bit; shape (N, d) each.
+        """
+        checked = [as_int("order", n, low=0) for n in orders]
+        tau, idx = self._locate(t)
+        return {n: horner_at(self.coeffs, idx, tau, n).reshape(tau.size, self.dim) for n in checked}
 
     def evaluate_yaw(self, t: FloatArray, order: int = 0) -> FloatArray:
         """The ``order``-th time derivative of yaw, shape (N,), rad / s^order (0 without yaw)."""
@@ -127,7 +137,7 @@ class PiecewisePolynomial:
         tau, idx = self._locate(t)
         if self.yaw_coeffs is None:
             return np.zeros(tau.size)
-        return horner(self.yaw_coeffs[idx], tau, order).reshape(tau.size)
+        return horner_at(self.yaw_coeffs, idx, tau, order).reshape(tau.size)
 
     def sample(self, rate: float) -> Samples:
         """Samples at ``rate`` Hz (position to jerk), including both ends."""

@@ -2,15 +2,18 @@
 
 from __future__ import annotations
 
+import json
 from itertools import pairwise
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from skyquill.errors import InputError
 from skyquill.export.base import ALLOWED_EXCESS
 from skyquill.export.skybrush.keyframe_times import MAX_FIT_MS, MIN_FIT_MS
-from skyquill.export.skybrush.keyframes import encode, skybrush_keyframes
+from skyquill.export.skybrush.keyframes import Keyframes, encode, skybrush_keyframes
 from skyquill.export.skybrush.playback import played_trajectory, quantize
 from skyquill.limits import VehicleLimits
 from skyquill.trajectory import PiecewisePolynomial, RestToRestSequence, SplineTrajectory
@@ -165,3 +168,22 @@ def test_jerk_ramps_long_enough_for_a_coarse_grid_play_inside_the_limits(
     assert keys.keyframes.scale == 14 and keys.attempt == 0
     assert keys.keyframes.exact_segments == keys.keyframes.units.shape[0]
     assert keys.delivered.within_allowed
+
+
+@settings(max_examples=30, deadline=None)
+@given(segments=st.integers(1, 30), scale=st.integers(1, 20), seed=st.integers(0, 2**32 - 1))
+def test_points_are_each_segment_listed_on_its_own(segments: int, scale: int, seed: int) -> None:
+    # show.json's points list, built from one tolist of every number, against the
+    # segment-by-segment listing it replaced.
+    rng = np.random.default_rng(seed)
+    units = rng.integers(-40_000, 40_000, (segments, 4, 3))
+    units[1:, 0] = units[:-1, 3]
+    times_ms = np.concatenate([[0], np.cumsum(rng.integers(1, 3000, segments))])
+    frames = Keyframes(times_ms, units, scale, 0.0)
+    values = encode(units, scale)
+    times = times_ms / 1000.0
+    listed = [[float(times[0]), values[0, 0].tolist(), []]] + [
+        [float(times[i + 1]), values[i, 3].tolist(), values[i, 1:3].tolist()]
+        for i in range(segments)
+    ]
+    assert json.dumps(frames.points()) == json.dumps(listed)

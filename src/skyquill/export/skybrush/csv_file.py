@@ -32,6 +32,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from skyquill.errors import InputError
+from skyquill.export.skybrush import DEFLATE_LEVEL
 from skyquill.io.atomic import atomic_path
 from skyquill.io.numbers import parse_number
 from skyquill.io.source import open_binary
@@ -109,7 +110,10 @@ def write_csv_zip(drones: Sequence[CsvDrone], path: str | Path) -> Path:
     if len(set(names)) != len(names):
         raise InputError(f"drones: got repeated names in {names[:10]}, expected unique names")
     target = Path(path)
-    with atomic_path(target) as tmp, zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as archive:
+    with (
+        atomic_path(target) as tmp,
+        zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED, compresslevel=DEFLATE_LEVEL) as archive,
+    ):
         for drone in drones:
             archive.writestr(f"{drone.name}.csv", _csv_text(drone))
     return target
@@ -218,8 +222,15 @@ def _plain_columns(
         return None
     if not _PLAIN_BODY.fullmatch(body):
         return None
-    values = np.array(re.split(r"[,\n]", body.replace("\r", "").rstrip("\n")), dtype=float)
-    table = values.reshape(-1, len(HEADER))
+    # numpy's C reader on the rows just matched (it converts as Python's float does: the
+    # same floats as splitting the text and converting each value, at a quarter the time)
+    table = np.loadtxt(
+        io.StringIO(body.replace("\r", "").rstrip("\n")),
+        delimiter=",",
+        comments=None,
+        ndmin=2,
+        dtype=float,
+    )
     if table.shape[0] < 2:
         return None
     t, positions, colors = table[:, 0], table[:, 1:4], table[:, 4:7]

@@ -49,7 +49,7 @@ from skyquill.export.skybrush.keyframe_fit import fit_region
 from skyquill.export.skybrush.keyframe_times import Segmentation, segmentation
 from skyquill.export.skybrush.playback import quantize, scaling_factor
 from skyquill.limits import DerivativeLimit
-from skyquill.trajectory import Trajectory
+from skyquill.trajectory import Trajectory, derivatives
 from skyquill.validation import FloatArray, as_float
 
 #: Points per segment at which the keyframes' distance from the plan is measured (ends included).
@@ -109,12 +109,13 @@ class Keyframes:
 
     def points(self) -> list[list[Any]]:
         """The ``points`` list of ``show.json``: ``[t, [x, y, z], [[c1], [c2]]]``, s and m."""
-        values = encode(self.units, self.scale)
-        times = self.times_ms / 1000.0
-        out: list[list[Any]] = [[float(times[0]), values[0, 0].tolist(), []]]
-        for i in range(values.shape[0]):
-            out.append([float(times[i + 1]), values[i, 3].tolist(), values[i, 1:3].tolist()])
-        return out
+        # one tolist of all the numbers, then lists of its lists: not three per segment
+        values = encode(self.units, self.scale).tolist()
+        times = (self.times_ms / 1000.0).tolist()
+        first: list[Any] = [times[0], values[0][0], []]
+        return [first] + [
+            [t, segment[3], segment[1:3]] for t, segment in zip(times[1:], values, strict=True)
+        ]
 
 
 def encode(units: NDArray[np.int64], scale: int) -> FloatArray:
@@ -136,8 +137,8 @@ def encode(units: NDArray[np.int64], scale: int) -> FloatArray:
 def _hermite(traj: Trajectory, times_ms: NDArray[np.int64]) -> FloatArray:
     """Cubic Hermite Bézier points of every segment, shape (P, 4, 3), m."""
     t = np.minimum(times_ms / 1000.0, traj.duration)  # past the end: held at the end
-    p = traj.evaluate(t)
-    v = traj.evaluate(t, 1)
+    at = derivatives(traj, t, (0, 1))
+    p, v = at[0], at[1]
     h = np.diff(times_ms)[:, None] / 1000.0
     return np.stack([p[:-1], p[:-1] + v[:-1] * h / 3, p[1:] - v[1:] * h / 3, p[1:]], axis=1)
 

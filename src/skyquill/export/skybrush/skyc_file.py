@@ -51,11 +51,12 @@ from pathlib import Path
 from typing import Any
 
 from skyquill.errors import InputError
+from skyquill.export.skybrush import DEFLATE_LEVEL
 from skyquill.export.skybrush.keyframes import Keyframes
 from skyquill.export.skybrush.lights import lights_json, program_bytes
 from skyquill.export.skybrush.playback import MAX_SEGMENT_S, played_show
 from skyquill.io.atomic import atomic_path
-from skyquill.io.json_read import parse_json
+from skyquill.io.json_read import collector_paused, parse_json
 from skyquill.io.source import open_binary
 from skyquill.trajectory import PiecewisePolynomial
 
@@ -155,20 +156,24 @@ def write_skyc(
         raise InputError("drones: got nothing, expected a non-empty sequence of SkycDrone")
     if not isinstance(title, str):
         raise InputError(f"title: got {type(title).__name__}, expected a string")
-    show: dict[str, Any] = {
-        "version": 1,
-        "environment": {"type": "indoor"}
-        if location is None
-        else {"type": "outdoor", "location": dict(location)},
-        "meta": {"title": title},
-        "swarm": {"drones": [_drone_json(d) for d in drones]},
-    }
-    if validation is not None:
-        show["settings"] = {"validation": dict(validation)}
-    validate_show(show)  # what we write must pass our own reader
-    file = Path(path)
-    with atomic_path(file) as tmp, zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as archive:
-        archive.writestr("show.json", json.dumps(show, allow_nan=False))
+    with collector_paused():  # millions of small lists: no cycles among them
+        show: dict[str, Any] = {
+            "version": 1,
+            "environment": {"type": "indoor"}
+            if location is None
+            else {"type": "outdoor", "location": dict(location)},
+            "meta": {"title": title},
+            "swarm": {"drones": [_drone_json(d) for d in drones]},
+        }
+        if validation is not None:
+            show["settings"] = {"validation": dict(validation)}
+        validate_show(show)  # what we write must pass our own reader
+        file = Path(path)
+        with (
+            atomic_path(file) as tmp,
+            zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED, compresslevel=DEFLATE_LEVEL) as archive,
+        ):
+            archive.writestr("show.json", json.dumps(show, allow_nan=False))
     return file
 
 

@@ -21,7 +21,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from skyquill.limits import BoxLimit, CylinderLimit, DerivativeLimit, NormLimit
-from skyquill.trajectory import Trajectory, dense_times
+from skyquill.trajectory import Trajectory, dense_times, derivatives
 
 #: How close to the true closest approach ``minDistance`` is proven, m.
 MIN_DISTANCE_TOLERANCE_M = 1e-3
@@ -89,20 +89,17 @@ def validation_settings(
 
 def _played_maxima(trajectories: Sequence[Trajectory]) -> dict[int, tuple[float, float, float]]:
     """Per order (1, 2): the largest (horizontal, down, up) value over every drone, sampled
-    densely."""
-    out: dict[int, tuple[float, float, float]] = {}
-    for order in KEYS:
-        worst = np.zeros(3)
-        for traj in trajectories:
-            d = traj.evaluate(dense_times(traj.breakpoints), order)
+    densely (both orders from one lookup of each drone's pieces)."""
+    worst = {order: np.zeros(3) for order in KEYS}
+    for traj in trajectories:
+        for order, d in derivatives(traj, dense_times(traj.breakpoints), tuple(KEYS)).items():
             here = [
                 float(np.hypot(d[:, 0], d[:, 1]).max()),
                 float(-d[:, 2].min()),
                 float(d[:, 2].max()),
             ]
-            worst = np.maximum(worst, here)
-        out[order] = (float(worst[0]), float(worst[1]), float(worst[2]))
-    return out
+            worst[order] = np.maximum(worst[order], here)
+    return {order: (float(w[0]), float(w[1]), float(w[2])) for order, w in worst.items()}
 
 
 def _closest(trajectories: Sequence[Trajectory]) -> float:
