@@ -6,7 +6,7 @@ import gc
 import time
 from collections.abc import Iterator
 from contextlib import contextmanager
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from pathlib import Path
 from typing import Annotated, Any
 
@@ -24,14 +24,16 @@ from skyquill.cli.main import (
     scheduler_address,
     stage_progress,
     user_errors,
+    worker_count,
 )
 from skyquill.cli.pictures import NoPictures, Pictures
-from skyquill.errors import InfeasibleError, InputError
+from skyquill.errors import InfeasibleError
 from skyquill.io.atomic import write_json
 from skyquill.io.outputs import staged_output
 from skyquill.io.plan_dir import trajectory_names, with_phases, write_plan
 from skyquill.io.points import check_rows_written
 from skyquill.io.trajectory_json import PlannedTrajectory
+from skyquill.parallel import Where
 from skyquill.phases import MIN_ALTITUDE_M
 from skyquill.show import ShowDrone, ShowLimits, ShowReport, check_show
 from skyquill.show.build import ShowPlan, build_show
@@ -41,8 +43,6 @@ from skyquill.show.script import ShowScript, load_script
 #: Relative round-off allowed over the planned limits in the independent check
 #: (Ruckig's profiles touch the limits exactly; the writing QP holds them to its tolerance).
 CHECK_ROUND_OFF = 1e-6
-#: Most ``--workers`` (processes planning the writing): more than any machine's cores is a typo.
-MAX_WORKERS = 256
 
 
 @app.command()
@@ -76,8 +76,7 @@ def show(
     with user_errors():
         check_out(out)
         floor = min_altitude(min_altitude_m)
-        if workers is not None and not 1 <= workers <= MAX_WORKERS:
-            raise InputError(f"--workers: got {workers}, expected 1 to {MAX_WORKERS}")
+        workers = worker_count(workers)
         scheduler = scheduler_address(scheduler)
         show_script = load_script(script)
         stages: dict[str, float] = {}
@@ -91,7 +90,7 @@ def show(
             _out_of_collectors_sight(),
         ):
             drawn = Pictures(not no_pictures)
-            where = _Where(workers, scheduler)
+            where = Where(workers, scheduler)
             summary = _write(stage, plan, show_script, report, stages, drawn, floor, where)
     say_done(
         f"{out}: {summary['drones']} drones, {summary['duration_s']:.1f} s, no two closer than "
@@ -118,15 +117,6 @@ def _out_of_collectors_sight() -> Iterator[None]:
         yield
     finally:
         gc.unfreeze()
-
-
-@dataclass(frozen=True)
-class _Where:
-    """Where the per-drone work runs: ``--workers`` processes, or the ``--scheduler``
-    (the writing, the .skyc and the Skybrush CSV; the files are written by local processes)."""
-
-    workers: int | None
-    scheduler: str | None
 
 
 def _plan(script: ShowScript, workers: int | None, scheduler: str | None) -> ShowPlan:
@@ -178,7 +168,7 @@ def _write(
     stages: dict[str, float],
     drawn: Pictures,
     min_altitude_m: float,
-    where: _Where,
+    where: Where,
 ) -> dict[str, Any]:
     from skyquill.viz.light_painting import write_pictures
 
@@ -246,7 +236,7 @@ def _write(
 
 
 def _studio_csv(
-    stage: Path, plans: list[tuple[str, PlannedTrajectory]], script: ShowScript, where: _Where
+    stage: Path, plans: list[tuple[str, PlannedTrajectory]], script: ShowScript, where: Where
 ) -> dict[str, Any]:
     """Write ``show.zip``, Skybrush Studio's per-drone CSVs, read back as Studio reads them."""
     from skyquill.export.base import ExportOptions
@@ -263,7 +253,7 @@ def _studio_csv(
 
 
 def _skyc(
-    stage: Path, plans: list[tuple[str, PlannedTrajectory]], script: ShowScript, where: _Where
+    stage: Path, plans: list[tuple[str, PlannedTrajectory]], script: ShowScript, where: Where
 ) -> dict[str, Any]:
     """Write ``show.skyc``, load it back as the drones play it and check it again.
 
