@@ -76,8 +76,16 @@ _Scratch = tuple[FloatArray, FloatArray, FloatArray]
 
 
 def _compiled(fn: _F) -> _F:
-    """``numba.njit(cache=True)`` with the function's own type for mypy."""
-    return cast(_F, numba.njit(cache=True)(fn))
+    """``numba.njit(cache=True)`` with the function's own type for mypy.
+
+    The machine code is cached beside this file, or in the user's cache directory when the
+    install is read-only; where neither can be written numba refuses ``cache=True`` (a
+    ``RuntimeError`` at import), and the kernels are then compiled in every process.
+    """
+    try:
+        return cast(_F, numba.njit(cache=True)(fn))
+    except RuntimeError:
+        return cast(_F, numba.njit(fn))
 
 
 @_compiled
@@ -108,7 +116,7 @@ def _corner(px: FloatArray, py: FloatArray, nv: int, k: int) -> float:
         return np.inf
     a = k - 1 if k > 0 else nv - 1
     z = k + 1 if k + 1 < nv else 0
-    return abs((px[k] - px[a]) * (py[z] - py[a]) - (py[k] - py[a]) * (px[z] - px[a]))
+    return float(abs((px[k] - px[a]) * (py[z] - py[a]) - (py[k] - py[a]) * (px[z] - px[a])))
 
 
 @_compiled
@@ -441,8 +449,9 @@ def solve_pairs(
     ndarray, shape (n,)
         ``b`` with ``0 <= b <= ub`` holding every row exactly.
     """
-    acc_c = tuple(np.ascontiguousarray(x, dtype=np.float64) for x in acc)
-    jerk_c = tuple(np.ascontiguousarray(x, dtype=np.float64) for x in jerk)
+    al, be, racc = (np.ascontiguousarray(x, dtype=np.float64) for x in acc)
+    cm, cc, cp, rj = (np.ascontiguousarray(x, dtype=np.float64) for x in jerk)
+    acc_c, jerk_c = (al, be, racc), (cm, cc, cp, rj)
     ub_c = np.ascontiguousarray(np.maximum(ub, 0.0), dtype=np.float64)
     polygons = _controllable(acc_c, jerk_c, ub_c, (int(cap), float(rtol)))
     b = _forward(polygons, jerk_c, ub_c)

@@ -17,7 +17,6 @@ from collections.abc import Callable
 import numpy as np
 
 from skyquill.coverage.deadline import Deadline
-from skyquill.coverage.speed.pairs import solve_pairs
 from skyquill.coverage.speed.reach import AccelerationRows, ReachPass
 from skyquill.coverage.speed.rows import _GridLP, jerk_coefficients
 from skyquill.validation import FloatArray
@@ -70,6 +69,10 @@ class PairsGrid:
         self.deadline = deadline
         self.pairs_time = 0.0
         self.pairs_solves = 0
+        # Imported here: numba takes 0.6 s to import, which no other method should pay.
+        from skyquill.coverage.speed.pairs import solve_pairs
+
+        self._solve_pairs = solve_pairs
 
     @property
     def time(self) -> float:
@@ -103,7 +106,7 @@ class PairsGrid:
             start = time.perf_counter()
             acc_r = r[:split].reshape(2 * q, n - 1).T
             lim = jerk_r.reshape(q, n - 2).T / self.root[:, None]
-            b = solve_pairs((self.acc.alpha, self.acc.beta, acc_r), (*self.jerk, lim), ub)
+            b = self._solve_pairs((self.acc.alpha, self.acc.beta, acc_r), (*self.jerk, lim), ub)
             self.pairs_time += time.perf_counter() - start
             self.pairs_solves += 1
             if np.all(b[1:-1] > 0.0) or not np.all(ub[1:-1] > 0.0):

@@ -126,7 +126,7 @@ def plan_speed(
     deadline : Deadline, optional
         A wall-time budget: checked before every LP solve, whose HiGHS time
         limit is what is left of it (see :class:`~skyquill.coverage.deadline.Deadline`).
-    method : {"auto", "reach", "banded", "lp"}, default "auto"
+    method : {"auto", "reach", "banded", "pairs", "lp"}, default "auto"
         How the grid problems are solved. ``"reach"``: without a jerk limit,
         by the backward and forward reachability passes (:mod:`.reach`; the
         LP's optimum, in linear time). ``"banded"``: with a jerk limit, the
@@ -134,6 +134,11 @@ def plan_speed(
         banded interior-point method (:mod:`.banded`, linear time per Newton
         step; with a norm limit on the rows of the polygon's directions that
         can bind, :mod:`.active_rows`); without one it is ``"reach"``.
+        ``"pairs"`` (opt-in): with a jerk limit, the pseudo-jerk LPs by
+        TOPP-RA lifted to pairs ``(b_i, b_{i+1})`` (:mod:`.pairs`, compiled by
+        numba: linear time, no Newton steps); every row held exactly, but the
+        greedy pass is not optimal: plans 0.02-1.4 % longer than the LP's
+        (``docs/coverage-speed.md``); without a jerk limit it is ``"reach"``.
         ``"lp"``: every problem by the HiGHS grid LP (the reference).
         ``"auto"``: ``"reach"`` without a jerk limit; with one ``"lp"`` below
         :data:`~.validate.BANDED_FROM_POINTS` grid points (its simplex
