@@ -22,6 +22,9 @@ _SAMPLE_GRID = 2000
 _MIN_SAMPLES = 3
 #: Weight of the last solution in the next pseudo-jerk reference (geometric mean).
 DAMPING = 0.65
+#: A change of the pseudo-jerk iteration sets a new low when it is below this share of the
+#: lowest before (with ``patience``: a creep of 1e-6 a step is no progress).
+STALL = 0.9
 
 
 def _initial_solve(
@@ -78,8 +81,8 @@ def _pseudo_jerk(
     stop
         ``(max_iterations, tolerance, patience)``: at most ``max_iterations``; stop at a
         relative change of ``sqrt(b)`` between a reference and its solution below
-        ``tolerance``, or once the change has not set a new low for ``patience``
-        iterations (a solver that is not exactly optimal, :mod:`.pairs`, settles to a
+        ``tolerance``, or once the change has not set a new low (:data:`STALL`) for
+        ``patience`` iterations (a solver that is not exactly optimal, :mod:`.pairs`, settles to a
         small cycle instead of a fixed point).
     log
         Lists that receive the objectives and the relative changes.
@@ -102,7 +105,7 @@ def _pseudo_jerk(
         sq = np.sqrt(b)
         change = float(np.max(np.abs(sq - np.sqrt(ref))) / max(np.max(sq), 1e-300))
         changes.append(change)
-        stalled = 0 if change < low else stalled + 1
+        stalled = 0 if change < STALL * low else stalled + 1
         low = min(low, change)
         if change < tol or stalled >= patience:
             break

@@ -25,6 +25,8 @@ _log = logging.getLogger(__name__)
 #: Pseudo-jerk iterations without a new smallest change after which the iteration stops
 #: (the greedy answers settle to a small cycle, see :func:`~.iteration._pseudo_jerk`).
 PATIENCE = 3
+#: Largest row excess of a pairs answer taken (scaled away); past it HiGHS answers.
+EXCESS_RTOL = 1e-6
 
 
 class PairsGrid:
@@ -106,12 +108,17 @@ class PairsGrid:
             start = time.perf_counter()
             acc_r = r[:split].reshape(2 * q, n - 1).T
             lim = jerk_r.reshape(q, n - 2).T / self.root[:, None]
-            b = self._solve_pairs((self.acc.alpha, self.acc.beta, acc_r), (*self.jerk, lim), ub)
+            acc_rows = (self.acc.alpha, self.acc.beta, acc_r)
+            b, excess = self._solve_pairs(acc_rows, (*self.jerk, lim), ub)
             self.pairs_time += time.perf_counter() - start
             self.pairs_solves += 1
-            if np.all(b[1:-1] > 0.0) or not np.all(ub[1:-1] > 0.0):
+            if excess > 1.0 + EXCESS_RTOL:
+                _log.warning("the pairs method broke a row by %.3g; HiGHS answers", excess - 1.0)
+            elif np.all(b[1:-1] > 0.0) or not np.all(ub[1:-1] > 0.0):
                 return b
-            _log.warning("the pairs method stopped the vehicle at an interior node; HiGHS answers")
+            else:
+                _log.warning("the pairs method stopped the vehicle at an interior node; "
+                             "HiGHS answers")  # fmt: skip
         if self._lp is None:
             self._lp = self._build_lp()
         return self._lp.solve(r, ub)
