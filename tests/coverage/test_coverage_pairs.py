@@ -29,9 +29,10 @@ from skyquill.validation import FloatArray
 
 #: How far below HiGHS's optimum a pairs answer's ``sum(b)`` may be on one pseudo-jerk LP.
 #: Measured on 120 random paths (300 points, linearised at 0.3-1 x the jerk-free optimum):
-#: median 0.10-0.14 % (three seeds of 40), worst 10.7 % (a 16-gon linearised at 0.88 x the
-#: envelope, far from any iterate of a plan): greedy is not optimal for ``sum(b)``.
-SUM_RTOL = 0.15
+#: median 0.10-0.14 % (three seeds of 40), worst 10.7 %; hypothesis found 16.7 % (a wiggle
+#: with a hook, linearised at the envelope itself, far from any iterate of a plan): greedy
+#: is not optimal for ``sum(b)``.
+SUM_RTOL = 0.2
 #: How much longer a pairs plan may be than the LP's (500 points, refinement to 2 %):
 #: measured +0.04 % to +0.43 % on the spiral, a hook, an S and a zigzag.
 PLAN_RTOL = 1e-2

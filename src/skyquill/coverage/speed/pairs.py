@@ -424,37 +424,66 @@ def _column(vx: FloatArray, vy: FloatArray, nv: int, x: float) -> tuple[float, f
 
 
 @_compiled
+def _least_broken(bounds: FloatArray, m: int) -> float:
+    """The ``z`` that breaks the rows ``(lo, hi, weight)`` (``m`` rows of ``bounds``) least,
+    ``max(weight (z - hi), weight (lo - z))`` over them, by bisection (their ranges do not
+    meet: round-off)."""
+    a, z = np.inf, -np.inf
+    for k in range(m):
+        a, z = min(a, bounds[k, 1]), max(z, bounds[k, 0])
+    for _ in range(60):
+        mid = 0.5 * (a + z)
+        over = under = 0.0
+        for k in range(m):
+            over = max(over, bounds[k, 2] * (mid - bounds[k, 1]))
+            under = max(under, bounds[k, 2] * (bounds[k, 0] - mid))
+        if over > under:
+            z = mid
+        else:
+            a = mid
+    return 0.5 * (a + z)
+
+
+@_compiled
 def _forward(
     polygons: tuple[FloatArray, FloatArray, Any],
     jerk: JerkRows,
     ub: FloatArray,
 ) -> FloatArray:
     """The greedy pass: node by node the largest ``b_{i+1}`` inside ``K_i`` and the jerk rows
-    of node ``i``."""
+    of node ``i``.
+
+    Where the jerk rows' ranges do not meet (round-off: a row of a direction almost normal
+    to the path, whose ``b_{i+1}`` coefficient is 1e-4 of another's, at 32,000 points),
+    the ``b_{i+1}`` that breaks them least relative to their bounds is taken, not the top
+    of their range: that broke the other row 4.5-fold.
+    """
     vx, vy, vn = polygons
     cm, cc, cp, rj = jerk
     n = ub.size
+    q = cm.shape[1]
     b = np.zeros(n)
+    rows = np.empty((q, 3))  # (lo, hi, weight) of every jerk row of the node
     for k in range(vn[0]):
         b[0] = max(b[0], vx[0, k])
     b[0] = min(b[0], ub[0])
     for i in range(n - 1):
-        lo, hi = _column(vx[i], vy[i], vn[i], b[i])
-        hi = min(hi, ub[i + 1])
-        if i >= 1:
-            for k in range(cm.shape[1]):
-                lim = rj[i - 1, k]
-                s = cp[i - 1, k]
-                if not np.isfinite(lim) or s == 0.0:
-                    continue
-                t = cm[i - 1, k] * b[i - 1] + cc[i - 1, k] * b[i]
-                if s > 0.0:
-                    hi = min(hi, (lim - t) / s)
-                    lo = max(lo, (-lim - t) / s)
-                else:
-                    hi = min(hi, (-lim - t) / s)
-                    lo = max(lo, (lim - t) / s)
-        b[i + 1] = max(hi, 0.0)
+        hi = min(_column(vx[i], vy[i], vn[i], b[i])[1], ub[i + 1])
+        m = 0
+        jlo, jhi = -np.inf, np.inf
+        for k in range(q if i >= 1 else 0):
+            lim = rj[i - 1, k]
+            s = cp[i - 1, k]
+            if not np.isfinite(lim) or s == 0.0:
+                continue
+            t = cm[i - 1, k] * b[i - 1] + cc[i - 1, k] * b[i]
+            rlo, rhi = min((lim - t) / s, (-lim - t) / s), max((lim - t) / s, (-lim - t) / s)
+            rows[m, 0], rows[m, 1], rows[m, 2] = rlo, rhi, abs(s) / lim
+            jlo, jhi = max(jlo, rlo), min(jhi, rhi)
+            m += 1
+        if jlo > jhi:
+            jhi = _least_broken(rows, m)
+        b[i + 1] = max(min(hi, jhi), 0.0)
     return b
 
 
