@@ -87,7 +87,9 @@ class SpeedPlan:
     grid : str
         ``"uniform"`` or ``"adaptive"`` (see :func:`plan_speed`).
     method : str
-        ``"reach"`` (the reachability passes solved every problem) or ``"lp"``.
+        The solver that answered (``method`` of :func:`plan_speed`): ``"reach"``,
+        ``"banded"``, ``"pairs"``, or ``"lp"`` (also when HiGHS had to answer for one
+        of the others).
     norm_sides : int or None
         None: ``amax``/``jmax`` hold per axis.  Else they are Euclidean norm
         limits, held in the LP by the inscribed polygon of this many sides
