@@ -160,9 +160,7 @@ def lp_cases(curve: Any, runs: int, grid: str) -> list[dict[str, Any]]:
     entries.append(first_jerk_lp(a, bounds, runs, grid))
     # Converge the pseudo-jerk iteration once, then time re-solves after a bound change.
     lp = _GridLP(a, backend="highspy")
-    b, _ = _pseudo_jerk(
-        lp, bounds, lp.solve(free, bounds.cols()), stop=(20, 1e-3, 20), log=([], [])
-    )
+    b, _ = _pseudo_jerk(lp, bounds, lp.solve(free, bounds.cols()), stop=(20, 1e-3), log=([], []))
     rows_a, rows_b = bounds.rows(b), bounds.rows(0.99 * b)
     flip = [False]
 

@@ -62,9 +62,7 @@ profile and its setpoints), :mod:`.rows` (the grid LP's rows and bounds, on
 :class:`skyquill.solvers.lp.LinearProgram`), :mod:`.norms` (per-axis or norm
 limits), :mod:`.iteration` (pseudo-jerk iteration, certification,
 refinement), :mod:`.grid` (the adaptive grid), :mod:`.validate` and
-:mod:`.plan` (:func:`plan_speed`); the grid problem's other solvers:
-:mod:`.reach` (without jerk), :mod:`.banded` with :mod:`.banded_grid` and
-:mod:`.active_rows`, :mod:`.pairs` with :mod:`.pairs_grid`.
+:mod:`.plan` (:func:`plan_speed`).
 """
 
 from skyquill.coverage.speed.curve import PathCurve

@@ -22,9 +22,6 @@ _SAMPLE_GRID = 2000
 _MIN_SAMPLES = 3
 #: Weight of the last solution in the next pseudo-jerk reference (geometric mean).
 DAMPING = 0.65
-#: A change of the pseudo-jerk iteration sets a new low when it is below this share of the
-#: lowest before (with ``patience``: a creep of 1e-6 a step is no progress).
-STALL = 0.9
 
 
 def _initial_solve(
@@ -33,7 +30,7 @@ def _initial_solve(
     *,
     c1: FloatArray,
     jmax: FloatArray | None,
-    stop: tuple[int, float, int],
+    stop: tuple[int, float],
     log: tuple[list[float], list[float]],
 ) -> tuple[FloatArray, int]:
     """Jerk-free LP; with a jerk limit then the end caps and the pseudo-jerk iteration."""
@@ -52,7 +49,7 @@ def _pseudo_jerk(
     bounds: _Bounds,
     start: FloatArray,
     *,
-    stop: tuple[int, float, int],
+    stop: tuple[int, float],
     log: tuple[list[float], list[float]],
 ) -> tuple[FloatArray, int]:
     """Damped pseudo-jerk fixed-point iteration from ``start``, then the certification LP.
@@ -79,11 +76,8 @@ def _pseudo_jerk(
         First reference (an over-estimate: the jerk-free optimum, or the
         previous plan before a refinement).
     stop
-        ``(max_iterations, tolerance, patience)``: at most ``max_iterations``; stop at a
-        relative change of ``sqrt(b)`` between a reference and its solution below
-        ``tolerance``, or once the change has not set a new low (:data:`STALL`) for
-        ``patience`` iterations (a solver that is not exactly optimal, :mod:`.pairs`, settles to a
-        small cycle instead of a fixed point).
+        ``(max_iterations, tolerance)`` on the relative change of ``sqrt(b)``
+        between a reference and its solution.
     log
         Lists that receive the objectives and the relative changes.
 
@@ -92,12 +86,11 @@ def _pseudo_jerk(
     tuple
         Final ``b`` and the number of iterations.
     """
-    max_iter, tol, patience = stop
+    max_iter, tol = stop
     objectives, changes = log
     ub = bounds.cols()
     ref = b = start
-    iterations = stalled = 0
-    low = np.inf
+    iterations = 0
     for _ in range(max_iter):
         b = lp.solve(bounds.rows(ref), ub, rough=True)
         iterations += 1
@@ -105,9 +98,7 @@ def _pseudo_jerk(
         sq = np.sqrt(b)
         change = float(np.max(np.abs(sq - np.sqrt(ref))) / max(np.max(sq), 1e-300))
         changes.append(change)
-        stalled = 0 if change < STALL * low else stalled + 1
-        low = min(low, change)
-        if change < tol or stalled >= patience:
+        if change < tol:
             break
         ref = ref ** (1.0 - DAMPING) * b**DAMPING
     big = np.maximum(ref, b)
@@ -123,7 +114,7 @@ def _refine(
     *,
     target: float | None,
     rounds: int,
-    stop: tuple[int, float, int],
+    stop: tuple[int, float],
     log: tuple[list[float], list[float]],
 ) -> tuple[SpeedPlan, int, float, int]:
     """Tighten the limits locally and re-solve until the estimated excess meets ``target``.

@@ -16,7 +16,6 @@ from skyquill.coverage.speed.curve import PathCurve, _derivs3, _eval, _Reparam
 from skyquill.coverage.speed.grid import _grid_map
 from skyquill.coverage.speed.iteration import _initial_solve, _refine
 from skyquill.coverage.speed.norms import component_limits, components
-from skyquill.coverage.speed.pairs_grid import PATIENCE, PairsGrid
 from skyquill.coverage.speed.profile import SpeedPlan, _duration, _profile_spline
 from skyquill.coverage.speed.reach import ReachGrid, acceleration_rows
 from skyquill.coverage.speed.rows import (
@@ -126,7 +125,7 @@ def plan_speed(
     deadline : Deadline, optional
         A wall-time budget: checked before every LP solve, whose HiGHS time
         limit is what is left of it (see :class:`~skyquill.coverage.deadline.Deadline`).
-    method : {"auto", "reach", "banded", "pairs", "lp"}, default "auto"
+    method : {"auto", "reach", "banded", "lp"}, default "auto"
         How the grid problems are solved. ``"reach"``: without a jerk limit,
         by the backward and forward reachability passes (:mod:`.reach`; the
         LP's optimum, in linear time). ``"banded"``: with a jerk limit, the
@@ -134,11 +133,6 @@ def plan_speed(
         banded interior-point method (:mod:`.banded`, linear time per Newton
         step; with a norm limit on the rows of the polygon's directions that
         can bind, :mod:`.active_rows`); without one it is ``"reach"``.
-        ``"pairs"`` (opt-in): with a jerk limit, the pseudo-jerk LPs by
-        TOPP-RA lifted to pairs ``(b_i, b_{i+1})`` (:mod:`.pairs`, compiled by
-        numba: linear time, no Newton steps); every row held exactly, but the
-        greedy pass is not optimal: plans 0.02-1.4 % longer than the LP's
-        (``docs/coverage-speed.md``); without a jerk limit it is ``"reach"``.
         ``"lp"``: every problem by the HiGHS grid LP (the reference).
         ``"auto"``: ``"reach"`` without a jerk limit; with one ``"lp"`` below
         :data:`~.validate.BANDED_FROM_POINTS` grid points (its simplex
@@ -212,19 +206,13 @@ def plan_speed(
         )
         if solver == "reach":
             lp = ReachGrid(acc, highs, deadline)
-        elif solver == "pairs":
-            assert jlim is not None  # "pairs" is "reach" without a jerk limit
-            lp = PairsGrid(acc, (p1, p2, p3), jlim * args.safety, vb, lp=highs, deadline=deadline)
         else:
             assert jlim is not None  # "banded" is "reach" without a jerk limit
             lp = BandedGrid(acc, banded_rows(acc, (p1, p2, p3), jlim * args.safety, vb), highs,
                             deadline)  # fmt: skip
     bounds = _Bounds(ub, None if jlim is None else vb, p1.shape[1], *_ones(n))
     log: tuple[list[float], list[float]] = ([], [])
-    # The pairs method's iterates settle to a small cycle (its greedy answers are not
-    # exactly optimal): it stops when the change stalls. The LP's fall steadily.
-    patience = PATIENCE if solver == "pairs" else args.jerk_iterations
-    stop = (args.jerk_iterations, args.jerk_tol, patience)
+    stop = (args.jerk_iterations, args.jerk_tol)
     b, iterations = _initial_solve(lp, bounds, c1=p1, jmax=jlim, stop=stop, log=log)
     plan = SpeedPlan(
         curve=curve,
@@ -261,9 +249,7 @@ def plan_speed(
         refinements=rounds,
         excess_estimate=est,
         lp_solves=lp.solves,
-        method="lp"
-        if isinstance(lp, ReachGrid | BandedGrid | PairsGrid) and lp.used_lp
-        else solver,
+        method="lp" if isinstance(lp, ReachGrid | BandedGrid) and lp.used_lp else solver,
     )
 
 

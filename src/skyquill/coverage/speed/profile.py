@@ -87,9 +87,8 @@ class SpeedPlan:
     grid : str
         ``"uniform"`` or ``"adaptive"`` (see :func:`plan_speed`).
     method : str
-        The solver that answered (``method`` of :func:`plan_speed`): ``"reach"``,
-        ``"banded"``, ``"pairs"``, or ``"lp"`` (also when HiGHS had to answer for one
-        of the others).
+        The solver that answered (``method`` of :func:`plan_speed`): ``"reach"`` (the
+        reachability passes solved every problem), ``"banded"`` or ``"lp"``.
     norm_sides : int or None
         None: ``amax``/``jmax`` hold per axis.  Else they are Euclidean norm
         limits, held in the LP by the inscribed polygon of this many sides

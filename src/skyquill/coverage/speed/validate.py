@@ -17,7 +17,7 @@ from skyquill.validation import FloatArray, as_float, as_int, per_axis
 #: Grid kinds of :func:`~skyquill.coverage.speed.plan_speed`.
 GRIDS = ("uniform", "adaptive")
 #: Methods of :func:`~skyquill.coverage.speed.plan_speed`.
-METHODS = ("auto", "reach", "banded", "pairs", "lp")
+METHODS = ("auto", "reach", "banded", "lp")
 #: Grid points from which ``method="auto"`` solves jerk-limited problems by the banded
 #: interior point instead of the HiGHS LP. Measured end to end (``plan_speed``, one BLAS
 #: thread, a loaded 2-core machine), the banded method's time over the LP's: on the 10 m
@@ -121,21 +121,20 @@ def _validate_limits(
 
 
 def _validate_method(method: object, *, jerk: bool, n: int) -> str:
-    """``"reach"``, ``"banded"``, ``"pairs"`` or ``"lp"``: the solver ``method`` names for a
-    problem with or without jerk on ``n`` grid points (without a jerk limit ``"banded"`` and
-    ``"pairs"`` are ``"reach"``: the same passes answer; ``"auto"`` with jerk is ``"banded"``
-    from :data:`BANDED_FROM_POINTS`)."""
+    """``"reach"``, ``"banded"`` or ``"lp"``: the solver ``method`` names for a problem with or
+    without jerk on ``n`` grid points (without a jerk limit ``"banded"`` is ``"reach"``: the
+    same passes answer; ``"auto"`` with jerk is ``"banded"`` from :data:`BANDED_FROM_POINTS`)."""
     if method not in METHODS:
         raise InputError(f"method: got {method!r}, expected one of {METHODS}")
     if method == "reach" and jerk:
         raise InputError(
-            "method: got 'reach' with a jerk limit, expected 'pairs', 'banded', 'lp' or 'auto' "
-            "(the passes hold speed and acceleration; jerk rows couple three nodes)"
+            "method: got 'reach' with a jerk limit, expected 'banded', 'lp' or 'auto' (the "
+            "passes hold speed and acceleration; jerk rows couple three nodes)"
         )
     if method == "auto":
         if not jerk:
             return "reach"
         return "banded" if n >= BANDED_FROM_POINTS else "lp"
-    if method in ("banded", "pairs") and not jerk:
+    if method == "banded" and not jerk:
         return "reach"
     return str(method)
