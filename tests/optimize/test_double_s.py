@@ -109,7 +109,9 @@ _LIMITS = st.tuples(
 @settings(max_examples=300, deadline=None)
 @given(st.floats(-6.0, np.log10(3.5e3)), _LIMITS)
 @example(np.log10(2.0), (1.0, 2.0, 5.0))  # the textbook S-curve: 0.4 / 0.1 / 0.4, cruise 1.1
-def test_rest_to_rest_is_ruckigs_profile(log_length: float, limits: tuple) -> None:
+def test_rest_to_rest_is_ruckigs_profile(
+    log_length: float, limits: tuple[float, float, float]
+) -> None:
     _check_against_ruckig(10.0**log_length, *limits)
 
 
@@ -120,7 +122,7 @@ def test_rest_to_rest_is_ruckigs_profile(log_length: float, limits: tuple) -> No
     st.floats(-1e-6, 1e-6),
 )
 def test_rest_to_rest_is_ruckigs_profile_where_a_limit_is_just_reached(
-    limits: tuple, boundary: str, nudge: float
+    limits: tuple[float, float, float], boundary: str, nudge: float
 ) -> None:
     v, a, j = limits
     if boundary == "vmax at amax":  # the speed limit reached just as the acceleration's is
@@ -152,7 +154,9 @@ def test_limits_one_per_move() -> None:
 
 @settings(max_examples=100, deadline=None)
 @given(_LIMITS, st.floats(1.0 + 1e-6, 1e4))
-def test_cruise_is_the_profile_of_every_move_that_cruises(limits: tuple, stretch: float) -> None:
+def test_cruise_is_the_profile_of_every_move_that_cruises(
+    limits: tuple[float, float, float], stretch: float
+) -> None:
     v, a, j = limits
     profile = cruise(v, a, j)
     assert profile is not None

@@ -5,9 +5,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+import ruckig
 from hypothesis import given, settings
 from hypothesis import strategies as st
-import ruckig
 from ruckig import InputParameter, Ruckig, Trajectory
 
 from skyquill.errors import InputError

@@ -23,6 +23,7 @@ and binding round trip each.
 from __future__ import annotations
 
 import functools
+import math
 from typing import NamedTuple
 
 import numpy as np
@@ -83,7 +84,7 @@ def _ramp_cap(
     """The longest a jerk phase can last, s: until the acceleration limit (``a / j``) or,
     if sooner, the speed limit with no constant-acceleration phase (``sqrt(v / j)``)."""
     if isinstance(vmax, float) and isinstance(amax, float) and isinstance(jmax, float):
-        return min(amax / jmax, (vmax / jmax) ** 0.5)  # shared limits: Python floats
+        return min(amax / jmax, math.sqrt(vmax / jmax))  # shared limits: Python floats
     return np.minimum(np.divide(amax, jmax), np.sqrt(np.divide(vmax, jmax)))
 
 
@@ -138,7 +139,7 @@ def cruise(vmax: float, amax: float, jmax: float) -> Cruise | None:
     per limits (m/s, m/s^2, m/s^3), in Python floats. None where a jerk phase would last
     :data:`MIN_PHASE_S` or less (limits too extreme for a profile without dropped phases).
     """
-    t1 = min(amax / jmax, (vmax / jmax) ** 0.5)
+    t1 = min(amax / jmax, math.sqrt(vmax / jmax))
     if t1 <= MIN_PHASE_S:
         return None
     peak_acc = jmax * t1

@@ -169,7 +169,9 @@ def legs_pieces(
     delta = ends - starts
     lengths = np.sqrt(np.vecdot(delta, delta))  # numpy.linalg.norm(axis=1), cheaper
     if speeds is None or not np.any(speeds):
-        cruising = _cruising(starts, ends, delta, lengths, float(lengths.min()), limits)
+        cruising = _cruising(
+            starts, ends, delta, lengths, shortest=float(lengths.min()), limits=limits
+        )
         if cruising is not None:
             durations = cruising.breaks[1:]
             leg_durations = durations.reshape(-1, cruising.phases).sum(axis=1)
@@ -227,6 +229,7 @@ def _cruising(
     ends: FloatArray,
     delta: FloatArray,
     lengths: FloatArray,
+    *,
     shortest: float,
     limits: LegLimits | Sequence[LegLimits],
 ) -> _Cruising | None:
@@ -273,7 +276,7 @@ def _mixing(vmax: float, amax: float, jmax: float, dim: int) -> tuple[Cruise, Fl
     profile = cruise(vmax, amax, jmax)
     if profile is None:
         return None
-    mixer = np.kron(profile.mix.T, np.eye(dim))
+    mixer = np.asarray(np.kron(profile.mix.T, np.eye(dim)), dtype=np.float64)
     mixer.setflags(write=False)
     return profile, mixer
 
@@ -639,7 +642,7 @@ def stop_and_go(waypoints: FloatArray, limits: LegLimits | Sequence[LegLimits]) 
         if not isinstance(limits, LegLimits):
             limits = [limits[k] for k in idx.tolist()]
     try:
-        trajectory, arrived = _flown(starts, ends, delta, steps, shortest, limits)
+        trajectory, arrived = _flown(starts, ends, delta, steps, shortest=shortest, limits=limits)
     except UntimeableLegError as exc:
         first = exc.leg if idx is None else int(idx[exc.leg])
         raise exc.naming("waypoints", f"the leg from waypoint {first} to {first + 1},") from None
@@ -651,6 +654,7 @@ def _flown(
     ends: FloatArray,
     delta: FloatArray,
     lengths: FloatArray,
+    *,
     shortest: float,
     limits: LegLimits | Sequence[LegLimits],
 ) -> tuple[PiecewisePolynomial, FloatArray]:
@@ -658,7 +662,7 @@ def _flown(
 
     ``starts``, ``ends``, ``delta`` (K, d), m; ``lengths`` (K,) and the ``shortest``, m.
     """
-    cruising = _cruising(starts, ends, delta, lengths, shortest, limits)
+    cruising = _cruising(starts, ends, delta, lengths, shortest=shortest, limits=limits)
     if cruising is None:
         legs = _legs(starts, delta, lengths, limits, None)
         arrived = np.zeros(lengths.size + 1)
