@@ -7,7 +7,6 @@ what was received and what was expected. Nothing is clipped or repaired.
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
 import numpy as np
@@ -61,9 +60,9 @@ def as_array(
         raise InputError(
             f"{name}: got an array of shape {arr.shape}, expected shape {_shape_text(shape)}"
         )
-    # One pass: a NaN or infinity makes the sum one; only if it is (or finite values
-    # overflow it) are the values counted one by one.
-    if not math.isfinite(arr.sum()) and (bad := int(np.count_nonzero(~np.isfinite(arr)))):
+    # (The ufunc's reduction: numpy.all and the method .all() wrap it in Python.)
+    if not np.logical_and.reduce(np.isfinite(arr), axis=None):
+        bad = int(np.count_nonzero(~np.isfinite(arr)))
         raise InputError(f"{name}: got {bad} NaN or infinite value(s), expected finite numbers")
     if max_abs is not None and arr.size and np.abs(arr).max() > max_abs:
         raise InputError(

@@ -123,7 +123,8 @@ class Legs:
         Phase durations of every leg in turn, shape (P,), s (zero-length phases dropped).
     coeffs
         Power-basis coefficients of each phase in its local time, lowest first, (P, 4, d)
-        (a transposed view of a (4, d, P) array, as it was computed: not C-contiguous).
+        (for legs timed one by one a transposed view of a (4, d, P) array, as it was
+        computed: not C-contiguous).
     leg_durations
         Each leg's duration, shape (K,), s.
     """
@@ -142,7 +143,9 @@ def legs_pieces(
     """Time ``K`` straight legs at once.
 
     Legs from rest to rest (no ``speeds``, or all zero) take the closed-form profile of
-    :func:`~skyquill.optimize.double_s.rest_to_rest`, all in a few numpy calls. Legs that
+    :func:`~skyquill.optimize.double_s.rest_to_rest`, all in a few numpy calls; under one
+    norm limit that every leg reaches, one shared profile mixed into every leg's pieces
+    (:func:`_cruising`), cheaper still. Legs that
     start or end moving are timed by Ruckig, one degree of freedom per leg in its
     unsynchronised mode (``Synchronization.No``, the same as ``K`` one-dimensional calls),
     in blocks of up to :data:`BLOCK` legs per call on objects kept per thread
@@ -629,10 +632,11 @@ def stop_and_go(waypoints: FloatArray, limits: LegLimits | Sequence[LegLimits]) 
             _check(lim, pts.shape[1])
     delta = pts[1:] - pts[:-1]
     steps = np.sqrt(np.vecdot(delta, delta))  # numpy.linalg.norm(axis=1), cheaper
-    repeat = REPEAT_TOLERANCE * max(1.0, float(abs(pts).max()))
+    # (The ufuncs' reductions: the methods .max() and .min() wrap them in Python.)
+    repeat = REPEAT_TOLERANCE * max(1.0, float(np.maximum.reduce(abs(pts), axis=None)))
     idx = None  # the legs flown, if not all: repeated points are skipped
     starts, ends = pts[:-1], pts[1:]
-    shortest = float(steps.min())
+    shortest = float(np.minimum.reduce(steps))
     if shortest <= repeat:
         idx = np.flatnonzero(steps > repeat)
         if not idx.size:
