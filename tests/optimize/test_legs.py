@@ -312,21 +312,25 @@ def test_pieces_too_short_for_a_long_flight_s_clock_are_dropped() -> None:
     np.testing.assert_array_equal(traj.coeffs, coeffs[[0, 2]])
 
 
-def test_legs_that_all_cruise_are_the_legs_timed_one_by_one() -> None:
+@pytest.mark.parametrize(("limits", "phases"), [((2.0, 3.0, 10.0), 7), ((0.5, 3.0, 10.0), 5)])
+def test_legs_that_all_cruise_are_the_legs_timed_one_by_one(
+    limits: tuple[float, float, float], phases: int
+) -> None:
     # One LegLimits for legs that all reach its speed: one shared profile mixed into every
-    # leg; a list of them (or a leg too short to cruise) times each leg on its own.
+    # leg (seven phases, or five when the speed limit comes before the acceleration's); a
+    # list of them times each leg on its own.
     rng = np.random.default_rng(7)
     pts = rng.uniform(0.0, 20.0, (31, 3))
-    lim = LegLimits(2.0, 3.0, 10.0)
+    lim = LegLimits(*limits)
     shared = stop_and_go(pts, lim)
     one_by_one = stop_and_go(pts, [lim] * 30)
-    assert shared.trajectory.n_pieces == one_by_one.trajectory.n_pieces == 30 * 7
+    assert shared.trajectory.n_pieces == one_by_one.trajectory.n_pieces == 30 * phases
     np.testing.assert_allclose(shared.arrivals, one_by_one.arrivals, rtol=1e-13)
     np.testing.assert_allclose(
         shared.trajectory.breaks, one_by_one.trajectory.breaks, rtol=1e-13, atol=1e-13
     )
     t = np.linspace(0.0, shared.trajectory.duration, 5001)
-    for n, scale in enumerate((20.0, 2.0, 3.0, 10.0)):
+    for n, scale in enumerate((20.0, *limits)):
         np.testing.assert_allclose(
             shared.trajectory.evaluate(t, n),
             one_by_one.trajectory.evaluate(t, n),
@@ -336,12 +340,15 @@ def test_legs_that_all_cruise_are_the_legs_timed_one_by_one() -> None:
     # The waypoints are reached exactly, at rest.
     np.testing.assert_allclose(shared.trajectory.evaluate(shared.arrivals), pts, atol=1e-12)
     np.testing.assert_allclose(shared.trajectory.evaluate(shared.arrivals, 1), 0.0, atol=1e-12)
-    # A leg of 0.5 m (shorter than the 1.93 m it takes to reach 2 m/s) among them.
-    pts[5] = pts[4] + [0.5, 0.0, 0.0]
-    mixed = stop_and_go(pts, lim)
-    np.testing.assert_allclose(
-        mixed.arrivals, stop_and_go(pts, [lim] * 30).arrivals, rtol=1e-13, atol=1e-13
-    )
+    # Legs of 0.1 mm and 0.1 m among them, too short to reach the speed limit: timed on
+    # their own, the others still through the shared profile.
+    pts[5] = pts[4] + [0.1, 0.0, 0.0]
+    pts[9] = pts[8] + [0.0, 1e-4, 0.0]
+    mixed, apart = stop_and_go(pts, lim), stop_and_go(pts, [lim] * 30)
+    assert mixed.trajectory.n_pieces == apart.trajectory.n_pieces < 30 * phases
+    np.testing.assert_allclose(mixed.arrivals, apart.arrivals, rtol=1e-13, atol=1e-13)
+    np.testing.assert_allclose(mixed.trajectory.breaks, apart.trajectory.breaks, rtol=1e-13)
+    np.testing.assert_allclose(mixed.trajectory.coeffs, apart.trajectory.coeffs, atol=1e-11)
     np.testing.assert_allclose(mixed.trajectory.evaluate(mixed.arrivals), pts, atol=1e-12)
 
 
@@ -357,11 +364,19 @@ def test_a_leg_that_reaches_the_acceleration_limit_exactly_is_timed() -> None:
     assert flown.trajectory.n_pieces == 3
 
 
-def test_a_leg_too_long_is_refused_alike_whether_or_not_the_legs_share_a_limit() -> None:
-    path = np.array([[0.0, 0.0], [1.0, 0.0], [1500.0, 0.0]])
+@pytest.mark.parametrize("first", [1.0, 0.01])
+def test_a_leg_too_long_is_refused_alike_whether_or_not_the_legs_share_a_limit(
+    first: float,
+) -> None:
+    # After a leg that cruises (all legs share one profile) or one too short to (0.05 m
+    # to reach 0.15 m/s: it is timed on its own, the others share the profile), and with
+    # a limit per leg (each timed on its own): the same leg named the same way.
+    path = np.array([[0.0, 0.0], [first, 0.0], [first + 1499.0, 0.0]])
     lim = LegLimits(0.15, 1.0, 5.0)
     message = r"waypoints: got the leg from waypoint 1 to 2, 1499 m long, which takes 9,994 s"
     with pytest.raises(InputError, match=message):
         stop_and_go(path, lim)
     with pytest.raises(InputError, match=message):
         stop_and_go(path, [lim, lim])
+    with pytest.raises(InputError, match=r"leg 1, 1499 m long"):
+        legs_pieces(path[:-1], path[1:], lim)

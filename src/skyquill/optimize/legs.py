@@ -178,9 +178,15 @@ def legs_pieces(
         if cruising is not None:
             durations = cruising.breaks[1:]
             leg_durations = durations.reshape(-1, cruising.phases).sum(axis=1)
-            cruising.check(lengths, float(leg_durations.max()))
+            cruising.check(lengths, float(np.maximum.reduce(leg_durations)))
             return Legs(durations, cruising.coeffs, leg_durations)
-    return _legs(starts, delta, lengths, limits, speeds)
+        partly = _partly_cruising(starts, ends, delta, lengths, limits)
+        if partly is not None:
+            return partly
+        legs = _legs(starts, delta, lengths, limits, None)[0]
+        _refuse_long(lengths, limits, legs.leg_durations)
+        return legs
+    return _legs(starts, delta, lengths, limits, speeds)[0]
 
 
 class _Phases(NamedTuple):
@@ -209,22 +215,28 @@ class _Cruising(NamedTuple):
         Power-basis coefficients of each phase in local time, lowest first, (K n, 4, d).
     phases
         ``n``, the phases of each leg.
-    vmax, ramp_s
-        The speed limit, m/s, and how long speeding up to it takes, s (and slowing down):
-        a leg of length ``L`` takes ``L / vmax + ramp_s``.
+    limits
+        The limits, whose speed every leg reaches.
+    ramp_s
+        How long speeding up to ``limits.vmax`` takes, s (and slowing down): a leg of
+        length ``L`` takes ``L / vmax + ramp_s``.
     """
 
     breaks: FloatArray
     coeffs: FloatArray
     phases: int
-    vmax: float
+    limits: LegLimits
     ramp_s: float
+
+    def leg_durations(self, lengths: FloatArray) -> FloatArray:
+        """How long the legs of ``lengths`` (K,), m, take, s."""
+        return lengths / self.limits.vmax + self.ramp_s
 
     def check(self, lengths: FloatArray, total_s: float) -> None:
         """Refuse a leg over :data:`RUCKIG_MAX_DURATION_S`, the legs of ``lengths`` (K,)
         taking ``total_s`` together (only then can one of them be too long)."""
         if total_s > RUCKIG_MAX_DURATION_S:
-            _refuse_long(lengths, self.vmax, lengths / self.vmax + self.ramp_s)
+            _refuse_long(lengths, self.limits, self.leg_durations(lengths))
 
 
 def _cruising(
@@ -233,7 +245,7 @@ def _cruising(
     delta: FloatArray,
     lengths: FloatArray,
     *,
-    shortest: float,
+    shortest: float | None,
     limits: LegLimits | Sequence[LegLimits],
 ) -> _Cruising | None:
     """Legs from rest to rest under one norm limit that all reach its speed: the cheap case.
@@ -242,8 +254,9 @@ def _cruising(
     pieces are that profile's, mixed from each leg's direction, start and end, in a handful
     of numpy calls whatever the number of legs (no phase to drop, each quantity one call).
     None if the limits are per leg or per axis, or a leg (the ``shortest``, m) is too short
-    to cruise (then :func:`_legs` times every leg). The caller checks the legs' durations
-    (:meth:`_Cruising.check`).
+    to cruise (then :func:`_partly_cruising` replaces those). Without ``shortest`` every leg
+    is taken as cruising: the caller replaces those that do not. The caller checks the legs'
+    durations (:meth:`_Cruising.check`).
     """
     if not isinstance(limits, LegLimits) or limits.per_axis:
         return None
@@ -254,7 +267,7 @@ def _cruising(
         return None
     profile, mixer = mixing
     # (The same float operations as on every leg below: the shortest cruises least.)
-    if shortest / vmax - profile.ramp_s <= MIN_PHASE_S:
+    if shortest is not None and shortest / vmax - profile.ramp_s <= MIN_PHASE_S:
         return None
     k, n = lengths.size, profile.durations.size
     breaks = np.empty(k * n + 1)
@@ -268,7 +281,7 @@ def _cruising(
     # coefficients, (K, 4 n d), by one matrix product.
     basis = np.concatenate((delta / lengths[:, None], starts, ends), axis=1)
     coeffs = basis @ mixer
-    return _Cruising(breaks, coeffs.reshape(k * n, 4, dim), n, vmax, profile.ramp_s)
+    return _Cruising(breaks, coeffs.reshape(k * n, 4, dim), n, limits, profile.ramp_s)
 
 
 @functools.lru_cache(maxsize=256)
@@ -284,14 +297,62 @@ def _mixing(vmax: float, amax: float, jmax: float, dim: int) -> tuple[Cruise, Fl
     return profile, mixer
 
 
+def _partly_cruising(
+    starts: FloatArray,
+    ends: FloatArray,
+    delta: FloatArray,
+    lengths: FloatArray,
+    limits: LegLimits | Sequence[LegLimits],
+) -> Legs | None:
+    """Legs from rest to rest under one norm limit, some too short to cruise.
+
+    Every leg is timed through the shared profile (:func:`_cruising`), then the phases of
+    those too short to cruise are replaced by their own (the closed form, in the same
+    phase slots), and the phases of no length dropped: one pass over the pieces more than
+    if all legs cruised. None if the limits are per leg or per axis.
+    """
+    cruising = _cruising(starts, ends, delta, lengths, shortest=None, limits=limits)
+    if cruising is None:
+        return None
+    k, n, dim = lengths.size, cruising.phases, delta.shape[1]
+    durations = cruising.breaks[1:].reshape(k, n)
+    at_cruise = 3 if n == 7 else 2  # (double_s.Cruise.at_cruise)
+    short = np.flatnonzero(durations[:, at_cruise] <= MIN_PHASE_S)
+    slots = _SLOTS[n]
+    bounds = np.array([[cruising.limits.vmax, cruising.limits.amax, cruising.limits.jmax]])
+    ph = _rest_to_rest(lengths.take(short), np.repeat(bounds, short.size, axis=0))
+    if n < 7 and np.any(ph.t[:, [1, 5]] > MIN_PHASE_S):  # (a hold the profile has not)
+        return None
+    durations[short] = ph.t[:, slots]
+    # p, v, a/2, j/6 at each slot's start, (k_short, n, 4), along each leg's direction.
+    scalar = np.stack(
+        (ph.p[:, slots], ph.v[:, slots], ph.a[:, slots] / 2.0, ph.j[:, slots] / 6.0), axis=-1
+    )
+    short_delta = delta.take(short, axis=0)
+    directions = short_delta / lengths.take(short)[:, None]
+    coeffs = cruising.coeffs.reshape(k, n, 4, dim)
+    coeffs[short] = scalar[..., None] * directions[:, None, None, :]
+    coeffs[short, :, 0] += starts.take(short, axis=0)[:, None, :]
+    leg_durations = durations.sum(axis=1)
+    _refuse_long(lengths, limits, leg_durations)
+    kept = np.flatnonzero(cruising.breaks[1:] > MIN_PHASE_S)
+    return Legs(cruising.breaks[1:].take(kept), cruising.coeffs.take(kept, axis=0), leg_durations)
+
+
+#: The phases of the seven-phase profile in the slots of a shared profile of n phases
+#: (:func:`double_s.cruise`: without its hold phases when it has none).
+_SLOTS = {7: np.arange(7), 5: np.array([0, 2, 3, 4, 6])}
+
+
 def _legs(
     starts: FloatArray,
     delta: FloatArray,
     lengths: FloatArray,
     limits: LegLimits | Sequence[LegLimits],
     speeds: FloatArray | None,
-) -> Legs:
-    """:func:`legs_pieces` of legs ``delta`` (K, d) of ``lengths`` (K,) from ``starts``.
+) -> tuple[Legs, NDArray[np.intp]]:
+    """:func:`legs_pieces` of legs ``delta`` (K, d) of ``lengths`` (K,) from ``starts``, each
+    leg timed on its own, and the leg each piece belongs to, (P,).
 
     At a few legs the cost is the number of numpy calls (a fraction of a microsecond or
     more each, whatever their size), at many the passes over memory: each quantity is one
@@ -325,31 +386,30 @@ def _legs(
     scalar[2:] /= _TAYLOR[2:, None]
     per_axis = scalar[:, None, :] * directions.T.take(leg, axis=1)
     per_axis[0] += starts.T.take(leg, axis=1)
-    return Legs(ph.t.take(at7), per_axis.transpose(2, 0, 1), ph.t @ _ONES)
+    return Legs(ph.t.take(at7), per_axis.transpose(2, 0, 1), ph.t @ _ONES), leg
 
 
 def _rest_to_rest(lengths: FloatArray, bounds: FloatArray) -> _Phases:
-    """The phases of legs from rest to rest under ``bounds`` (K, 3): the closed form.
-
-    A leg longer than :data:`RUCKIG_MAX_DURATION_S` is refused as Ruckig would refuse it,
-    so that whether a leg is timed does not depend on the speeds at its ends.
-    """
+    """The phases of legs from rest to rest under ``bounds`` (K, 3): the closed form (the
+    caller refuses legs too long, :func:`_refuse_long`)."""
     vmax, amax, jmax = bounds.T
     t = rest_to_rest(lengths, vmax, amax, jmax)
-    _refuse_long(lengths, vmax, t @ _ONES)
     return _states(t, JERK_SIGNS * jmax[:, None])
 
 
-def _refuse_long(lengths: FloatArray, vmax: float | FloatArray, durations: FloatArray) -> None:
-    """Refuse the first leg longer than :data:`RUCKIG_MAX_DURATION_S`, if any (lengths,
-    durations (K,); the speed limit one for all legs or one each)."""
+def _refuse_long(
+    lengths: FloatArray, limits: LegLimits | Sequence[LegLimits], durations: FloatArray
+) -> None:
+    """Refuse the first leg longer than :data:`RUCKIG_MAX_DURATION_S`, if any, as Ruckig
+    would refuse it (lengths, durations (K,)), so that whether a leg is timed does not
+    depend on the speeds at its ends."""
     too_long = np.flatnonzero(durations > RUCKIG_MAX_DURATION_S)
     if too_long.size:
         i = int(too_long[0])
         raise UntimeableLegError(
             i,
             float(lengths[i]),
-            float(np.broadcast_to(vmax, lengths.shape)[i]),
+            (limits if isinstance(limits, LegLimits) else limits[i]).vmax,
             float(durations[i]),
             argument="starts, ends",
             what=f"leg {i},",
@@ -668,7 +728,10 @@ def _flown(
     """
     cruising = _cruising(starts, ends, delta, lengths, shortest=shortest, limits=limits)
     if cruising is None:
-        legs = _legs(starts, delta, lengths, limits, None)
+        legs = _partly_cruising(starts, ends, delta, lengths, limits)
+        if legs is None:
+            legs = _legs(starts, delta, lengths, limits, None)[0]
+            _refuse_long(lengths, limits, legs.leg_durations)
         arrived = np.zeros(lengths.size + 1)
         np.cumsum(legs.leg_durations, out=arrived[1:])
         return _chain(legs.durations, legs.coeffs), arrived
