@@ -280,7 +280,7 @@ def _cruising(
     # Each leg's unit direction, start and end, (K, 3 d), mixed into every phase's
     # coefficients, (K, 4 n d), by one matrix product.
     basis = np.concatenate((delta / lengths[:, None], starts, ends), axis=1)
-    coeffs = basis @ mixer
+    coeffs = np.dot(basis, mixer)  # (the matmul operator's dispatch costs more)
     return _Cruising(breaks, coeffs.reshape(k * n, 4, dim), n, limits, profile.ramp_s)
 
 
