@@ -183,10 +183,10 @@ def legs_pieces(
         partly = _partly_cruising(starts, ends, delta, lengths, limits)
         if partly is not None:
             return partly
-        legs = _legs(starts, delta, lengths, limits, None)[0]
+        legs = _legs(starts, delta, lengths, limits, None)
         _refuse_long(lengths, limits, legs.leg_durations)
         return legs
-    return _legs(starts, delta, lengths, limits, speeds)[0]
+    return _legs(starts, delta, lengths, limits, speeds)
 
 
 class _Phases(NamedTuple):
@@ -213,8 +213,8 @@ class _Cruising(NamedTuple):
         sum in place is the breaks of the legs flown back to back.
     coeffs
         Power-basis coefficients of each phase in local time, lowest first, (K n, 4, d).
-    phases
-        ``n``, the phases of each leg.
+    phases, at_cruise
+        ``n``, the phases of each leg, and the index of its cruise among them.
     limits
         The limits, whose speed every leg reaches.
     ramp_s
@@ -225,6 +225,7 @@ class _Cruising(NamedTuple):
     breaks: FloatArray
     coeffs: FloatArray
     phases: int
+    at_cruise: int
     limits: LegLimits
     ramp_s: float
 
@@ -281,7 +282,9 @@ def _cruising(
     # coefficients, (K, 4 n d), by one matrix product.
     basis = np.concatenate((delta / lengths[:, None], starts, ends), axis=1)
     coeffs = np.dot(basis, mixer)  # (the matmul operator's dispatch costs more)
-    return _Cruising(breaks, coeffs.reshape(k * n, 4, dim), n, limits, profile.ramp_s)
+    return _Cruising(
+        breaks, coeffs.reshape(k * n, 4, dim), n, profile.at_cruise, limits, profile.ramp_s
+    )
 
 
 @functools.lru_cache(maxsize=256)
@@ -316,8 +319,7 @@ def _partly_cruising(
         return None
     k, n, dim = lengths.size, cruising.phases, delta.shape[1]
     durations = cruising.breaks[1:].reshape(k, n)
-    at_cruise = 3 if n == 7 else 2  # (double_s.Cruise.at_cruise)
-    short = np.flatnonzero(durations[:, at_cruise] <= MIN_PHASE_S)
+    short = np.flatnonzero(durations[:, cruising.at_cruise] <= MIN_PHASE_S)
     slots = _SLOTS[n]
     bounds = np.array([[cruising.limits.vmax, cruising.limits.amax, cruising.limits.jmax]])
     ph = _rest_to_rest(lengths.take(short), np.repeat(bounds, short.size, axis=0))
@@ -350,9 +352,9 @@ def _legs(
     lengths: FloatArray,
     limits: LegLimits | Sequence[LegLimits],
     speeds: FloatArray | None,
-) -> tuple[Legs, NDArray[np.intp]]:
+) -> Legs:
     """:func:`legs_pieces` of legs ``delta`` (K, d) of ``lengths`` (K,) from ``starts``, each
-    leg timed on its own, and the leg each piece belongs to, (P,).
+    leg timed on its own.
 
     At a few legs the cost is the number of numpy calls (a fraction of a microsecond or
     more each, whatever their size), at many the passes over memory: each quantity is one
@@ -386,7 +388,7 @@ def _legs(
     scalar[2:] /= _TAYLOR[2:, None]
     per_axis = scalar[:, None, :] * directions.T.take(leg, axis=1)
     per_axis[0] += starts.T.take(leg, axis=1)
-    return Legs(ph.t.take(at7), per_axis.transpose(2, 0, 1), ph.t @ _ONES), leg
+    return Legs(ph.t.take(at7), per_axis.transpose(2, 0, 1), ph.t @ _ONES)
 
 
 def _rest_to_rest(lengths: FloatArray, bounds: FloatArray) -> _Phases:
@@ -730,7 +732,7 @@ def _flown(
     if cruising is None:
         legs = _partly_cruising(starts, ends, delta, lengths, limits)
         if legs is None:
-            legs = _legs(starts, delta, lengths, limits, None)[0]
+            legs = _legs(starts, delta, lengths, limits, None)
             _refuse_long(lengths, limits, legs.leg_durations)
         arrived = np.zeros(lengths.size + 1)
         np.cumsum(legs.leg_durations, out=arrived[1:])
