@@ -9,9 +9,11 @@ minsnap-trajectories at 10 waypoints; Ruckig legs at most 3x a direct call."
   to rest, degree 7; timed alternately (ours, peer, ours, ...), the medians compared. At
   10,000 waypoints ours alone (the peer's dense solve does not scale), per piece. Both
   answers are compared (largest position difference over dense samples).
-* **Legs**: ``stop_and_go`` over K random waypoints (its legs timed in one Ruckig call)
-  against the direct call: ``Ruckig(1).calculate`` on reused objects, one leg at a time,
-  which returns no pieces -- the least any leg timing can cost through Ruckig's Python API.
+* **Legs**: ``stop_and_go`` over K random waypoints (its legs timed by the closed-form
+  rest-to-rest profile, ``optimize/double_s.py``; at 1,000 the chain has 6 legs too short
+  to reach the speed limit) against the direct call: ``Ruckig(1).calculate`` on reused
+  objects, one leg at a time, which returns no pieces -- the least any leg timing costs
+  through Ruckig's Python API.
 
 BLAS is pinned to one thread, the collector is off while timing, and the clock is the
 process's CPU time; the machine has 2 noisy cores, so the ratios (same run, interleaved)

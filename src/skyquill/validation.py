@@ -60,7 +60,8 @@ def as_array(
         raise InputError(
             f"{name}: got an array of shape {arr.shape}, expected shape {_shape_text(shape)}"
         )
-    if not np.all(np.isfinite(arr)):
+    # (The ufunc's reduction: numpy.all and the method .all() wrap it in Python.)
+    if not np.logical_and.reduce(np.isfinite(arr), axis=None):
         bad = int(np.count_nonzero(~np.isfinite(arr)))
         raise InputError(f"{name}: got {bad} NaN or infinite value(s), expected finite numbers")
     if max_abs is not None and arr.size and np.abs(arr).max() > max_abs:

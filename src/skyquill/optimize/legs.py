@@ -1,12 +1,13 @@
 """Straight rest-to-rest legs, each time-optimal under speed, acceleration and jerk limits.
 
-Each leg is a move along its own direction ``d`` (a unit vector) from rest to
-rest. Its time-optimal jerk-limited profile comes from Ruckig (Berscheid &
-Kröger, RSS 2021), the reference implementation of such profiles, rather than
-from a hand-written seven-phase S-curve. A profile is piecewise cubic in time
-(constant jerk per phase), so a chain of legs is exactly a
-:class:`~skyquill.trajectory.PiecewisePolynomial`: stop-and-go coverage,
-transits, approaches.
+Each leg is a move along its own direction ``d`` (a unit vector). From rest to rest
+its time-optimal jerk-limited profile is the closed-form seven-phase "double S"
+(:mod:`skyquill.optimize.double_s`, the profile Ruckig returns, checked against it in
+the tests), computed for all legs at once; a leg that starts or ends moving (a coverage
+lane entered at speed) is timed by Ruckig (Berscheid & Kröger, RSS 2021). A profile is
+piecewise cubic in time (constant jerk per phase), so a chain of legs is exactly a
+:class:`~skyquill.trajectory.PiecewisePolynomial`: stop-and-go coverage, transits,
+approaches.
 
 Limits: ``vmax`` is the speed (a norm: along a straight leg the speed is the
 scalar speed along it). Acceleration and jerk limits are either norms (the
@@ -16,6 +17,7 @@ scalar profile's own limits) or per-axis boxes, which along ``d`` become
 
 from __future__ import annotations
 
+import functools
 import threading
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -26,6 +28,7 @@ from numpy.typing import NDArray
 from ruckig import InputParameter, Profile, Result, Ruckig, Synchronization, Trajectory
 
 from skyquill.errors import InputError, SolverError
+from skyquill.optimize.double_s import JERK_SIGNS, MIN_PHASE_S, Cruise, cruise, rest_to_rest
 from skyquill.trajectory import PiecewisePolynomial
 from skyquill.validation import FloatArray, as_array, as_float
 
@@ -120,7 +123,8 @@ class Legs:
         Phase durations of every leg in turn, shape (P,), s (zero-length phases dropped).
     coeffs
         Power-basis coefficients of each phase in its local time, lowest first, (P, 4, d)
-        (a transposed view of a (4, d, P) array, as it was computed: not C-contiguous).
+        (for legs timed one by one a transposed view of a (4, d, P) array, as it was
+        computed: not C-contiguous).
     leg_durations
         Each leg's duration, shape (K,), s.
     """
@@ -136,17 +140,18 @@ def legs_pieces(
     limits: LegLimits | Sequence[LegLimits],
     speeds: FloatArray | None = None,
 ) -> Legs:
-    """Time ``K`` straight legs at once: Ruckig calls with a degree of freedom per leg.
+    """Time ``K`` straight legs at once.
 
-    Each leg is a scalar move along its own direction; Ruckig's unsynchronised mode
-    (``Synchronization.No``) gives every degree of freedom its own time-optimal profile,
-    the same as ``K`` one-dimensional calls. Crossing into Ruckig and building its objects
-    is what cost 24 us a leg when legs were timed one by one: here the objects are built
-    once per thread and block size (:func:`_ruckig`) and reused, and a block of up to
-    :data:`BLOCK` legs is one call. What is read back through the Python binding is
-    what dominates the cost, so as little is read as the result needs: up to
-    :data:`READ_UP_TO` legs their whole profiles (:func:`_read_block`), beyond only the
-    phase durations (:func:`_time_block`), the states integrated here (:func:`_states`).
+    Legs from rest to rest (no ``speeds``, or all zero) take the closed-form profile of
+    :func:`~skyquill.optimize.double_s.rest_to_rest`, all in a few numpy calls; under one
+    norm limit that every leg reaches, one shared profile mixed into every leg's pieces
+    (:func:`_cruising`), cheaper still. Legs that
+    start or end moving are timed by Ruckig, one degree of freedom per leg in its
+    unsynchronised mode (``Synchronization.No``, the same as ``K`` one-dimensional calls),
+    in blocks of up to :data:`BLOCK` legs per call on objects kept per thread
+    (:func:`_ruckig`): up to :data:`READ_UP_TO` legs their whole profiles are read back
+    (:func:`_read_block`), beyond only the phase durations and jerks, the states
+    integrated here (:func:`_states`).
 
     Parameters
     ----------
@@ -160,12 +165,27 @@ def legs_pieces(
     Raises
     ------
     InputError
-        A leg Ruckig cannot time (:class:`UntimeableLegError`: longer than
-        :data:`RUCKIG_MAX_DURATION_S` at its speed).
+        A leg longer than Ruckig times (:class:`UntimeableLegError`: over
+        :data:`RUCKIG_MAX_DURATION_S` at its limits), whether or not Ruckig times it.
     """
     starts, ends = np.asarray(starts, dtype=float), np.asarray(ends, dtype=float)
     delta = ends - starts
-    lengths = np.sqrt(np.add.reduce(delta * delta, axis=1))  # numpy.linalg.norm(axis=1)
+    lengths = np.sqrt(np.vecdot(delta, delta))  # numpy.linalg.norm(axis=1), cheaper
+    if speeds is None or not np.any(speeds):
+        cruising = _cruising(
+            starts, ends, delta, lengths, shortest=float(lengths.min()), limits=limits
+        )
+        if cruising is not None:
+            durations = cruising.breaks[1:]
+            leg_durations = durations.reshape(-1, cruising.phases).sum(axis=1)
+            cruising.check(lengths, float(np.maximum.reduce(leg_durations)))
+            return Legs(durations, cruising.coeffs, leg_durations)
+        partly = _partly_cruising(starts, ends, delta, lengths, limits)
+        if partly is not None:
+            return partly
+        legs = _legs(starts, delta, lengths, limits, None)
+        _refuse_long(lengths, limits, legs.leg_durations)
+        return legs
     return _legs(starts, delta, lengths, limits, speeds)
 
 
@@ -183,6 +203,149 @@ class _Phases(NamedTuple):
     a: FloatArray
 
 
+class _Cruising(NamedTuple):
+    """Legs that all cruise at one speed limit, timed (:func:`_cruising`).
+
+    Attributes
+    ----------
+    breaks
+        0, then the phase durations of every leg in turn, shape (K n + 1,), s: its running
+        sum in place is the breaks of the legs flown back to back.
+    coeffs
+        Power-basis coefficients of each phase in local time, lowest first, (K n, 4, d).
+    phases, at_cruise
+        ``n``, the phases of each leg, and the index of its cruise among them.
+    limits
+        The limits, whose speed every leg reaches.
+    ramp_s
+        How long speeding up to ``limits.vmax`` takes, s (and slowing down): a leg of
+        length ``L`` takes ``L / vmax + ramp_s``.
+    """
+
+    breaks: FloatArray
+    coeffs: FloatArray
+    phases: int
+    at_cruise: int
+    limits: LegLimits
+    ramp_s: float
+
+    def leg_durations(self, lengths: FloatArray) -> FloatArray:
+        """How long the legs of ``lengths`` (K,), m, take, s."""
+        return lengths / self.limits.vmax + self.ramp_s
+
+    def check(self, lengths: FloatArray, total_s: float) -> None:
+        """Refuse a leg over :data:`RUCKIG_MAX_DURATION_S`, the legs of ``lengths`` (K,)
+        taking ``total_s`` together (only then can one of them be too long)."""
+        if total_s > RUCKIG_MAX_DURATION_S:
+            _refuse_long(lengths, self.limits, self.leg_durations(lengths))
+
+
+def _cruising(
+    starts: FloatArray,
+    ends: FloatArray,
+    delta: FloatArray,
+    lengths: FloatArray,
+    *,
+    shortest: float | None,
+    limits: LegLimits | Sequence[LegLimits],
+) -> _Cruising | None:
+    """Legs from rest to rest under one norm limit that all reach its speed: the cheap case.
+
+    All such legs share one profile but for its cruise (:func:`double_s.cruise`), so the
+    pieces are that profile's, mixed from each leg's direction, start and end, in a handful
+    of numpy calls whatever the number of legs (no phase to drop, each quantity one call).
+    None if the limits are per leg or per axis, or a leg (the ``shortest``, m) is too short
+    to cruise (then :func:`_partly_cruising` replaces those). Without ``shortest`` every leg
+    is taken as cruising: the caller replaces those that do not. The caller checks the legs'
+    durations (:meth:`_Cruising.check`).
+    """
+    if not isinstance(limits, LegLimits) or limits.per_axis:
+        return None
+    vmax = limits.vmax
+    dim = delta.shape[1]
+    mixing = _mixing(vmax, float(limits.amax), float(limits.jmax), dim)  # (norms: numbers)
+    if mixing is None:
+        return None
+    profile, mixer = mixing
+    # (The same float operations as on every leg below: the shortest cruises least.)
+    if shortest is not None and shortest / vmax - profile.ramp_s <= MIN_PHASE_S:
+        return None
+    k, n = lengths.size, profile.durations.size
+    breaks = np.empty(k * n + 1)
+    breaks[0] = 0.0
+    durations = breaks[1:].reshape(k, n)
+    durations[:] = profile.durations
+    cruise_s = durations[:, profile.at_cruise]
+    np.divide(lengths, vmax, out=cruise_s)
+    cruise_s -= profile.ramp_s
+    # Each leg's unit direction, start and end, (K, 3 d), mixed into every phase's
+    # coefficients, (K, 4 n d), by one matrix product.
+    basis = np.concatenate((delta / lengths[:, None], starts, ends), axis=1)
+    coeffs = np.dot(basis, mixer)  # (the matmul operator's dispatch costs more)
+    return _Cruising(
+        breaks, coeffs.reshape(k * n, 4, dim), n, profile.at_cruise, limits, profile.ramp_s
+    )
+
+
+@functools.lru_cache(maxsize=256)
+def _mixing(vmax: float, amax: float, jmax: float, dim: int) -> tuple[Cruise, FloatArray] | None:
+    """:func:`double_s.cruise` of the limits, and its :attr:`~double_s.Cruise.mix` for legs
+    in ``dim`` axes: ``kron(mix.T, eye(dim))``, (3 dim, 4 n dim), so that a leg's direction,
+    start and end in a row (3 dim,) times it are its phases' coefficients (4 n dim,)."""
+    profile = cruise(vmax, amax, jmax)
+    if profile is None:
+        return None
+    mixer = np.asarray(np.kron(profile.mix.T, np.eye(dim)), dtype=np.float64)
+    mixer.setflags(write=False)
+    return profile, mixer
+
+
+def _partly_cruising(
+    starts: FloatArray,
+    ends: FloatArray,
+    delta: FloatArray,
+    lengths: FloatArray,
+    limits: LegLimits | Sequence[LegLimits],
+) -> Legs | None:
+    """Legs from rest to rest under one norm limit, some too short to cruise.
+
+    Every leg is timed through the shared profile (:func:`_cruising`), then the phases of
+    those too short to cruise are replaced by their own (the closed form, in the same
+    phase slots), and the phases of no length dropped: one pass over the pieces more than
+    if all legs cruised. None if the limits are per leg or per axis.
+    """
+    cruising = _cruising(starts, ends, delta, lengths, shortest=None, limits=limits)
+    if cruising is None:
+        return None
+    k, n, dim = lengths.size, cruising.phases, delta.shape[1]
+    durations = cruising.breaks[1:].reshape(k, n)
+    short = np.flatnonzero(durations[:, cruising.at_cruise] <= MIN_PHASE_S)
+    slots = _SLOTS[n]
+    bounds = np.array([[cruising.limits.vmax, cruising.limits.amax, cruising.limits.jmax]])
+    ph = _rest_to_rest(lengths.take(short), np.repeat(bounds, short.size, axis=0))
+    if n < 7 and np.any(ph.t[:, [1, 5]] > MIN_PHASE_S):  # (a hold the profile has not)
+        return None
+    durations[short] = ph.t[:, slots]
+    # p, v, a/2, j/6 at each slot's start, (k_short, n, 4), along each leg's direction.
+    scalar = np.stack(
+        (ph.p[:, slots], ph.v[:, slots], ph.a[:, slots] / 2.0, ph.j[:, slots] / 6.0), axis=-1
+    )
+    short_delta = delta.take(short, axis=0)
+    directions = short_delta / lengths.take(short)[:, None]
+    coeffs = cruising.coeffs.reshape(k, n, 4, dim)
+    coeffs[short] = scalar[..., None] * directions[:, None, None, :]
+    coeffs[short, :, 0] += starts.take(short, axis=0)[:, None, :]
+    leg_durations = durations.sum(axis=1)
+    _refuse_long(lengths, limits, leg_durations)
+    kept = np.flatnonzero(cruising.breaks[1:] > MIN_PHASE_S)
+    return Legs(cruising.breaks[1:].take(kept), cruising.coeffs.take(kept, axis=0), leg_durations)
+
+
+#: The phases of the seven-phase profile in the slots of a shared profile of n phases
+#: (:func:`double_s.cruise`: without its hold phases when it has none).
+_SLOTS = {7: np.arange(7), 5: np.array([0, 2, 3, 4, 6])}
+
+
 def _legs(
     starts: FloatArray,
     delta: FloatArray,
@@ -190,23 +353,28 @@ def _legs(
     limits: LegLimits | Sequence[LegLimits],
     speeds: FloatArray | None,
 ) -> Legs:
-    """:func:`legs_pieces` of legs ``delta`` (K, d) of ``lengths`` (K,) from ``starts``.
+    """:func:`legs_pieces` of legs ``delta`` (K, d) of ``lengths`` (K,) from ``starts``, each
+    leg timed on its own.
 
-    At a few legs the cost is the number of numpy calls (a microsecond or more each,
-    whatever their size), at many the passes over memory: each quantity is one call over
-    all legs and phases, on arrays whose last axis is long (numpy's loops over a last axis
-    of length 3 or 4 are several times slower).
+    At a few legs the cost is the number of numpy calls (a fraction of a microsecond or
+    more each, whatever their size), at many the passes over memory: each quantity is one
+    call over all legs and phases, on arrays whose last axis is long (numpy's loops over a
+    last axis of length 3 or 4 are several times slower).
     """
     directions = delta / lengths[:, None]
     bounds = _bounds(limits, directions)
-    v_ends = np.zeros((lengths.size, 2)) if speeds is None else np.asarray(speeds, dtype=float)
-    if lengths.size <= READ_UP_TO:
-        ph = _read_block(lengths, v_ends, bounds)
+    if speeds is None or not np.any(speeds):
+        ph = _rest_to_rest(lengths, bounds)
     else:
-        ph = _integrated(lengths, v_ends, bounds, rest=speeds is None)
+        v_ends = np.asarray(speeds, dtype=float)
+        if lengths.size <= READ_UP_TO:
+            ph = _read_block(lengths, v_ends, bounds)
+        else:
+            t, jerk = _timed(lengths, v_ends, bounds)
+            ph = _states(t, jerk, v_ends[:, 0])
     # The phases kept (sub-picosecond ones only add round-off), as flat positions in the
     # (K, 7) and (K, 8) arrays, in flight order.
-    at7 = np.flatnonzero(ph.t > 1e-12)
+    at7 = np.flatnonzero(ph.t > MIN_PHASE_S)
     leg = at7 // 7
     at8 = at7 + leg
     # p, v, a/2, j/6 at each kept phase's start along its leg, (4, P); times the leg's
@@ -223,30 +391,31 @@ def _legs(
     return Legs(ph.t.take(at7), per_axis.transpose(2, 0, 1), ph.t @ _ONES)
 
 
-def _integrated(
-    lengths: FloatArray, v_ends: FloatArray, bounds: FloatArray, *, rest: bool
-) -> _Phases:
-    """The phases of many legs: Ruckig's durations and jerks (:func:`_timed`), the states
-    integrated here (:func:`_states`), cheaper than reading them through the binding."""
-    t, jerk = _timed(lengths, v_ends, bounds, read_jerk=not rest)
-    ph = _states(t, jerk, v_ends[:, 0])
-    if rest:
-        # Jerks taken from Ruckig's rest-to-rest profile (:func:`_time_block`) are kept only
-        # where that profile ends where Ruckig's own check demands; any other leg is timed
-        # again with its jerks read.
-        tol_p, tol_v, tol_a = _END_TOLERANCE
-        miss = np.abs(ph.p[:, 7] - lengths) >= tol_p
-        miss |= np.abs(ph.v[:, 7]) >= tol_v
-        miss |= np.abs(ph.a[:, 7]) >= tol_a
-        if miss.any():
-            other = np.flatnonzero(miss)
-            t[other], jerk[other] = _timed(
-                lengths[other], v_ends[other], bounds[other], read_jerk=True
-            )
-            again = _states(t[other], jerk[other], v_ends[other, 0])
-            for whole, part in zip(ph, again, strict=True):
-                whole[other] = part
-    return ph
+def _rest_to_rest(lengths: FloatArray, bounds: FloatArray) -> _Phases:
+    """The phases of legs from rest to rest under ``bounds`` (K, 3): the closed form (the
+    caller refuses legs too long, :func:`_refuse_long`)."""
+    vmax, amax, jmax = bounds.T
+    t = rest_to_rest(lengths, vmax, amax, jmax)
+    return _states(t, JERK_SIGNS * jmax[:, None])
+
+
+def _refuse_long(
+    lengths: FloatArray, limits: LegLimits | Sequence[LegLimits], durations: FloatArray
+) -> None:
+    """Refuse the first leg longer than :data:`RUCKIG_MAX_DURATION_S`, if any, as Ruckig
+    would refuse it (lengths, durations (K,)), so that whether a leg is timed does not
+    depend on the speeds at its ends."""
+    too_long = np.flatnonzero(durations > RUCKIG_MAX_DURATION_S)
+    if too_long.size:
+        i = int(too_long[0])
+        raise UntimeableLegError(
+            i,
+            float(lengths[i]),
+            (limits if isinstance(limits, LegLimits) else limits[i]).vmax,
+            float(durations[i]),
+            argument="starts, ends",
+            what=f"leg {i},",
+        )
 
 
 #: Most legs timed in one Ruckig call (the objects of each power-of-two size up to it are kept).
@@ -275,11 +444,6 @@ def _ruckig(size: int) -> tuple[InputParameter, Trajectory, Ruckig]:
     return cache[size]
 
 
-#: Jerk signs of Ruckig's "up, down, down, up" profile (``ControlSigns::UDDU``), per phase.
-_UDDU = np.array([1.0, 0.0, -1.0, 0.0, -1.0, 0.0, 1.0])
-#: Ruckig's own tolerances on a profile's end position, speed and acceleration
-#: (``Profile::p_precision``, ``v_precision``, ``a_precision``).
-_END_TOLERANCE = np.array([1e-8, 1e-8, 1e-10])
 #: Divisors from a phase's start state (p, v, a, j) to its power-basis coefficients.
 _TAYLOR = np.array([1.0, 1.0, 2.0, 6.0])
 #: ``_BEFORE[m, i] = 1`` for phases ``m < i``: running sums over phases as one product.
@@ -289,51 +453,41 @@ _ONES = np.ones(7)
 
 
 def _timed(
-    lengths: FloatArray, v_ends: FloatArray, bounds: FloatArray, *, read_jerk: bool
+    lengths: FloatArray, v_ends: FloatArray, bounds: FloatArray
 ) -> tuple[FloatArray, FloatArray]:
     """Phase durations and jerks (K, 7) of ``K`` legs, in calls of up to :data:`BLOCK` legs."""
     k = lengths.size
     if k <= BLOCK:
-        return _time_block(lengths, v_ends, bounds, read_jerk=read_jerk)
+        return _time_block(lengths, v_ends, bounds)
     t, jerk = np.empty((k, 7)), np.empty((k, 7))
     for first in range(0, k, BLOCK):
         block = slice(first, min(first + BLOCK, k))
-        t[block], jerk[block] = _time_block(
-            lengths[block], v_ends[block], bounds[block], read_jerk=read_jerk
-        )
+        t[block], jerk[block] = _time_block(lengths[block], v_ends[block], bounds[block])
     return t, jerk
 
 
 def _time_block(
-    lengths: FloatArray, v_ends: FloatArray, bounds: FloatArray, *, read_jerk: bool
+    lengths: FloatArray, v_ends: FloatArray, bounds: FloatArray
 ) -> tuple[FloatArray, FloatArray]:
     """Phase durations and jerks (k, 7) of up to :data:`BLOCK` legs, in one Ruckig call.
 
     Reading a profile back through the Python binding costs more than Ruckig's own
-    calculation, about half a microsecond per array of a leg, so unless ``read_jerk`` only
-    the phase durations are read, and the jerks are those of a time-optimal rest-to-rest
-    move in the positive direction: Ruckig's up-down-down-up profile, ``+j, 0, -j, 0, -j,
-    0, +j`` on its phases of positive length (``Profile::check``). The caller checks that
-    the profile then ends where it must (:func:`_integrated`).
+    calculation, about half a microsecond per array of a leg: only these two are read.
     """
     k = lengths.size
     phases = _calculate(lengths, v_ends, bounds)
     read: list[float] = []
     for profile in phases:
         read += profile.t
-    if read_jerk:
-        for profile in phases:
-            read += profile.j
-    values = np.array(read).reshape(-1, k, 7)
-    if read_jerk:
-        return values[0], values[1]
-    t = values[0]
-    return t, np.where(t > 0.0, _UDDU * bounds[:, 2:], 0.0)
+    for profile in phases:
+        read += profile.j
+    values = np.array(read).reshape(2, k, 7)
+    return values[0], values[1]
 
 
-#: Up to this many legs the states are read from Ruckig's profiles (:func:`_read_block`):
-#: four more arrays a leg through the binding cost less than the fifteen or so numpy calls
-#: that integrate them (:func:`_integrated`), 1-3 us each whatever the number of legs.
+#: Up to this many legs timed by Ruckig their states are read from its profiles
+#: (:func:`_read_block`): three more arrays a leg through the binding cost less than the
+#: dozen numpy calls that integrate them (:func:`_states`), whatever the number of legs.
 READ_UP_TO = 16
 
 
@@ -467,10 +621,11 @@ def _smallest(bound: float | FloatArray) -> float:
     return bound if isinstance(bound, float) else float(np.min(bound))
 
 
-def _states(t: FloatArray, jerk: FloatArray, v0: FloatArray) -> _Phases:
+def _states(t: FloatArray, jerk: FloatArray, v0: FloatArray | None = None) -> _Phases:
     """The phases of legs of durations ``t`` and jerks ``jerk`` (K, 7), integrated.
 
-    Each leg starts at position 0 with speed ``v0`` (K,) and no acceleration. The
+    Each leg starts at position 0 with speed ``v0`` (K,) (at rest without it) and no
+    acceleration. The
     recurrence is Ruckig's (``Profile::check``)::
 
         a[i+1] = a[i] + t[i] * j[i]
@@ -484,7 +639,7 @@ def _states(t: FloatArray, jerk: FloatArray, v0: FloatArray) -> _Phases:
     a = tj @ _BEFORE
     before = a[:, :7]
     v = (t * (before + tj / 2)) @ _BEFORE
-    if np.any(v0):
+    if v0 is not None:
         v += v0[:, None]
     p = (t * (v[:, :7] + t * (before / 2 + tj / 6))) @ _BEFORE
     return _Phases(t, jerk, p, v, a)
@@ -528,7 +683,8 @@ def stop_and_go(waypoints: FloatArray, limits: LegLimits | Sequence[LegLimits]) 
     if pts.shape[0] < 2:
         raise InputError(f"waypoints: got {pts.shape[0]} point(s), expected at least 2")
     if isinstance(limits, LegLimits):
-        _check(limits, pts.shape[1])
+        if limits.per_axis:
+            _check(limits, pts.shape[1])
     else:
         if len(limits) != pts.shape[0] - 1:
             raise InputError(
@@ -537,35 +693,63 @@ def stop_and_go(waypoints: FloatArray, limits: LegLimits | Sequence[LegLimits]) 
         for lim in {id(lim): lim for lim in limits}.values():
             _check(lim, pts.shape[1])
     delta = pts[1:] - pts[:-1]
-    steps = np.sqrt(np.add.reduce(delta * delta, axis=1))  # numpy.linalg.norm(axis=1)
-    moving = steps > REPEAT_TOLERANCE * max(1.0, float(np.abs(pts).max()))
-    every = bool(moving.all())
-    idx = np.arange(steps.size) if every else np.flatnonzero(moving)
-    if not idx.size:
-        raise InputError("waypoints: got coincident points, expected a path of positive length")
-    if not every:
-        delta, steps = delta[idx], steps[idx]
+    steps = np.sqrt(np.vecdot(delta, delta))  # numpy.linalg.norm(axis=1), cheaper
+    # (The ufuncs' reductions: the methods .max() and .min() wrap them in Python.)
+    repeat = REPEAT_TOLERANCE * max(1.0, float(np.maximum.reduce(abs(pts), axis=None)))
+    idx = None  # the legs flown, if not all: repeated points are skipped
+    starts, ends = pts[:-1], pts[1:]
+    shortest = float(np.minimum.reduce(steps))
+    if shortest <= repeat:
+        idx = np.flatnonzero(steps > repeat)
+        if not idx.size:
+            raise InputError("waypoints: got coincident points, expected a path of positive length")
+        delta, steps, starts, ends = delta[idx], steps[idx], pts[idx], pts[idx + 1]
+        shortest = float(steps.min())
         if not isinstance(limits, LegLimits):
             limits = [limits[k] for k in idx.tolist()]
     try:
-        legs = _legs(pts[:-1] if every else pts[idx], delta, steps, limits, None)
+        trajectory, arrived = _flown(starts, ends, delta, steps, shortest=shortest, limits=limits)
     except UntimeableLegError as exc:
-        first = int(idx[exc.leg])
+        first = exc.leg if idx is None else int(idx[exc.leg])
         raise exc.naming("waypoints", f"the leg from waypoint {first} to {first + 1},") from None
-    return StopAndGo(
-        _chain(legs.durations, legs.coeffs), _arrivals(pts.shape[0], idx, legs.leg_durations)
-    )
+    return StopAndGo(trajectory, arrived if idx is None else _arrivals(pts.shape[0], idx, arrived))
 
 
-def _arrivals(n_points: int, idx: NDArray[np.intp], leg_durations: FloatArray) -> FloatArray:
-    """Arrival time at each of ``n_points`` waypoints, the legs ``idx`` taking ``leg_durations``
-    (a repeated waypoint arrives when the previous one did)."""
+def _flown(
+    starts: FloatArray,
+    ends: FloatArray,
+    delta: FloatArray,
+    lengths: FloatArray,
+    *,
+    shortest: float,
+    limits: LegLimits | Sequence[LegLimits],
+) -> tuple[PiecewisePolynomial, FloatArray]:
+    """The legs flown back to back from rest to rest, and when each ends, (K + 1,), s (from 0).
+
+    ``starts``, ``ends``, ``delta`` (K, d), m; ``lengths`` (K,) and the ``shortest``, m.
+    """
+    cruising = _cruising(starts, ends, delta, lengths, shortest=shortest, limits=limits)
+    if cruising is None:
+        legs = _partly_cruising(starts, ends, delta, lengths, limits)
+        if legs is None:
+            legs = _legs(starts, delta, lengths, limits, None)
+            _refuse_long(lengths, limits, legs.leg_durations)
+        arrived = np.zeros(lengths.size + 1)
+        np.cumsum(legs.leg_durations, out=arrived[1:])
+        return _chain(legs.durations, legs.coeffs), arrived
+    breaks = cruising.breaks
+    np.add.accumulate(breaks, out=breaks)  # (numpy.cumsum's wrapper costs as much again)
+    cruising.check(lengths, float(breaks[-1]))
+    return _trusted(breaks, cruising.coeffs), breaks[:: cruising.phases]
+
+
+def _arrivals(n_points: int, idx: NDArray[np.intp], arrived: FloatArray) -> FloatArray:
+    """Arrival time at each of ``n_points`` waypoints, the legs ``idx`` flown arriving at
+    ``arrived[1:]`` (a repeated waypoint arrives when the previous one did)."""
+    leg_time = np.zeros(n_points - 1)
+    leg_time[idx] = np.diff(arrived)
     arrivals = np.zeros(n_points)
-    if idx.size < n_points - 1:
-        leg_time = np.zeros(n_points - 1)
-        leg_time[idx] = leg_durations
-        leg_durations = leg_time
-    np.cumsum(leg_durations, out=arrivals[1:])
+    np.cumsum(leg_time, out=arrivals[1:])
     return arrivals
 
 
@@ -580,6 +764,12 @@ def _chain(durations: FloatArray, coeffs: FloatArray) -> PiecewisePolynomial:
     breaks = np.empty(durations.size + 1)
     breaks[0] = 0.0
     np.cumsum(durations, out=breaks[1:])
+    return _trusted(breaks, coeffs)
+
+
+def _trusted(breaks: FloatArray, coeffs: FloatArray) -> PiecewisePolynomial:
+    """The pieces ``coeffs`` (P, 4, d) between ``breaks`` (P + 1,), s, as :func:`_chain`
+    builds them (pieces lost in the clock's round-off dropped)."""
     if breaks[-1] > _ROUND_OFF_HORIZON_S:
         grows = breaks[1:] > breaks[:-1]
         if not grows.all():
