@@ -7,13 +7,15 @@ takes ``--no-pictures``. Either way ``summary.json`` says what happened, under
 ``pictures``: ``drawn`` (false with ``--no-pictures``), the ``files`` drawn and
 ``time_s``, the time spent drawing them, s (so a user sees what they cost).
 
-Run from a shell, ``fit``, ``fly`` and ``write`` draw ``plot.png`` in the picture worker
-(:mod:`skyquill.viz.worker`), started by the console script before the program's
-imports, so that matplotlib's import and the fonts' loading are done on the machine's
-other core while the command plans: ``time_s`` then counts starting the worker, sampling
-the plan and waiting for the file, ``process`` says ``"worker"``. Should the worker fail
-(it died, or its drawing raised), the picture is drawn here instead, as without it, and
-``worker_error`` says why: the plan's files never depend on it.
+Run from a shell with a core free, ``fit``, ``fly`` and ``write`` draw ``plot.png`` in
+the picture worker (:mod:`skyquill.viz.worker`), started by the console script before
+the program's imports, so that matplotlib's import and the fonts' loading are done on
+the free core while the command plans. ``process`` then says ``"worker"``, and
+``time_s`` counts starting the worker, sampling the plan, waiting for the file and
+``contention_s``, what the worker's work took from the command while both ran. Should
+the worker fail (it died, or its drawing raised), the picture is drawn here instead, as
+without it, ``process`` says ``"command"`` and ``worker_error`` why: the plan's files
+never depend on the worker.
 """
 
 from __future__ import annotations

@@ -17,7 +17,8 @@ on the shared 2-core machine at load 3: ``fit``'s wall time 1.17x drawing in-pro
 
 Started with ``spawn``: a fresh interpreter, nothing inherited (``fork`` would copy
 BLAS's threads' locks and the command's status-line thread). It ignores Ctrl+C (the
-command reports it) and ends when the command closes it or ends.
+command reports it) and ends when the command closes it or ends. POSIX only, like the
+console script's other signal handling.
 
 The command's picture time (``summary.json``'s ``pictures.time_s``) counts what the
 pictures cost the command, as the outside view (the command with and without
@@ -99,7 +100,14 @@ class PictureWorker:
         self._process = context.Process(
             target=_serve, args=(theirs, DRAWING_MODULES), name="skyquill-pictures", daemon=True
         )
-        self._process.start()
+        # Ctrl+C reaches the worker too (one process group): blocked while it starts, the
+        # signal stays blocked in it from its first instruction (the mask survives exec),
+        # and is delivered here once unblocked, not lost.
+        blocked = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+        try:
+            self._process.start()
+        finally:
+            signal.pthread_sigmask(signal.SIG_SETMASK, blocked)
         theirs.close()
         self.start_s = time.perf_counter() - clock
         self.contention_s: float | None = None
@@ -143,6 +151,7 @@ class PictureWorker:
 def _serve(connection: Connection, modules: tuple[str, ...]) -> None:
     """The worker: import ``modules``, warm up, then draw what comes until told to stop."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl+C is the command's to report
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})  # ignored now: no need
     for module in modules:
         importlib.import_module(module)
     _warm_up()
