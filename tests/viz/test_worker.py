@@ -102,7 +102,8 @@ def test_only_drawing_commands_start_it() -> None:
 def test_fit_from_the_console_script_draws_in_the_worker(tmp_path: Path) -> None:
     """As a user runs it (a core taken as free: the machine running the tests may be busy)."""
     script = (
-        "import sys; import skyquill.viz.worker as w; w.a_core_is_free = lambda: True; "
+        "import atexit, sys; import skyquill.viz.worker as w; w.a_core_is_free = lambda: True; "
+        "atexit.register(lambda: print('matplotlib here:', 'matplotlib' in sys.modules)); "
         "from skyquill.cli.entry import run; run()"
     )
     out = tmp_path / "o"
@@ -117,3 +118,15 @@ def test_fit_from_the_console_script_draws_in_the_worker(tmp_path: Path) -> None
     assert pictures["process"] == "worker" and "worker_error" not in pictures
     assert pictures["files"] == ["plot.png"] and (out / "plot.png").stat().st_size > 0
     assert pictures["time_s"] >= pictures["contention_s"] >= 0.0
+    assert "matplotlib here: False" in done.stdout  # imported by the worker alone
+
+
+def test_the_samples_unpickle_without_matplotlib_or_the_core() -> None:
+    """What the worker imports to read the samples: numpy, not the planner (0.5 s more)."""
+    probe = (
+        "import sys, skyquill.viz.sampled; "
+        "print(sorted(m for m in sys.modules if m.startswith(('matplotlib', 'scipy', "
+        "'skyquill.limits', 'skyquill.optimize'))))"
+    )
+    done = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, check=True)
+    assert done.stdout.strip() == "[]"
