@@ -88,6 +88,16 @@ def test_no_pictures_closes_a_started_worker() -> None:
     assert worker_module.take() is None
 
 
+def test_no_worker_when_no_process_can_start(monkeypatch: pytest.MonkeyPatch) -> None:
+    def refused() -> PictureWorker:
+        raise OSError(11, "Resource temporarily unavailable")
+
+    monkeypatch.setattr(worker_module, "a_core_is_free", lambda: True)
+    monkeypatch.setattr(worker_module, "PictureWorker", refused)
+    worker_module.prestart()
+    assert worker_module.take() is None  # the command draws itself
+
+
 def test_only_drawing_commands_start_it() -> None:
     assert _will_draw(["fit", "a.csv", "--out", "o"])
     assert _will_draw(["write", "Hi", "--out", "o"])

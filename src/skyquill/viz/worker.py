@@ -17,8 +17,8 @@ on the shared 2-core machine at load 3: ``fit``'s wall time 1.17x drawing in-pro
 
 Started with ``spawn``: a fresh interpreter, nothing inherited (``fork`` would copy
 BLAS's threads' locks and the command's status-line thread). It ignores Ctrl+C (the
-command reports it) and ends when the command closes it or ends. POSIX only, like the
-console script's other signal handling.
+command reports it) and ends when the command closes it or ends. POSIX only (signal
+masks): elsewhere the command draws its pictures itself.
 
 The command's picture time (``summary.json``'s ``pictures.time_s``) counts what the
 pictures cost the command, as the outside view (the command with and without
@@ -220,9 +220,17 @@ def a_core_is_free() -> bool:
 
 def prestart() -> None:
     """Start the worker now, for the command about to run, if a core is free for it
-    (:func:`take` hands it over)."""
-    if not _PRESTARTED and a_core_is_free():
+    (:func:`take` hands it over).
+
+    Without POSIX signal masks, or when no process can be started (the system's
+    limits), there is none: the command draws its pictures itself, as it would anyway.
+    """
+    if _PRESTARTED or not hasattr(signal, "pthread_sigmask") or not a_core_is_free():
+        return
+    try:
         _PRESTARTED.append(PictureWorker())
+    except OSError:
+        return
 
 
 def take() -> PictureWorker | None:
