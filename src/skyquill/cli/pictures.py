@@ -60,7 +60,7 @@ class Pictures:
     def __init__(self, draw: bool) -> None:
         self.entry: dict[str, Any] = {"drawn": draw, "files": [], "time_s": 0.0}
         self._worker: PictureWorker | None = take()
-        if self._worker is not None and not draw:  # not started with --no-pictures; still
+        if self._worker is not None and not draw:  # started on a wrong guess: not needed
             self._worker.close()
             self._worker = None
         if self._worker is not None:
