@@ -47,7 +47,7 @@ def test_the_worker_draws_the_same_png_as_this_process(
     _flight().draw(tmp_path / "here.png")
     worker.draw(_flight(), tmp_path / "there.png")
     assert (tmp_path / "there.png").read_bytes() == (tmp_path / "here.png").read_bytes()
-    # What it took from the command before drawing: at most its CPU time, never negative.
+    # The command's wait for a core until it asked for the drawing: never negative.
     assert worker.contention_s is not None and 0.0 <= worker.contention_s < 60.0
 
 
