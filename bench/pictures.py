@@ -15,7 +15,11 @@ A command run from the shell also starts Python and imports skyquill (a few seco
 this machine, more than ``fit`` plans in), and, when it draws, matplotlib (inside the
 pictures' time). So the short commands (:data:`FRESH`) are also run as a user runs them,
 ``skyquill ...`` in a fresh process, alternated the same way: ``fresh_process`` holds
-their shares of that wall time.
+their shares of that wall time. There ``fit``, ``fly`` and ``write`` draw in the picture
+worker (:mod:`skyquill.viz.worker`) when a core is free as they start:
+``runs_drawn_in_the_worker`` counts those runs. In the same loop each is also run with
+the worker always started (``worker_always``) and never (``worker_never``), the A/B of
+the worker under the same load (``always_over_never``: the ratio of their wall times).
 
 Written to ``bench/results/pictures.json``. Run: ``.venv/bin/python bench/pictures.py``
 (about 10 minutes on two free cores with ``--runs 3``, the default); ``--runs 1`` on a busy
@@ -67,6 +71,11 @@ FRESH = ("fit spiral", "fly spiral", "write Hi")
 #: The console script a user runs, and BLAS on one thread in its process too.
 SKYQUILL = Path(sys.executable).with_name("skyquill")
 ONE_THREAD = {name: "1" for name in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")}
+#: The console script's entry with the picture worker always (True) or never (False) started.
+FORCED = (
+    "import skyquill.viz.worker as w; w.a_core_is_free = lambda: %s; "
+    "from skyquill.cli.entry import run; run()"
+)
 
 
 def _run(args: list[str], folder: Path, plan: Path) -> tuple[float, dict[str, Any]]:
@@ -82,14 +91,21 @@ def _run(args: list[str], folder: Path, plan: Path) -> tuple[float, dict[str, An
     return wall, json.loads((out / "summary.json").read_text())
 
 
-def _run_fresh(args: list[str], folder: Path, plan: Path) -> tuple[float, dict[str, Any]]:
-    """Wall time of one command run as ``skyquill ...`` in a new process, and its summary."""
+def _run_fresh(
+    args: list[str], folder: Path, plan: Path, worker: bool | None = None
+) -> tuple[float, dict[str, Any]]:
+    """Wall time of one command run as ``skyquill ...`` in a new process, and its summary.
+
+    ``worker``: ``None`` as a user runs it (the worker when a core is free); ``True`` or
+    ``False``, the console script's entry with the worker always or never started.
+    """
     out = folder / "out"
     shutil.rmtree(out, ignore_errors=True)
     filled = [a.format(out=out, plan=plan) for a in args]
+    program = [str(SKYQUILL)] if worker is None else [sys.executable, "-c", FORCED % worker]
     clock = time.perf_counter()
     done = subprocess.run(
-        [str(SKYQUILL), *filled],
+        [*program, *filled],
         check=False,
         capture_output=True,
         text=True,
@@ -111,17 +127,23 @@ def measure(
     run = _run_fresh if fresh else _run
     with_s, without_s, shares = [], [], []
     drawn: list[str] = []
+    in_worker = 0
+    forced: dict[bool, list[tuple[float, float]]] = {True: [], False: []}
     for _ in range(runs):
         wall, summary = run(args, folder, plan)
         pictures = summary["pictures"]
+        in_worker += pictures.get("process") == "worker"
         with_s.append(wall)
         shares.append(pictures["time_s"] / wall)
         drawn = pictures["files"]
+        for worker in forced if fresh else ():
+            wall, summary = _run_fresh(args, folder, plan, worker)
+            forced[worker].append((wall, summary["pictures"]["time_s"] / wall))
         wall, summary = run([*args, "--no-pictures"], folder, plan)
         assert summary["pictures"]["drawn"] is False
         without_s.append(wall)
     share = float(np.median(shares))
-    return {
+    return _forced_rows(forced, float(np.median(without_s))) | {
         "workload": name,
         "command": " ".join(args),
         "pictures": drawn,
@@ -132,8 +154,27 @@ def measure(
         "without_over_with": float(np.median(without_s) / np.median(with_s)),
         "runs": runs,
         "process": "fresh (skyquill ...)" if fresh else "this one (CliRunner)",
+        "runs_drawn_in_the_worker": in_worker,
         "meets_goal": share <= GOAL_SHARE,
     }
+
+
+def _forced_rows(forced: dict[bool, list[tuple[float, float]]], without_s: float) -> dict[str, Any]:
+    """The runs with the worker forced on and off (fresh processes): A/B under one load."""
+    if not forced[True]:
+        return {}
+    rows = {}
+    for worker, runs in forced.items():
+        wall = float(np.median([w for w, _ in runs]))
+        rows["worker_always" if worker else "worker_never"] = {
+            "wall_with_pictures_s": wall,
+            "share": float(np.median([s for _, s in runs])),
+            "without_over_with": without_s / wall,
+        }
+    rows["always_over_never"] = (
+        rows["worker_always"]["wall_with_pictures_s"] / rows["worker_never"]["wall_with_pictures_s"]
+    )
+    return rows
 
 
 def main() -> None:

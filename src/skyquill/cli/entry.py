@@ -4,6 +4,10 @@ Importing the app takes most of a second (numpy, scipy, rich, typer). Ctrl+C in
 that time would print a ``KeyboardInterrupt`` traceback, since the app's own
 boundary (:class:`~skyquill.cli.boundary.OneLineGroup`) does not exist yet; this
 module imports nothing heavy itself, so that it can say one line instead.
+
+It is also the first moment a command that will draw its ``plot.png`` can start the
+picture worker (:mod:`skyquill.viz.worker`): the worker imports matplotlib on the
+other core while this process imports the program and plans.
 """
 
 from __future__ import annotations
@@ -12,14 +16,34 @@ import sys
 
 #: Exit status of an interrupted command (128 + SIGINT); the same as the app's.
 INTERRUPTED = 130
+#: The commands whose ``plot.png`` the picture worker draws (``--no-pictures`` skips it).
+DRAWN_BY_THE_WORKER = ("fit", "fly", "write")
 
 
 def run() -> None:
     """Import and run the app; one line and exit status 130 on Ctrl+C, whenever it comes."""
     try:
+        if _will_draw(sys.argv[1:]):
+            from skyquill.viz.worker import prestart
+
+            prestart()
         from skyquill.cli.main import app
 
         app(prog_name="skyquill")
     except KeyboardInterrupt:
         sys.stderr.write("error: interrupted by Ctrl+C before anything was written\n")
         sys.exit(INTERRUPTED)
+
+
+def _will_draw(args: list[str]) -> bool:
+    """Whether the command line ``args`` runs a command that draws in the picture worker.
+
+    Read before the program is imported, so from the words alone: the command first,
+    no ``--no-pictures`` nor help. A wrong guess costs a worker started for nothing (a
+    few milliseconds here) or a picture drawn in this process.
+    """
+    return (
+        bool(args)
+        and args[0] in DRAWN_BY_THE_WORKER
+        and not {"--no-pictures", "--help"} & set(args)
+    )

@@ -43,6 +43,8 @@ from skyquill.optimize.budget import lifted
 from skyquill.optimize.fit import FitOptions, PointFit, fit_points
 from skyquill.phases import DEFAULT_ALTITUDE_M, MIN_ALTITUDE_M, check_altitude
 from skyquill.validation import FloatArray
+from skyquill.viz.sampled import sample_fit
+from skyquill.viz.worker import Drawing
 
 #: ``--weight`` of the point deviation: beyond 1e9 the solver's conditioning, not the fit,
 #: decides (1e300 did not end).
@@ -135,7 +137,7 @@ def run_fit(
             rate=rate,
             guaranteed=True,
             summary=fields | {"pictures": drawn.entry},
-            plot=drawn.plot(lambda path: _plot_fit(fit, path, title)),
+            plot=drawn.sampled(lambda: _fit_drawing(fit, title)),
             min_altitude_m=flight.min_altitude_m,
         )
     uploads = "" if fit.budget is None else f", {len(fit.budget.uploads)} upload(s)"
@@ -148,11 +150,10 @@ def run_fit(
     return summary
 
 
-def _plot_fit(fit: PointFit, path: Path, title: str) -> None:
-    """``plot.png``; matplotlib is imported here, only when drawn and inside the pictures' time."""
-    from skyquill.viz.fit_plot import plot_fit
-
-    plot_fit(fit, path, title)
+def _fit_drawing(fit: PointFit, title: str) -> Drawing:
+    """``plot.png``: matplotlib is imported where it is drawn, only when drawn, inside the
+    pictures' time (:class:`~skyquill.cli.pictures.Pictures`)."""
+    return Drawing("skyquill.viz.fit_plot", "draw_fit", sample_fit(fit, title))
 
 
 @app.command()

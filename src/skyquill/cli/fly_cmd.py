@@ -24,6 +24,8 @@ from skyquill.cli.pictures import NoPictures, Pictures
 from skyquill.errors import InputError
 from skyquill.io.atomic import write_json
 from skyquill.io.outputs import staged_output
+from skyquill.viz.sampled import sample_flight
+from skyquill.viz.worker import Drawing
 
 if TYPE_CHECKING:  # the fly command imports the simulator lazily
     from skyquill.sim import Disturbances, Flight, OuterLoop
@@ -156,9 +158,12 @@ def _fly_drone(
     rows = write_flight_csv(out / f"flight{suffix}.csv", flight)
     if drawn.drawn:
         with console.status("plotting"), drawn.timing(f"plot{suffix}.png"):
-            from skyquill.viz.flight_plot import plot_flight  # matplotlib: timed, when drawn
-
-            plot_flight(flight, out / f"plot{suffix}.png", name)
+            # matplotlib: imported where it is drawn, only when drawn, inside the timing.
+            samples = sample_flight(flight, name)
+            drawn.draw(
+                Drawing("skyquill.viz.flight_plot", "draw_flight", samples),
+                out / f"plot{suffix}.png",
+            )
     summary = flight.summary()
     return summary | {
         "name": name,

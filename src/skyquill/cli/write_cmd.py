@@ -48,6 +48,8 @@ from skyquill.io.trajectory_json import PlannedTrajectory
 from skyquill.limits import VehicleLimits
 from skyquill.phases import MIN_ALTITUDE_M
 from skyquill.show.lights import COLOR_BY, window_palette
+from skyquill.viz.sampled import sample_missions
+from skyquill.viz.worker import Drawing
 
 #: ``--separation`` between drones, m: more than 100 m apart is no show of one drawing.
 SEPARATION_RANGE_M = (0.0, 100.0)
@@ -568,7 +570,7 @@ def write_outputs(
                 "pictures": drawn.entry,
             }
             | (extra or {}),
-            plot=drawn.plot(lambda path: _plot_missions(missions, path)),
+            plot=drawn.sampled(lambda: _missions_drawing(missions)),
             min_altitude_m=min_altitude_m,
         )
 
@@ -591,11 +593,11 @@ def _window_colors(
     return window_palette([len(m.pen_windows) for m in missions], *palette)
 
 
-def _plot_missions(missions: Sequence[Any], path: Path) -> None:
-    """``plot.png``; matplotlib is imported here, only when drawn and inside the pictures' time."""
-    from skyquill.viz.writing_plot import plot_missions
-
-    plot_missions(list(missions), path, "skyquill write")
+def _missions_drawing(missions: Sequence[Any]) -> Drawing:
+    """``plot.png``: matplotlib is imported where it is drawn, only when drawn, inside the
+    pictures' time (:class:`~skyquill.cli.pictures.Pictures`)."""
+    samples = sample_missions(list(missions), "skyquill write")
+    return Drawing("skyquill.viz.writing_plot", "draw_missions", samples)
 
 
 def _light_pictures(

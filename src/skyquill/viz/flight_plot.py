@@ -3,11 +3,15 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from matplotlib.figure import Figure
 
-from skyquill.sim.result import Flight
 from skyquill.viz.figures import figure_style, new_figure, save_png, stack_time_panels
+from skyquill.viz.sampled import FlightSamples, sample_flight
+
+if TYPE_CHECKING:
+    from skyquill.sim.result import Flight
 
 AXES = "xyz"
 
@@ -30,14 +34,28 @@ def plot_flight(flight: Flight, path: str | Path, title: str = "") -> None:
     title
         Figure title (the controller, simulator and errors are appended).
     """
+    draw_flight(sample_flight(flight, title), path)
+
+
+def draw_flight(samples: FlightSamples, path: str | Path) -> None:
+    """Draw :func:`plot_flight`'s figure of ``samples``
+    (:func:`~skyquill.viz.sampled.sample_flight`).
+
+    Parameters
+    ----------
+    samples
+        The flight sampled.
+    path
+        PNG file to write.
+    """
     # A fixed layout: constrained layout draws the figure twice to measure it.
     fig = new_figure((13, 8))
     with figure_style():
-        _draw(fig, flight, title)
+        _draw(fig, samples)
     save_png(fig, path, dpi=110)
 
 
-def _draw(fig: Figure, flight: Flight, title: str) -> None:
+def _draw(fig: Figure, flight: FlightSamples) -> None:
     """The five panels of :func:`plot_flight` and its title, on ``fig``."""
     top = fig.add_axes((0.06, 0.07, 0.42, 0.84))
     top.plot(flight.p_ref[:, 0], flight.p_ref[:, 1], "--", lw=1.2, color="0.45", label="reference")
@@ -67,8 +85,4 @@ def _draw(fig: Figure, flight: Flight, title: str) -> None:
     err.set_ylim(bottom=0.0)
     err.legend(loc="upper right", fontsize=8, ncols=2)
 
-    saturated = sum(flight.saturations.values())
-    fig.suptitle(
-        f"{title}  {flight.controller} on {flight.sim}: RMSE {1e3 * flight.rmse_m:.2f} mm, "
-        f"max {1e3 * flight.max_error_m:.2f} mm, {saturated} saturated step(s)".strip()
-    )
+    fig.suptitle(flight.title)
