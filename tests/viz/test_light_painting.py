@@ -10,17 +10,18 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from PIL import Image
+from PIL import Image, ImageSequence
 
 from skyquill.errors import InputError
 from skyquill.io.trajectory_json import PlannedTrajectory
 from skyquill.trajectory import PiecewisePolynomial
+from skyquill.viz import light_painting
 from skyquill.viz.camera import Camera
 from skyquill.viz.light_painting import (
     DARK,
     STAMP,
     View,
-    _palette,
+    _palette_colors,
     animate_show,
     long_exposure,
     write_pictures,
@@ -149,7 +150,26 @@ def test_palette_has_the_colours_of_every_sample(drones: int, samples: int, seed
     rgb = np.clip(np.round(255 * colors.reshape(-1, 3)), 0, 255).astype(np.int64)
     lights = np.unique(rgb, axis=0).astype(float)
     fixed = np.array([(0, 0, 0), [round(255 * c) for c in DARK], STAMP], dtype=float)
-    every = np.unique(np.concatenate([fixed, lights]), axis=0)[:256].astype(np.uint8)
-    expected = np.zeros(768, dtype=np.uint8)
-    expected[: every.size] = every.ravel()
-    assert _palette(colors).getpalette() == expected.tolist()
+    every = np.unique(np.concatenate([fixed, lights]), axis=0).astype(np.uint8)
+    np.testing.assert_array_equal(_palette_colors(colors), every)
+
+
+@pytest.mark.parametrize("trail_s", [1.0, math.inf])
+def test_frames_drawn_as_palette_indices_equal_rgb_frames_quantized(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, trail_s: float
+) -> None:
+    # The preview's frames are drawn as palette indices; drawn in RGB and quantized to the
+    # same palette (as with more colours than a GIF holds), every frame decodes the same.
+    indexed = tmp_path / "indexed.gif"
+    animate_show(_drones(), CAMERA, indexed, trail_s=trail_s, max_frames=20)
+    monkeypatch.setattr(light_painting, "_indexer", lambda palette: None)
+    quantized = tmp_path / "quantized.gif"
+    animate_show(_drones(), CAMERA, quantized, trail_s=trail_s, max_frames=20)
+
+    def frames(path: Path) -> list[np.ndarray]:
+        return [np.asarray(f.convert("RGB")) for f in ImageSequence.Iterator(Image.open(path))]
+
+    a, b = frames(indexed), frames(quantized)
+    assert len(a) == len(b) == 20
+    assert all(np.array_equal(x, y) for x, y in zip(a, b, strict=True))
+    assert any(x.any() for x in a)  # something is lit

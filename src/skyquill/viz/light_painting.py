@@ -17,9 +17,10 @@ their colours) and a :class:`~skyquill.viz.camera.Camera`.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
-from dataclasses import dataclass
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import Any
 
 import matplotlib
 
@@ -46,6 +47,8 @@ MAX_EXPOSURE_SAMPLES = 2_000_000
 GLOW = ((7.0, 0.07), (3.5, 0.2), (1.4, 1.0))
 #: Most frames of the preview, and its frame rate (frames per second).
 MAX_FRAMES = 120
+#: Colours a GIF frame holds.
+GIF_COLORS = 256
 PREVIEW_FPS = 12
 #: Samples per second of the preview's trails.
 TRAIL_RATE_HZ = 25.0
@@ -256,9 +259,16 @@ def animate_show(
     trail = horizon if trail_s == math.inf else as_float("trail_s", trail_s, nonneg=True)
     clock = np.linspace(0.0, horizon, max(2, int(horizon * TRAIL_RATE_HZ)) + 1)
     uv, lit, colors = _tracks(drones, camera, clock, default_rgb)
+    # One palette for every frame (the lights' colours, dark, the stamp), instead of
+    # Pillow's median cut per frame: the frames hold only these colours. With at most 256
+    # of them the frames are drawn as palette indices (no quantizing of 120 RGB frames).
+    palette = _palette_colors(colors)
+    index = _indexer(palette)
     pixels = _trail_pixels(uv, lit, colors, clock, camera)
+    if index is not None:
+        pixels = replace(pixels, rgb=index(pixels.rgb))
     times = np.linspace(0.0, horizon, min(frames, max(2, int(horizon * PREVIEW_FPS))))
-    size = (camera.height_px, camera.width_px, 3)
+    size = (camera.height_px, camera.width_px) + (() if index is not None else (3,))
     built = np.zeros(size, dtype=np.uint8)  # trails that never fade (trail >= the show)
     shown = 0
     images = []
@@ -272,16 +282,12 @@ def animate_show(
         else:
             frame = np.zeros(size, dtype=np.uint8)
             pixels.paint(frame, int(np.searchsorted(pixels.t, t - trail)), end)
-        _paint_dots(frame, uv[:, k], np.where(lit[:, k, None], colors[:, k], DARK))
-        image = Image.fromarray(frame)
-        draw = ImageDraw.Draw(image)
-        draw.fontmode = "1"  # no antialiasing: the frame keeps the palette's colours
-        draw.text((10, 10), f"t = {t:5.1f} s", fill=STAMP)
-        images.append(image)
-    # One palette for every frame (the lights' colours, dark, the stamp), instead of
-    # Pillow's median cut per frame: the frames hold only these colours.
-    palette = _palette(colors)
-    images = [im.quantize(palette=palette, dither=Image.Dither.NONE) for im in images]
+        dots = _rgb(np.where(lit[:, k, None], colors[:, k], DARK))
+        _paint_dots(frame, uv[:, k], dots if index is None else index(dots))
+        images.append(_stamped(frame, palette, index, f"t = {t:5.1f} s"))
+    if index is None:  # more colours than a GIF holds: each pixel to its nearest
+        quantized = _palette_image(palette[:GIF_COLORS])
+        images = [im.quantize(palette=quantized, dither=Image.Dither.NONE) for im in images]
     images[0].save(
         str(path),
         format="GIF",
@@ -289,13 +295,15 @@ def animate_show(
         append_images=images[1:],
         duration=round(1000 / PREVIEW_FPS),
         loop=0,
+        optimize=False,  # the palette is ours already: no histogram of every frame
     )
     return int(times.size)
 
 
 @dataclass(frozen=True)
 class _Pixels:
-    """Pixels of every lit trail segment, by the time each is reached (sorted)."""
+    """Pixels of every lit trail segment, by the time each is reached (sorted); ``rgb``: their
+    colours (N, 3), or their palette indices (N,) for an indexed frame."""
 
     t: FloatArray
     u: NDArray[np.intp]
@@ -329,7 +337,7 @@ def _trail_pixels(
     when = clock[k[seg]] + frac * (clock[k[seg] + 1] - clock[k[seg]])
     keep = np.all((points >= 0) & (points < box), axis=1)
     order = np.argsort(when[keep], kind="stable")
-    rgb = np.clip(np.round(255 * colors[drone[seg], k[seg]]), 0, 255).astype(np.uint8)
+    rgb = _rgb(colors[drone[seg], k[seg]])
     return _Pixels(
         when[keep][order],
         points[keep, 0].astype(np.intp)[order],
@@ -338,8 +346,72 @@ def _trail_pixels(
     )
 
 
-def _palette(colors: FloatArray) -> Image.Image:
-    """A P-mode image whose palette holds black, dark, the stamp and every light colour."""
+def _stamped(
+    frame: NDArray[np.uint8],
+    palette: NDArray[np.uint8],
+    index: Callable[[NDArray[np.uint8]], NDArray[np.uint8]] | None,
+    text: str,
+) -> Image.Image:
+    """The frame as an image (palette indices: P mode; RGB: as it is), ``text`` stamped on."""
+    if index is None:
+        image = Image.fromarray(frame)
+        fill: int | tuple[int, ...] = STAMP
+    else:
+        image = Image.frombytes("P", (frame.shape[1], frame.shape[0]), frame.tobytes())
+        image.putpalette(_flat(palette[:GIF_COLORS]))
+        fill = int(index(np.array([STAMP], dtype=np.uint8))[0])
+    draw = ImageDraw.Draw(image)
+    draw.fontmode = "1"  # no antialiasing: the frame keeps the palette's colours
+    draw.text((10, 10), text, fill=fill)
+    return image
+
+
+def _rgb(colors: FloatArray) -> NDArray[np.uint8]:
+    """Colours 0..1, shape (..., 3), as bytes 0..255."""
+    out: NDArray[np.uint8] = np.clip(np.round(255 * colors), 0, 255).astype(np.uint8)
+    return out
+
+
+def _packed(rgb: NDArray[np.integer[Any]]) -> NDArray[np.int64]:
+    """Colours (..., 3) as 24-bit integers (...,): sorted as the rows are."""
+    wide = rgb.astype(np.int64)
+    out: NDArray[np.int64] = (wide[..., 0] << 16) | (wide[..., 1] << 8) | wide[..., 2]
+    return out
+
+
+def _indexer(
+    palette: NDArray[np.uint8],
+) -> Callable[[NDArray[np.uint8]], NDArray[np.uint8]] | None:
+    """Colours (..., 3) -> their indices (...,) in ``palette`` (sorted rows holding them);
+    None when the palette is too large for a GIF."""
+    if palette.shape[0] > GIF_COLORS:
+        return None
+    packed = _packed(palette)
+
+    def index(rgb: NDArray[np.uint8]) -> NDArray[np.uint8]:
+        found: NDArray[np.uint8] = np.searchsorted(packed, _packed(rgb)).astype(np.uint8)
+        return found
+
+    return index
+
+
+def _flat(palette: NDArray[np.uint8]) -> list[int]:
+    """A palette (K, 3) as Pillow's list of 768 values."""
+    flat = np.zeros(768, dtype=np.uint8)
+    flat[: palette.size] = palette.ravel()
+    values: list[int] = flat.tolist()
+    return values
+
+
+def _palette_image(palette: NDArray[np.uint8]) -> Image.Image:
+    """A P-mode image with ``palette`` (K <= 256, 3), for :meth:`PIL.Image.Image.quantize`."""
+    image = Image.new("P", (1, 1))
+    image.putpalette(_flat(palette))
+    return image
+
+
+def _palette_colors(colors: FloatArray) -> NDArray[np.uint8]:
+    """Black, dark, the stamp and every light colour, shape (K, 3), rows sorted."""
     # unique colours as packed 24-bit integers (a 1-D unique: np.unique(axis=0) sorts rows
     # of the whole show's samples one by one, 4 s at 250 drones); same rows, same order.
     # Only the samples whose colour differs from the one before are rounded: the same
@@ -352,20 +424,17 @@ def _palette(colors: FloatArray) -> Image.Image:
     packed = np.unique((rgb[:, 0] << 16) | (rgb[:, 1] << 8) | rgb[:, 2])
     lights = np.column_stack([packed >> 16, (packed >> 8) & 255, packed & 255]).astype(float)
     fixed = np.array([(0, 0, 0), [round(255 * c) for c in DARK], STAMP], dtype=float)
-    every = np.unique(np.concatenate([fixed, lights]), axis=0)[:256].astype(np.uint8)
-    flat = np.zeros(768, dtype=np.uint8)
-    flat[: every.size] = every.ravel()
-    image = Image.new("P", (1, 1))
-    image.putpalette(flat.tolist())
-    return image
+    every: NDArray[np.uint8] = np.unique(np.concatenate([fixed, lights]), axis=0).astype(np.uint8)
+    return every
 
 
-def _paint_dots(frame: NDArray[np.uint8], uv: FloatArray, rgb: FloatArray) -> None:
-    """Each drone as a 3 px square at ``uv`` (D, 2) in its colour (D, 3) 0..1 (none if hidden)."""
+def _paint_dots(frame: NDArray[np.uint8], uv: FloatArray, values: NDArray[np.uint8]) -> None:
+    """Each drone as a 3 px square at ``uv`` (D, 2) in its colour (none if hidden): ``values``
+    (D, 3) bytes in an RGB frame, (D,) palette indices in an indexed one."""
     height, width = frame.shape[:2]
     seen = np.all(np.isfinite(uv), axis=1)
     centre = np.round(uv[seen]).astype(np.intp)
-    colour = np.clip(np.round(255 * rgb[seen]), 0, 255).astype(np.uint8)
+    colour = values[seen]
     for du in (-1, 0, 1):
         for dv in (-1, 0, 1):
             u, v = centre[:, 0] + du, centre[:, 1] + dv
