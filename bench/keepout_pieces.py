@@ -1,0 +1,88 @@
+"""Keep-out fields with their pieces planned at once against one after the other (issue 27 part 3).
+
+A field with holes is flown as a mission of hole-free pieces, each planned on its own; since
+session 35 ``skyquill cover`` plans them at once, one process per CPU (``--workers``, or a
+dask cluster with ``--scheduler``). This runs ``plan_tuned`` (as ``cover`` runs it: the default
+spiral and limits, 99 % coverage, a 5 m swath) on the 1.3 ha fields with two holes of
+``examples/coverage`` with the pieces here (``workers=1``) and at once (``workers=2``),
+alternated, and on the same outline without holes (the goal's reference: a field with holes
+within 2x and 5 s), one timed run each by default. Both placements must give the same flight
+(checked: duration and coverage equal).
+
+Run: ``.venv/bin/python bench/keepout_pieces.py [--runs N]`` ->
+``bench/results/keepout_pieces.json`` (about 2 minutes on two free cores). The machine has 2
+cores: at once gains only where the second core is free (record the load).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from shapely.geometry import Polygon
+
+from common import jsonable, machine_info, one_blas_thread
+from skyquill.coverage import DEFAULT_MIN_COVERAGE
+from skyquill.coverage.plan import CoverageOptions, CoveragePlan, plan_tuned
+from skyquill.coverage.regions import Region, load_region
+from skyquill.parallel import Where
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples" / "coverage"
+RESULTS = Path(__file__).parent / "results" / "keepout_pieces.json"
+FIELDS = ("holes_1_3ha", "heldout_holes_1_3ha")
+OPTIONS = CoverageOptions(width=5.0, time_limit=300.0)
+
+
+def _timed(region: Region, where: Where) -> tuple[float, CoveragePlan]:
+    start = time.perf_counter()
+    plan = plan_tuned(region, OPTIONS, DEFAULT_MIN_COVERAGE, where=where)
+    return time.perf_counter() - start, plan
+
+
+def field_case(name: str, runs: int) -> dict[str, Any]:
+    """One field: wall times here, at once and without holes, and the flights' equality."""
+    region = load_region(EXAMPLES / f"{name}.geojson")
+    here, together = [], []
+    for _ in range(runs):
+        t_here, plan_here = _timed(region, Where(workers=1))
+        t_together, plan_together = _timed(region, Where(workers=2))
+        here.append(t_here)
+        together.append(t_together)
+        assert plan_together.duration == plan_here.duration
+        assert plan_together.coverage == plan_here.coverage
+    t_open, plan_open = _timed(Polygon(region.exterior), Where(workers=1))
+    return {
+        "field": name,
+        "pieces": plan_here.summary()["pieces"],
+        "flight_s": plan_here.duration,
+        "coverage": plan_here.coverage,
+        "here_s": float(np.median(here)),
+        "at_once_s": float(np.median(together)),
+        "at_once_over_here": float(np.median(together) / np.median(here)),
+        "without_holes_s": t_open,
+        "without_holes_flight_s": plan_open.duration,
+        "at_once_over_without_holes": float(np.median(together) / t_open),
+        "goals": {"at_once_s <= 5": float(np.median(together)) <= 5.0,
+                  "at_once_over_without_holes <= 2": float(np.median(together)) <= 2 * t_open},
+    }  # fmt: skip
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--runs", type=int, default=1)
+    args = parser.parse_args()
+    with one_blas_thread():
+        cases = [field_case(name, args.runs) for name in FIELDS]
+    for case in cases:
+        print(json.dumps(case))
+    out = {"machine": machine_info(("numpy", "scipy", "highspy", "shapely")), "runs": args.runs,
+           "cases": cases}  # fmt: skip
+    RESULTS.write_text(json.dumps(jsonable(out), indent=2) + "\n")
+
+
+if __name__ == "__main__":
+    main()
