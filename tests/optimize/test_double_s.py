@@ -11,47 +11,15 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-import ruckig
 from hypothesis import assume, example, given, settings
 from hypothesis import strategies as st
-from ruckig import InputParameter, Ruckig, Trajectory
+from ruckig_reference import merged_phases, ruckig_move
 
 from skyquill.optimize.double_s import JERK_SIGNS, MIN_PHASE_S, cruise, rest_to_rest
 
 #: Relative tolerance on durations (of the move's total): the closed form and Ruckig agree
 #: to a few ulps; 1e-9 leaves room for neither to be exact.
 REL = 1e-9
-
-
-def _ruckig(length: float, v: float, a: float, j: float) -> Trajectory | None:
-    """A fresh one-degree-of-freedom Ruckig call, or None where Ruckig finds no profile.
-
-    (Ruckig 0.19 raises in its step 1 on some moves that reach the acceleration limit
-    exactly, ``L = 2 a^3 / j^2``, about one in ten.)
-    """
-    inp = InputParameter(1)
-    inp.target_position = [length]
-    inp.max_velocity, inp.max_acceleration, inp.max_jerk = [v], [a], [j]
-    out = Trajectory(1)
-    try:
-        Ruckig(1).calculate(inp, out)
-    except ruckig.RuckigError:
-        return None
-    return out
-
-
-def _phases(t: np.ndarray, jerk: np.ndarray, tol: float) -> list[list[float]]:
-    """Phases longer than ``tol`` as [duration, jerk], neighbours of one jerk merged: the
-    profile itself, whichever way it is split into phases."""
-    merged: list[list[float]] = []
-    for duration, j in zip(t.tolist(), jerk.tolist(), strict=True):
-        if duration <= tol:
-            continue
-        if merged and merged[-1][1] == j:
-            merged[-1][0] += duration
-        else:
-            merged.append([duration, j])
-    return merged
 
 
 def _states(t: np.ndarray, jerk: float, at: np.ndarray) -> np.ndarray:
@@ -78,16 +46,16 @@ def _states(t: np.ndarray, jerk: float, at: np.ndarray) -> np.ndarray:
     return out
 
 
-def _check_against_ruckig(length: float, v: float, a: float, j: float) -> None:
-    reference = _ruckig(length, v, a, j)
+def _check_againstruckig_move(length: float, v: float, a: float, j: float) -> None:
+    reference = ruckig_move(length, v, a, j)
     assume(reference is not None)
     assert reference is not None
     t = rest_to_rest(np.array([length]), v, a, j)[0]
     total = float(reference.duration)
     assert t.sum() == pytest.approx(total, rel=REL)
     profile = reference.profiles[0][0]
-    ours = _phases(t, JERK_SIGNS * j, REL * total)
-    theirs = _phases(np.array(profile.t), np.array(profile.j), REL * total)
+    ours = merged_phases(t, JERK_SIGNS * j, REL * total)
+    theirs = merged_phases(np.array(profile.t), np.array(profile.j), REL * total)
     assert [p[1] for p in ours] == [p[1] for p in theirs]
     np.testing.assert_allclose([p[0] for p in ours], [p[0] for p in theirs], atol=REL * total)
     # Densely sampled states: positions to the length, speeds and accelerations to their
@@ -112,7 +80,7 @@ _LIMITS = st.tuples(
 def test_rest_to_rest_is_ruckigs_profile(
     log_length: float, limits: tuple[float, float, float]
 ) -> None:
-    _check_against_ruckig(10.0**log_length, *limits)
+    _check_againstruckig_move(10.0**log_length, *limits)
 
 
 @settings(max_examples=200, deadline=None)
@@ -133,10 +101,10 @@ def test_rest_to_rest_is_ruckigs_profile_where_a_limit_is_just_reached(
     else:  # the shortest move reaching the speed limit
         ramp = v / a + a / j if v * j >= a * a else 2.0 * np.sqrt(v / j)
         length = v * ramp * (1.0 + nudge)
-    _check_against_ruckig(length, v, a, j)
+    _check_againstruckig_move(length, v, a, j)
 
 
-def test_jerk_only_moves_have_ruckigs_three_phases() -> None:
+def test_jerk_only_moves_have_ruckigs_threemerged_phases() -> None:
     # Too short to reach either limit: +j, -j for twice as long, +j (Ruckig's layout).
     t = rest_to_rest(np.array([1e-3]), 2.0, 3.0, 10.0)[0]
     t1 = (1e-3 / 20.0) ** (1 / 3)

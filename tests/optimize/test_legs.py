@@ -5,10 +5,10 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-import ruckig
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from ruckig import InputParameter, Ruckig, Trajectory
+from ruckig_reference import merged_phases, ruckig_move
 
 from skyquill.errors import InputError
 from skyquill.limits import vehicle_limits
@@ -160,32 +160,6 @@ def test_batched_legs_are_the_legs_timed_one_by_one(k: int, seed: int, per_axis:
         assert np.allclose(end, ends[i], atol=1e-9 * 40)
 
 
-def _ruckig_motion(length: float, v: float, a: float, j: float) -> Trajectory | None:
-    """A fresh one-leg Ruckig call, rest to rest, or None where Ruckig finds no profile
-    (it raises on some legs that reach the acceleration limit exactly)."""
-    inp = InputParameter(1)
-    inp.current_position, inp.target_position = [0.0], [length]
-    inp.max_velocity, inp.max_acceleration, inp.max_jerk = [v], [a], [j]
-    out = Trajectory(1)
-    try:
-        Ruckig(1).calculate(inp, out)
-    except ruckig.RuckigError:
-        return None
-    return out
-
-
-def _merged(t: np.ndarray, jerk: np.ndarray, tol: float) -> list[list[float]]:
-    """Phases longer than ``tol`` as [duration, jerk], neighbours of one jerk merged."""
-    merged: list[list[float]] = []
-    for duration, j in zip(t.tolist(), jerk.tolist(), strict=True):
-        if duration > tol:
-            if merged and merged[-1][1] == pytest.approx(j, rel=1e-12):
-                merged[-1][0] += duration
-            else:
-                merged.append([duration, j])
-    return merged
-
-
 def _assert_legs_are_ruckigs(
     starts: np.ndarray, ends: np.ndarray, lims: LegLimits | list[LegLimits]
 ) -> None:
@@ -202,7 +176,7 @@ def _assert_legs_are_ruckigs(
         length = float(np.linalg.norm(end - start))
         u = (end - start) / length
         v, a, j = lim.along(u)
-        ref = _ruckig_motion(length, v, a, j)
+        ref = ruckig_move(length, v, a, j)
         if ref is None:
             continue
         total = float(ref.duration)
@@ -210,8 +184,8 @@ def _assert_legs_are_ruckigs(
         mine = owner == i
         jerks = legs.coeffs[mine, 3] @ u * 6.0
         profile = ref.profiles[0][0]
-        ours = _merged(legs.durations[mine], jerks, 1e-9 * total)
-        theirs = _merged(np.array(profile.t), np.array(profile.j), 1e-9 * total)
+        ours = merged_phases(legs.durations[mine], jerks, 1e-9 * total)
+        theirs = merged_phases(np.array(profile.t), np.array(profile.j), 1e-9 * total)
         assert [p[1] for p in ours] == pytest.approx([p[1] for p in theirs], rel=1e-12)
         np.testing.assert_allclose(
             [p[0] for p in ours], [p[0] for p in theirs], rtol=0, atol=1e-9 * total
@@ -357,7 +331,7 @@ def test_a_leg_that_reaches_the_acceleration_limit_exactly_is_timed() -> None:
     # form is the jerk-only profile, at a then, for 2 a / j.
     v, a, j = 2.0, 1.3, 10.4
     length = 2.0 * a**3 / j**2
-    assert _ruckig_motion(length, v, a, j) is None
+    assert ruckig_move(length, v, a, j) is None
     flown = stop_and_go(np.array([[0.0, 0.0], [length, 0.0]]), LegLimits(v, a, j))
     assert flown.trajectory.duration == pytest.approx(4.0 * a / j, rel=1e-9)
     assert flown.trajectory.duration == pytest.approx(_rest_to_rest(length, v, a, j), rel=1e-9)
