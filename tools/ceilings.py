@@ -43,7 +43,6 @@ def rows() -> list[tuple[str, str, str]]:
         fly_cmd,
         main,
         paint_cmd,
-        show_cmd,
         write_cmd,
     )
     from skyquill.coverage import plan as coverage_plan
@@ -98,8 +97,8 @@ def rows() -> list[tuple[str, str, str]]:
          f"before any path is built); `--altitude` {_n(alt_lo)} (excluded) to {_n(alt_hi)} m; "
          f"`--origin-alt` {_n(origin_lo)} to {_n(origin_hi)} m; `--delta` <= "
          f"{_n(cover_cmd.DELTA_RANGE_M[1])} m; `--time-limit` <= "
-         f"{_n(cover_cmd.TIME_LIMIT_RANGE_S[1])} s",
-         "coverage.plan.MAX_REGION_SIZE_M, coverage.regions, cli.cover_cmd"),
+         f"{_n(cover_cmd.TIME_LIMIT_RANGE_S[1])} s; `--workers` <= {_n(main.MAX_WORKERS)}",
+         "coverage.plan.MAX_REGION_SIZE_M, coverage.regions, cli.cover_cmd, cli.main.MAX_WORKERS"),
         ("`paint`", lambda: f"{_n(dots.MAX_DOTS)} dots (`--dots` too); `--width` <= "
          f"{_n(paint_cmd.MAX_WIDTH_M)} m; pictures <= "
          f"{_n(dots.MAX_IMAGE_PIXELS / 1e6)} Mpx (from the header, before decoding) and "
@@ -107,8 +106,8 @@ def rows() -> list[tuple[str, str, str]]:
         ("`show` scripts", lambda: f"{_n(script.MAX_DRONES)} drones, {_n(script.MAX_SCENES)} "
          f"scenes, holding <= {_n(script.MAX_HOLDING_S)} s, extent <= "
          f"{_n(script.MAX_EXTENT_M)} m, altitude <= {_n(script.MAX_ALTITUDE_M)} m, rate <= "
-         f"{_n(script.MAX_RATE_HZ)} Hz, `--workers` <= {_n(show_cmd.MAX_WORKERS)}",
-         "show.script, cli.show_cmd.MAX_WORKERS"),
+         f"{_n(script.MAX_RATE_HZ)} Hz, `--workers` <= {_n(main.MAX_WORKERS)}",
+         "show.script, cli.main.MAX_WORKERS"),
         ("`check`", lambda: f"{_n(check_cmd.MAX_DRONES)} drones; "
          f"{_n(separation.MAX_INTERVALS)} intervals of close approach",
          "cli.check_cmd.MAX_DRONES, show.separation.MAX_INTERVALS"),

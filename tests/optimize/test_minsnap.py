@@ -12,7 +12,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from skyquill.errors import InputError
@@ -86,6 +86,17 @@ def _piece_derivative(traj: PiecewisePolynomial, piece: int, tau: float, r: int)
     return (factors * tau ** (powers - r)) @ c[r:]
 
 
+def _jump_tolerance(r: int, order: int) -> float:
+    """Largest jump of derivative ``r`` at a waypoint, relative to the derivatives' size.
+
+    The highest continuous one (``2 order - 2``: the sixth for min-snap) carries the banded
+    solve's round-off amplified most: up to 1.8e-6 of the size in 600 random draws of
+    degree-7 chains (the lower ones stay below 1e-7). It is the solve's, not the test's
+    evaluation: relative to the sum of the evaluated terms' magnitudes it is the same.
+    """
+    return 1e-5 if r == 2 * order - 2 else 1e-7
+
+
 @settings(max_examples=40, deadline=None)
 @given(
     st.integers(2, 30),
@@ -93,6 +104,7 @@ def _piece_derivative(traj: PiecewisePolynomial, piece: int, tau: float, r: int)
     st.sampled_from([2, 3, 4]),
     st.floats(1e-3, 1e3),
 )
+@example(16, 1, 4, 1.0)  # the sixth derivative's jump at waypoint 14: 1.0004e-7 of its size
 def test_optimality_conditions_hold(n: int, seed: int, order: int, time_scale: float) -> None:
     w, t = _waypoints(n, seed)
     t = t * time_scale
@@ -116,7 +128,8 @@ def test_optimality_conditions_hold(n: int, seed: int, order: int, time_scale: f
         for r in range(2 * order - 1):
             left = _piece_derivative(traj, i - 1, T[i - 1], r)
             right = _piece_derivative(traj, i, 0.0, r)
-            assert np.abs(left - right).max() * time_scale**r <= 1e-7 * size, (r, i)
+            jump = np.abs(left - right).max() * time_scale**r
+            assert jump <= _jump_tolerance(r, order) * size, (r, i)
 
 
 def _hermite_pieces(derivs: np.ndarray, T: np.ndarray) -> PiecewisePolynomial:
