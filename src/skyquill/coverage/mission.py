@@ -242,7 +242,11 @@ def _planned(
         return here
     deadline.check(f"{len(pieces)} pieces, planned at once in {where.describe()}")
     alone = functools.partial(_planned_alone, plan_piece=plan_piece, budget=deadline.remaining())
-    return [_Piece(*flight) for flight in where.map(alone, pieces)]
+    # The largest first (their planning time grows with the area): the workers finish
+    # together instead of one waiting on a large piece started last.
+    order = sorted(range(len(pieces)), key=lambda k: -pieces[k].area)
+    flights = dict(zip(order, where.map(alone, [pieces[k] for k in order]), strict=True))
+    return [_Piece(*flights[k]) for k in range(len(pieces))]
 
 
 def _planned_alone(
