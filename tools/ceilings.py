@@ -70,8 +70,9 @@ def rows() -> list[tuple[str, str, str]]:
         ("sample rate of written files (`--rate`)", lambda: f"{_n(lo)} to {_n(hi)} Hz",
          "cli.main.SAMPLE_RATE_HZ"),
         ("samples written (`--rate` x duration)", lambda: f"{_n(table.MAX_ROWS)} rows in a "
-         f"`trajectory.csv` (what its readers take); {_n(base.MAX_SAMPLES)} samples in any one "
-         "evaluation", "io.points.check_rows_written, trajectory.base.MAX_SAMPLES"),
+         f"`trajectory.csv` (what its readers take; `paint` refuses while it simulates, once the "
+         f"flight is sure to be longer); {_n(base.MAX_SAMPLES)} samples in any one evaluation",
+         "io.points.check_rows_written, painting.flight.FlightClock, trajectory.base.MAX_SAMPLES"),
         ("`fly` simulation", lambda: f"{_n(bounds.MAX_SIM_STEPS)} steps; rate "
          f"{_n(bounds.MIN_RATE_HZ)} to {_n(bounds.MAX_RATE_HZ)} Hz; wind and gusts "
          f"<= {_n(fly_cmd.MAX_WIND_MPS)} m/s", "sim.bounds, cli.fly_cmd.MAX_WIND_MPS"),

@@ -119,9 +119,10 @@ def paint(
 
     from skyquill.io.outputs import staged_output
     from skyquill.io.plan_dir import write_plan
+    from skyquill.io.points import check_rows_written
     from skyquill.io.trajectory_json import PlannedTrajectory
     from skyquill.painting.dots import MAX_DOTS, drawing_span
-    from skyquill.painting.flight import painting_flight
+    from skyquill.painting.flight import FlightClock, painting_flight
     from skyquill.painting.mission import MissionConfig, check_on_wall, run_mission
     from skyquill.painting.wall import Placement, Wall, parse_angles
     from skyquill.painting.wall_file import read_wall
@@ -185,6 +186,10 @@ def paint(
                 ),
                 rng=np.random.default_rng(seed),
                 progress=lambda done, total: bar.update(task, completed=done, total=total),
+                # trajectory.csv too long for its readers: refused as soon as it is sure
+                flown=FlightClock(
+                    lambda at_least_s: check_rows_written(at_least_s, rate, "--rate", at_least=True)
+                ).add,
             )
         inputs = [p for p in (dots_csv, image, wall) if p is not None]
         with (

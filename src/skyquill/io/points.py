@@ -63,7 +63,9 @@ def trajectory_table(traj: Trajectory, rate: float) -> FloatArray:
     return np.column_stack([s.t, as3(s.p), as3(s.v), as3(s.a), as3(s.j)])
 
 
-def check_rows_written(duration: float, rate: float, argument: str = "rate") -> None:
+def check_rows_written(
+    duration: float, rate: float, argument: str = "rate", *, at_least: bool = False
+) -> None:
     """Refuse a ``trajectory.csv`` of more rows than its readers take, before sampling.
 
     Parameters
@@ -74,11 +76,15 @@ def check_rows_written(duration: float, rate: float, argument: str = "rate") -> 
         Sample rate, Hz.
     argument
         What the refusal names: where the rate came from.
+    at_least
+        ``duration`` is a lower bound of a flight still being planned (said so).
     """
     rows = math.floor(duration * rate + 1e-9) + 2  # the samples, and the end when off the grid
     if rows > MAX_ROWS:
+        more = "at least " if at_least else ""
+        flight = f"a flight of {more}{duration:.6g} s" if at_least else f"a {duration:.6g} s flight"
         raise InputError(
-            f"{argument}: got {rate:g} Hz over a {duration:.6g} s flight ({rows:,} rows), "
+            f"{argument}: got {rate:g} Hz over {flight} ({more}{rows:,} rows), "
             f"expected at most {MAX_ROWS:,} rows in trajectory.csv, the most it is read back "
             "with (a lower rate)"
         )

@@ -43,7 +43,7 @@ painted, nothing is measured, the drone pushes to the end of its travel).
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
@@ -622,6 +622,22 @@ def _target_w(dots: FloatArray, wall: Wall, update: str) -> FloatArray:
     return np.column_stack([foot, z])
 
 
+def _told(
+    progress: Callable[[int, int], None] | None,
+    flown: Callable[[FloatArray, Sequence[str]], None] | None,
+    flight: _Flight,
+    done: tuple[int, int],
+    counted: int,
+) -> int:
+    """After a dot: ``progress`` told the dots ``done`` (of all), ``flown`` the legs recorded
+    since the first ``counted``; the legs counted now."""
+    if progress is not None:
+        progress(*done)
+    if flown is not None:
+        flown(np.array(flight.path_w[counted:]), flight.leg_kinds[counted:])
+    return len(flight.leg_kinds)
+
+
 def run_mission(
     dots: FloatArray,
     *,
@@ -635,6 +651,7 @@ def run_mission(
     config: MissionConfig | None = None,
     rng: np.random.Generator,
     progress: Callable[[int, int], None] | None = None,
+    flown: Callable[[FloatArray, Sequence[str]], None] | None = None,
 ) -> MissionResult:
     """Paint ``dots`` on ``wall`` from a drone placed at ``truth``; estimate on line.
 
@@ -665,6 +682,10 @@ def run_mission(
         All randomness (hover error, IMU noise, drift, faults).
     progress
         Called as ``progress(done, total)`` after each dot.
+    flown
+        Called after each dot with the path points recorded since the last call (the
+        first one repeated: (K + 1, 3), m) and their legs' kinds (K,); may raise to stop
+        the mission (e.g. :class:`~skyquill.painting.flight.FlightClock`).
     """
     dots = check_dots("dots", dots)
     check_on_wall(dots, wall)
@@ -702,6 +723,7 @@ def run_mission(
     queue += [(int(i), np.array([dots[i, 0], 0.0, dots[i, 1]])) for i in route]
     if cfg.probe and isinstance(est, RigidEstimator) and len(dots) > 1:
         queue.insert(0, (-1, _probe_dot(dots, int(route[0]))))
+    counted = 0  # legs handed to ``flown``
     for done, (i, ref_w) in enumerate(queue):
         est.tick(flight.landings, flight.t_air)
         plan, wait = _planned(est, ref_w, cfg)
@@ -721,8 +743,7 @@ def run_mission(
         _record(
             hist, t=flight.t, dot=i, est=est, yaw=plan.yaw_rad, measured=measured, landed=landed
         )
-        if progress is not None:
-            progress(done + 1, len(queue))
+        counted = _told(progress, flown, flight, (done + 1, len(queue)), counted)
     flight.transit(np.zeros(3))  # home for good
     errors = _errors(painted, target, update)
     aim_errors = _errors(aimed, target, update)
