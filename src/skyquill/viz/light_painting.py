@@ -271,6 +271,7 @@ def animate_show(
     size = (camera.height_px, camera.width_px) + (() if index is not None else (3,))
     built = np.zeros(size, dtype=np.uint8)  # trails that never fade (trail >= the show)
     shown = 0
+    stamp = _Stamp.of(palette, index)
     images = []
     for t in times:
         k = min(int(np.searchsorted(clock, t)), clock.size - 1)
@@ -284,7 +285,7 @@ def animate_show(
             pixels.paint(frame, int(np.searchsorted(pixels.t, t - trail)), end)
         dots = _rgb(np.where(lit[:, k, None], colors[:, k], DARK))
         _paint_dots(frame, uv[:, k], dots if index is None else index(dots))
-        images.append(_stamped(frame, palette, index, f"t = {t:5.1f} s"))
+        images.append(stamp.on(frame, f"t = {t:5.1f} s"))
     if index is None:  # more colours than a GIF holds: each pixel to its nearest
         quantized = _palette_image(palette[:GIF_COLORS])
         images = [im.quantize(palette=quantized, dither=Image.Dither.NONE) for im in images]
@@ -346,24 +347,37 @@ def _trail_pixels(
     )
 
 
-def _stamped(
-    frame: NDArray[np.uint8],
-    palette: NDArray[np.uint8],
-    index: Callable[[NDArray[np.uint8]], NDArray[np.uint8]] | None,
-    text: str,
-) -> Image.Image:
-    """The frame as an image (palette indices: P mode; RGB: as it is), ``text`` stamped on."""
-    if index is None:
-        image = Image.fromarray(frame)
-        fill: int | tuple[int, ...] = STAMP
-    else:
-        image = Image.frombytes("P", (frame.shape[1], frame.shape[0]), frame.tobytes())
-        image.putpalette(_flat(palette[:GIF_COLORS]))
-        fill = int(index(np.array([STAMP], dtype=np.uint8))[0])
-    draw = ImageDraw.Draw(image)
-    draw.fontmode = "1"  # no antialiasing: the frame keeps the palette's colours
-    draw.text((10, 10), text, fill=fill)
-    return image
+@dataclass(frozen=True)
+class _Stamp:
+    """How a frame becomes an image with its time stamped on: indexed frames in P mode with
+    the show's palette (``palette``: Pillow's 768 values), RGB frames as they are (None);
+    ``fill``: the stamp's palette index or colour. Made once for every frame."""
+
+    palette: list[int] | None
+    fill: int | tuple[int, ...]
+
+    @classmethod
+    def of(
+        cls,
+        palette: NDArray[np.uint8],
+        index: Callable[[NDArray[np.uint8]], NDArray[np.uint8]] | None,
+    ) -> _Stamp:
+        """For frames in ``palette``'s indices (``index``) or, without ``index``, in RGB."""
+        if index is None:
+            return cls(None, STAMP)
+        return cls(_flat(palette), int(index(np.array([STAMP], dtype=np.uint8))[0]))
+
+    def on(self, frame: NDArray[np.uint8], text: str) -> Image.Image:
+        """``frame`` as an image, ``text`` stamped on."""
+        if self.palette is None:
+            image = Image.fromarray(frame)
+        else:
+            image = Image.frombytes("P", (frame.shape[1], frame.shape[0]), frame.tobytes())
+            image.putpalette(self.palette)
+        draw = ImageDraw.Draw(image)
+        draw.fontmode = "1"  # no antialiasing: the frame keeps the palette's colours
+        draw.text((10, 10), text, fill=self.fill)
+        return image
 
 
 def _rgb(colors: FloatArray) -> NDArray[np.uint8]:
@@ -420,8 +434,7 @@ def _palette_colors(colors: FloatArray) -> NDArray[np.uint8]:
     every_sample = colors.reshape(-1, 3)
     changed = np.ones(every_sample.shape[0], dtype=bool)
     changed[1:] = (every_sample[1:] != every_sample[:-1]).any(axis=1)
-    rgb = np.clip(np.round(255 * every_sample[changed]), 0, 255).astype(np.int64)
-    packed = np.unique((rgb[:, 0] << 16) | (rgb[:, 1] << 8) | rgb[:, 2])
+    packed = np.unique(_packed(_rgb(every_sample[changed])))
     lights = np.column_stack([packed >> 16, (packed >> 8) & 255, packed & 255]).astype(float)
     fixed = np.array([(0, 0, 0), [round(255 * c) for c in DARK], STAMP], dtype=float)
     every: NDArray[np.uint8] = np.unique(np.concatenate([fixed, lights]), axis=0).astype(np.uint8)
