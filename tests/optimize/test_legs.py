@@ -360,14 +360,15 @@ def test_a_chain_copies_its_phase_durations_from_the_longest_chain_so_far() -> N
     # One norm limit: each chain's breaks start as 0 then the shared profile's durations once
     # a leg (the cruise 0, filled in per leg), copied from an array kept for the longest
     # chain so far, grown as longer ones come: a new array each time, whatever came before.
+    # Chains longer than KEPT_LEGS tile their own.
     from skyquill.optimize.double_s import cruise
-    from skyquill.optimize.legs import _Shared
+    from skyquill.optimize.legs import KEPT_LEGS, _Shared
 
     profile = cruise(2.0, 3.0, 10.0)
     assert profile is not None
     shared = _Shared(profile, 3)
     handed = []
-    for k in (3, 1, 10, 4, 25, 11, 60, 2):
+    for k in (3, 1, 10, 4, 25, 11, 60, 2, KEPT_LEGS, KEPT_LEGS + 1, 1000, KEPT_LEGS - 1, 7):
         breaks = shared.breaks(k)
         np.testing.assert_array_equal(breaks, np.r_[0.0, np.tile(profile.durations, k)])
         assert breaks.flags.writeable and breaks.flags.c_contiguous

@@ -301,23 +301,31 @@ class _Shared:
         self.profile = profile
         self.mixer = np.asarray(np.kron(profile.mix.T, np.eye(dim)), dtype=np.float64)
         self.mixer.setflags(write=False)
-        self._tiled = np.zeros(1)
+        self._kept = np.zeros(1)
 
     def breaks(self, k: int) -> FloatArray:
         """0, then the profile's ``n`` phase durations ``k`` times over, (k n + 1,), s: a new
-        array, to be filled in with each leg's cruise (0 here) and summed in place.
+        array, for the caller to fill in each leg's cruise (0 here) and sum in place.
 
-        Copied from one kept for the longest chain so far (grown by doubling, never
-        shrunk): one numpy call instead of the five that fill it in.
+        Up to :data:`KEPT_LEGS` legs, copied from an array kept for the longest chain so far
+        (grown by doubling): one numpy call instead of the five that fill it in, a tenth of
+        a chain of ten legs. Longer chains tile their own (the copy saves nothing there).
         """
-        size = k * self.profile.durations.size + 1
-        tiled = self._tiled
-        if tiled.size < size:
-            legs = max(k, 2 * (tiled.size - 1) // self.profile.durations.size)
-            tiled = np.concatenate(([0.0], np.tile(self.profile.durations, legs)))
-            tiled.setflags(write=False)
-            self._tiled = tiled  # (one reference replaced: safe between threads)
-        return tiled[:size].copy()
+        n = self.profile.durations.size
+        if k > KEPT_LEGS:
+            return np.concatenate(([0.0], np.tile(self.profile.durations, k)))
+        kept = self._kept
+        if kept.size < k * n + 1:
+            legs = min(KEPT_LEGS, max(k, 2 * (kept.size - 1) // n))
+            kept = np.concatenate(([0.0], np.tile(self.profile.durations, legs)))
+            kept.setflags(write=False)
+            self._kept = kept  # (one reference replaced: safe between threads)
+        return kept[: k * n + 1].copy()
+
+
+#: The longest chain whose phase durations are copied from an array kept per shared profile
+#: (:meth:`_Shared.breaks`): at most 1,793 numbers, 14 kB, for each of the 256 kept.
+KEPT_LEGS = 256
 
 
 @functools.lru_cache(maxsize=256)
