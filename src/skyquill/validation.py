@@ -79,8 +79,8 @@ def largest_magnitude(name: str, arr: FloatArray) -> float:
     checked finite as :func:`as_array` checks them, with the same refusal.
 
     For callers that need the array's scale anyway: after ``as_array(..., finite=False)``,
-    one reduction does both (on a chain of ten legs the second pass cost a tenth of
-    :func:`~skyquill.optimize.legs.stop_and_go`).
+    one reduction does both (the second pass cost about 1.4 us, 7 % of
+    :func:`~skyquill.optimize.legs.stop_and_go` on a chain of ten legs).
 
     Raises
     ------
