@@ -309,7 +309,7 @@ class _Shared:
 
         Up to :data:`KEPT_LEGS` legs, copied from an array kept for the longest chain so far
         (grown by doubling): one numpy call instead of the five that fill it in (about 1 us
-        of the 15-20 a chain of ten legs takes). Longer chains tile their own (the copy
+        of the 15-20 us a chain of ten legs takes). Longer chains tile their own (the copy
         saves nothing there).
         """
         n = self.profile.durations.size
