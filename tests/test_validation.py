@@ -39,3 +39,18 @@ def test_known_keys_names_the_table_and_the_unknown_key() -> None:
         known_keys({"a": 1, "c": 2}, "[t]", ("a", "b"))
     with pytest.raises(InputError, match=r"^\[t\]: got list, expected a table$"):
         known_keys([1], "[t]", ("a",))
+
+
+def test_largest_magnitude_checks_finite_as_as_array_does() -> None:
+    from skyquill.validation import as_array, largest_magnitude
+
+    assert largest_magnitude("x", np.array([[1.0, -3.0], [2.0, 0.5]])) == 3.0
+    assert largest_magnitude("x", np.zeros((2, 0))) == 0.0  # no entries: no scale
+    for bad in ([[np.nan, 0.0], [1.0, 2.0]], [[1.0, -np.inf], [np.inf, np.nan]]):
+        with pytest.raises(InputError) as checked:
+            as_array("x", bad)
+        unchecked = as_array("x", bad, finite=False)  # converted, not checked
+        with pytest.raises(InputError) as here:
+            largest_magnitude("x", unchecked)
+        assert str(here.value) == str(checked.value)
+        assert str(here.value).startswith(f"x: got {np.sum(~np.isfinite(unchecked))} NaN or")

@@ -354,3 +354,103 @@ def test_a_leg_too_long_is_refused_alike_whether_or_not_the_legs_share_a_limit(
         stop_and_go(path, [lim, lim])
     with pytest.raises(InputError, match=r"leg 1, 1499 m long"):
         legs_pieces(path[:-1], path[1:], lim)
+
+
+def test_a_chain_copies_its_phase_durations_from_the_longest_chain_so_far() -> None:
+    # One norm limit: each chain's breaks start as 0 then the shared profile's durations once
+    # a leg (the cruise 0, filled in per leg), copied from an array kept for the longest
+    # chain so far, grown as longer ones come: a new array each time, whatever came before.
+    # Chains longer than KEPT_LEGS tile their own.
+    from skyquill.optimize.double_s import cruise
+    from skyquill.optimize.legs import KEPT_LEGS, _Shared
+
+    profile = cruise(2.0, 3.0, 10.0)
+    assert profile is not None
+    shared = _Shared(profile, 3)
+    handed = []
+    for k in (3, 1, 10, 4, 25, 11, 60, 2, KEPT_LEGS, KEPT_LEGS + 1, 1000, KEPT_LEGS - 1, 7):
+        breaks = shared.breaks(k)
+        np.testing.assert_array_equal(breaks, np.r_[0.0, np.tile(profile.durations, k)])
+        assert breaks.flags.writeable and breaks.flags.c_contiguous
+        assert not any(np.shares_memory(breaks, other) for other in handed)
+        handed.append(breaks)
+        breaks[:] = -1.0  # its owner sums it in place: the next chain is not affected
+
+
+# A chain's legs: cruising, too short to cruise, repeated points, and on the boundaries of
+# the double-S profile's cases (just cruising or not, just reaching the acceleration limit).
+_LEG_KINDS = st.sampled_from(["long", "short", "repeat", "cruise edge", "acceleration edge"])
+_CHAIN = st.tuples(st.lists(_LEG_KINDS, min_size=1, max_size=25), st.integers(0, 2**32 - 1))
+
+
+def _chain_points(kinds: list[str], seed: int, limits: tuple[float, float, float]) -> np.ndarray:
+    """Waypoints (K + 1, 3) of legs of ``kinds`` in random directions under norm ``limits``."""
+    v, a, j = limits
+    t1 = min(a / j, np.sqrt(v / j))
+    cruising_from = v * (2.0 * t1 + max(v / (j * t1) - t1, 0.0))  # vmax times the ramp
+    rng = np.random.default_rng(seed)
+    lengths = []
+    for kind in kinds:
+        if kind == "long":
+            lengths.append(cruising_from * rng.uniform(1.01, 20.0))
+        elif kind == "short":
+            lengths.append(cruising_from * 10.0 ** rng.uniform(-7.0, -0.01))
+        elif kind == "repeat":
+            lengths.append(0.0)
+        elif kind == "cruise edge":
+            lengths.append(cruising_from * (1.0 + rng.choice([-1e-9, -1e-12, 0.0, 1e-12, 1e-9])))
+        else:
+            lengths.append(2.0 * a**3 / j**2 * (1.0 + rng.choice([-1e-9, 0.0, 1e-9])))
+    directions = rng.normal(size=(len(kinds), 3))
+    directions /= np.linalg.norm(directions, axis=1)[:, None]
+    start = rng.uniform(-10.0, 10.0, 3)
+    steps = np.asarray(lengths)[:, None] * directions
+    return np.vstack([start, start + np.cumsum(steps, axis=0)])
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    st.lists(_CHAIN, min_size=1, max_size=4),
+    st.tuples(st.floats(0.1, 10.0), st.floats(0.1, 10.0), st.floats(0.5, 100.0)),
+)
+def test_chains_under_one_limit_are_their_legs_timed_one_by_one(
+    chains: list[tuple[list[str], int]], limits: tuple[float, float, float]
+) -> None:
+    # Chains of any lengths in turn under one LegLimits (the legs that cruise share one
+    # profile, its phase durations kept for the longest chain so far) against the same
+    # chains with a LegLimits per leg (every leg its own closed-form profile), and every
+    # leg's duration against a fresh Ruckig call.
+    lim = LegLimits(*limits)
+    for kinds, seed in chains:
+        pts = _chain_points(kinds, seed, limits)
+        if all(kind == "repeat" for kind in kinds):
+            with pytest.raises(InputError, match="coincident"):
+                stop_and_go(pts, lim)
+            continue
+        shared, apart = stop_and_go(pts, lim), stop_and_go(pts, [lim] * len(kinds))
+        np.testing.assert_allclose(shared.arrivals, apart.arrivals, rtol=1e-12, atol=1e-12)
+        traj = shared.trajectory
+        PiecewisePolynomial(traj.breaks, traj.coeffs)  # breaks increase, coefficients finite
+        scale = max(1.0, float(np.abs(pts).max()))
+        t = np.linspace(0.0, traj.duration, 2001)
+        for n, size in enumerate((scale, *limits)):
+            np.testing.assert_allclose(
+                traj.evaluate(t, n), apart.trajectory.evaluate(t, n), rtol=0, atol=1e-9 * size
+            )
+        np.testing.assert_allclose(traj.evaluate(shared.arrivals), pts, atol=1e-12 * scale)
+        np.testing.assert_allclose(traj.evaluate(shared.arrivals, 1), 0.0, atol=1e-9 * limits[0])
+        lengths = np.linalg.norm(np.diff(pts, axis=0), axis=1)
+        for length, took in zip(lengths, np.diff(shared.arrivals), strict=True):
+            reference = ruckig_move(float(length), *limits) if took > 0.0 else None
+            if reference is not None:
+                assert took == pytest.approx(float(reference.duration), rel=1e-9)
+
+
+def test_waypoints_without_axes_or_finite_coordinates_are_refused_in_plain_words() -> None:
+    lim = LegLimits(1.0, 1.0, 1.0)
+    with pytest.raises(InputError, match=r"^waypoints: got coincident points"):
+        stop_and_go(np.zeros((2, 0)), lim)  # (numpy's bare ValueError on an empty maximum)
+    with pytest.raises(InputError, match=r"^waypoints: got 2 NaN or infinite value"):
+        stop_and_go([[np.nan, 0.0], [1.0, np.inf]], lim)
+    with pytest.raises(InputError, match=r"^waypoints: got 1 NaN or infinite value"):
+        stop_and_go([[np.nan, 0.0]], lim)  # (before the count of points, as before)

@@ -30,7 +30,7 @@ from ruckig import InputParameter, Profile, Result, Ruckig, Synchronization, Tra
 from skyquill.errors import InputError, SolverError
 from skyquill.optimize.double_s import JERK_SIGNS, MIN_PHASE_S, Cruise, cruise, rest_to_rest
 from skyquill.trajectory import PiecewisePolynomial
-from skyquill.validation import FloatArray, as_array, as_float
+from skyquill.validation import FloatArray, as_array, as_float, largest_magnitude
 
 #: Legs shorter than this (relative to the coordinates' scale) are dropped as repeats.
 REPEAT_TOLERANCE = 1e-9
@@ -263,41 +263,78 @@ def _cruising(
         return None
     vmax = limits.vmax
     dim = delta.shape[1]
-    mixing = _mixing(vmax, float(limits.amax), float(limits.jmax), dim)  # (norms: numbers)
-    if mixing is None:
+    shared = _shared(vmax, float(limits.amax), float(limits.jmax), dim)  # (norms: numbers)
+    if shared is None:
         return None
-    profile, mixer = mixing
+    profile = shared.profile
     # (The same float operations as on every leg below: the shortest cruises least.)
     if shortest is not None and shortest / vmax - profile.ramp_s <= MIN_PHASE_S:
         return None
     k, n = lengths.size, profile.durations.size
-    breaks = np.empty(k * n + 1)
-    breaks[0] = 0.0
-    durations = breaks[1:].reshape(k, n)
-    durations[:] = profile.durations
-    cruise_s = durations[:, profile.at_cruise]
+    breaks = shared.breaks(k)
+    cruise_s = breaks[1 + profile.at_cruise :: n]
     np.divide(lengths, vmax, out=cruise_s)
     cruise_s -= profile.ramp_s
     # Each leg's unit direction, start and end, (K, 3 d), mixed into every phase's
     # coefficients, (K, 4 n d), by one matrix product.
     basis = np.concatenate((delta / lengths[:, None], starts, ends), axis=1)
-    coeffs = np.dot(basis, mixer)  # (the matmul operator's dispatch costs more)
+    coeffs = np.dot(basis, shared.mixer)  # (the matmul operator's dispatch costs more)
     return _Cruising(
         breaks, coeffs.reshape(k * n, 4, dim), n, profile.at_cruise, limits, profile.ramp_s
     )
 
 
+class _Shared:
+    """What every chain of legs under one norm limit in ``dim`` axes reuses (:func:`_shared`).
+
+    Attributes
+    ----------
+    profile
+        :func:`double_s.cruise` of the limits.
+    mixer
+        Its :attr:`~double_s.Cruise.mix` for legs in ``dim`` axes: ``kron(mix.T, eye(dim))``,
+        (3 dim, 4 n dim), so that a leg's direction, start and end in a row (3 dim,) times it
+        are its phases' coefficients (4 n dim,).
+    """
+
+    def __init__(self, profile: Cruise, dim: int) -> None:
+        self.profile = profile
+        self.mixer = np.asarray(np.kron(profile.mix.T, np.eye(dim)), dtype=np.float64)
+        self.mixer.setflags(write=False)
+        self._kept = np.zeros(1)
+
+    def breaks(self, k: int) -> FloatArray:
+        """0, then the profile's ``n`` phase durations ``k`` times over, (k n + 1,), s: a new
+        array, for the caller to fill in each leg's cruise (0 here) and sum in place.
+
+        Up to :data:`KEPT_LEGS` legs, copied from an array kept for the longest chain so far
+        (grown by doubling): one numpy call instead of the five that fill it in (about 1 us
+        of the 15-20 us a chain of ten legs takes). Longer chains tile their own (the copy
+        saves nothing there).
+        """
+        n = self.profile.durations.size
+        if k > KEPT_LEGS:
+            return np.concatenate(([0.0], np.tile(self.profile.durations, k)))
+        kept = self._kept
+        if kept.size < k * n + 1:
+            legs = min(KEPT_LEGS, max(k, 2 * (kept.size - 1) // n))
+            kept = np.concatenate(([0.0], np.tile(self.profile.durations, legs)))
+            kept.setflags(write=False)
+            self._kept = kept  # (one reference replaced: safe between threads)
+        return kept[: k * n + 1].copy()
+
+
+#: The longest chain whose phase durations are copied from an array kept per shared profile
+#: (:meth:`_Shared.breaks`): at most 1,793 numbers, 14 kB, for each of the 256 kept.
+KEPT_LEGS = 256
+
+
 @functools.lru_cache(maxsize=256)
-def _mixing(vmax: float, amax: float, jmax: float, dim: int) -> tuple[Cruise, FloatArray] | None:
-    """:func:`double_s.cruise` of the limits, and its :attr:`~double_s.Cruise.mix` for legs
-    in ``dim`` axes: ``kron(mix.T, eye(dim))``, (3 dim, 4 n dim), so that a leg's direction,
-    start and end in a row (3 dim,) times it are its phases' coefficients (4 n dim,)."""
+def _shared(vmax: float, amax: float, jmax: float, dim: int) -> _Shared | None:
+    """The :class:`_Shared` profile of the limits (m/s, m/s^2, m/s^3) for legs in ``dim`` axes,
+    or None where :func:`double_s.cruise` has none."""
     profile = cruise(vmax, amax, jmax)
-    if profile is None:
-        return None
-    mixer = np.asarray(np.kron(profile.mix.T, np.eye(dim)), dtype=np.float64)
-    mixer.setflags(write=False)
-    return profile, mixer
+    return None if profile is None else _Shared(profile, dim)
 
 
 def _partly_cruising(
@@ -679,7 +716,9 @@ def stop_and_go(waypoints: FloatArray, limits: LegLimits | Sequence[LegLimits]) 
         Bad waypoints or limits, or a leg Ruckig cannot time (longer than
         :data:`RUCKIG_MAX_DURATION_S` at its speed limit).
     """
-    pts = as_array("waypoints", waypoints, ndim=2)
+    pts = as_array("waypoints", waypoints, ndim=2, finite=False)
+    # (Checked finite by the reduction that gives their scale, the repeats' threshold.)
+    repeat = REPEAT_TOLERANCE * max(1.0, largest_magnitude("waypoints", pts))
     if pts.shape[0] < 2:
         raise InputError(f"waypoints: got {pts.shape[0]} point(s), expected at least 2")
     if isinstance(limits, LegLimits):
@@ -694,8 +733,6 @@ def stop_and_go(waypoints: FloatArray, limits: LegLimits | Sequence[LegLimits]) 
             _check(lim, pts.shape[1])
     delta = pts[1:] - pts[:-1]
     steps = np.sqrt(np.vecdot(delta, delta))  # numpy.linalg.norm(axis=1), cheaper
-    # (The ufuncs' reductions: the methods .max() and .min() wrap them in Python.)
-    repeat = REPEAT_TOLERANCE * max(1.0, float(np.maximum.reduce(abs(pts), axis=None)))
     idx = None  # the legs flown, if not all: repeated points are skipped
     starts, ends = pts[:-1], pts[1:]
     shortest = float(np.minimum.reduce(steps))
