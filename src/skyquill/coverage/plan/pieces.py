@@ -13,6 +13,7 @@ import numpy as np
 from numpy.typing import NDArray
 from shapely.geometry import Polygon
 
+from skyquill.coverage.congruent import Motions
 from skyquill.coverage.deadline import Deadline
 from skyquill.coverage.missed import missed_area
 from skyquill.coverage.mission import fly_mission
@@ -55,7 +56,9 @@ def plan_mission(
     """The mission over ``region``'s hole-free pieces, each planned by ``plan_piece``.
 
     A spiral piece that cannot be timed within its share of the budget is
-    planned by ``zigzag`` instead (see :func:`spiral_or_zigzag`). ``where``: the
+    planned by ``zigzag`` instead (see :func:`spiral_or_zigzag`). A piece that is a
+    copy of another is not planned: the other's plan is moved onto it (see
+    :func:`copy_motions` and :func:`~skyquill.coverage.mission.fly_mission`). ``where``: the
     pieces one after the other here, or at once in a pool or on a dask cluster (then
     ``plan_piece`` and ``zigzag`` must pickle: module-level functions or their partials).
     """
@@ -77,6 +80,7 @@ def plan_mission(
         plan_piece=functools.partial(_flight, plan_piece=planner),
         convex=opts.pattern in {"spiral", "zigzag-jerk"},
         where=where,
+        copies=copy_motions(opts),
     )
     check = within_limits(mission.trajectory, opts, "mission", deadline)
     return CoveragePlan(
@@ -92,6 +96,21 @@ def plan_mission(
         missed=missed_area(region, mission.swept),
         mission=mission,
     )
+
+
+def copy_motions(opts: CoverageOptions) -> Motions:
+    """The motions by which a piece's plan is moved onto its copies in a mission.
+
+    A shift keeps every planner's flight (to round-off) and every limit. A turn
+    or mirror keeps norm limits but not per-axis ones, and not every planner's
+    choices: fresh plans of mirrored pieces differ from the moved plan. Measured
+    on 12 random mirror-symmetric fields with a hole in the middle (planned with
+    and without moving): the spiral's convex parts -1.4 % to +0.3 % of flight
+    (median -0.4 %), planning 0.66x; the zigzag-stop's concave pieces +2.3 % to
+    +9.4 % (median +5.6 %: a mirrored zigzag starts at the far side), so only
+    spirals under norm limits are moved by turns and mirrors.
+    """
+    return "rigid" if opts.pattern == "spiral" and not opts.per_axis else "translations"
 
 
 #: Share of the remaining budget any spiral piece of a mission may spend before it is zigzagged.
