@@ -1,8 +1,9 @@
 """Congruent pieces of a mission: which pieces are one polygon moved, and by which motion.
 
 A field cut round its holes often gives pieces that are copies of each other:
-``holes_1_3ha``'s 11 pieces hold three pairs (302 m², turned by 180°; 290 m²,
-mirrored; 2990 m², shifted), each planned twice before. A piece is planned once
+``holes_1_3ha``'s 11 pieces hold three pairs (302, 290 and 2990 m²: rectangles,
+shifted copies), each planned twice before; the 10 ha field's four 108 m² triangles
+round its round hole are one turned four ways. A piece is planned once
 per class (:func:`congruence_classes`) and its plan moved onto the others
 (:func:`~skyquill.trajectory.moved.moved`).
 
@@ -99,12 +100,11 @@ def motion_onto(a: Polygon, b: Polygon, motions: Motions) -> Motion | None:
     ca, cb = pa.mean(axis=0), pb.mean(axis=0)
     # Corners in b's order from each start, and reversed (a mirror reverses the order).
     orders = [np.roll(pb, -k, axis=0) for k in range(len(pb))]
+    candidates = [np.eye(2)]
     if motions == "rigid":
         orders += [np.roll(pb[::-1], -k, axis=0) for k in range(len(pb))]
-    candidates = [np.eye(2)] if motions == "translations" else []
-    if motions == "rigid":
         # Procrustes: the orthogonal matrix (mirrors allowed) that best fits the corners.
-        candidates = [np.eye(2)] + [orthogonal_procrustes(pa - ca, t - cb)[0].T for t in orders]
+        candidates += [orthogonal_procrustes(pa - ca, t - cb)[0].T for t in orders]
     for rotation in candidates:
         motion = Motion(rotation, cb - rotation @ ca)
         moved = motion.apply(pa)
