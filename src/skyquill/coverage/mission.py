@@ -5,7 +5,10 @@ each piece is planned as a region of its own (any planner: the plain one or
 the tuned one), the pieces are ordered for the shortest transits (Held-Karp
 over the routed transit lengths, :mod:`skyquill.coverage.part_order`'s
 search) and joined by rest-to-rest straight legs routed around the holes
-(:func:`~skyquill.coverage.transit.transit_route`) with the spray off.
+(:func:`~skyquill.coverage.transit.transit_route`) with the spray off. A piece that
+is a copy of another (turned, mirrored or shifted, as the limits allow:
+:mod:`skyquill.coverage.congruent`) is not planned again: the other's plan is moved
+onto it.
 
 The spray is on while a piece is flown and the swath's footprint is clear
 of every hole (a piece's path can pass closer than half a swath where its
@@ -28,6 +31,7 @@ from numpy.typing import NDArray
 from shapely.geometry import LineString, Polygon
 from shapely.geometry.base import BaseGeometry
 
+from skyquill.coverage.congruent import Motion, Motions, congruence_classes
 from skyquill.coverage.deadline import Deadline
 from skyquill.coverage.holes import hole_free_pieces, planning_obstacle
 from skyquill.coverage.keepout import KeepoutCheck, check_keepout
@@ -39,6 +43,7 @@ from skyquill.errors import InfeasibleError
 from skyquill.optimize.legs import LegLimits, stop_and_go
 from skyquill.parallel import HERE, Where
 from skyquill.trajectory import Trajectory, concatenate
+from skyquill.trajectory.moved import moved
 from skyquill.validation import FloatArray
 
 #: Spacing of the flight's dense sampling (spray gating, keep-out check, coverage), m.
@@ -88,6 +93,9 @@ class Mission:
         The area the spray reached (m).
     pieces : int
         Pieces flown.
+    copies : int
+        Pieces flown by another's plan moved onto them (see ``copies`` of
+        :func:`fly_mission`), among ``pieces``.
     headlands : int
         Laps flown round holes (see :func:`_hole_rings`).
     fields : int
@@ -105,6 +113,7 @@ class Mission:
     coverage: float
     swept: BaseGeometry
     pieces: int
+    copies: int
     headlands: int
     fields: int
     transit_length_m: float
@@ -115,6 +124,7 @@ class Mission:
             "keepout": self.keepout.summary(),
             "fields": self.fields,
             "pieces": self.pieces,
+            "copies": self.copies,
             "headlands": self.headlands,
             "transit_length_m": self.transit_length_m,
         }
@@ -134,6 +144,7 @@ def fly_mission(
     plan_piece: PiecePlanner,
     convex: bool = False,
     where: Where = HERE,
+    copies: Motions | None = None,
 ) -> Mission:
     """Plan every piece of ``region``, order and join them, gate the spray, check the holes.
 
@@ -162,6 +173,13 @@ def fly_mission(
     where
         Where the pieces are planned: one after the other here (the default), or at once
         in a process pool or on a dask cluster (each within the budget left then).
+    copies
+        Plan one piece of each congruence class and move its plan onto the
+        others (:func:`~skyquill.coverage.congruent.congruence_classes`):
+        ``"rigid"`` where any rotation or mirror keeps the plan within the
+        limits (norm limits), ``"translations"`` where only shifts do (per-axis
+        limits); None plans every piece. A moved plan goes through the same
+        keep-out check, and the caller's dense check, as the whole flight.
 
     Raises
     ------
@@ -175,7 +193,8 @@ def fly_mission(
         pieces = [part for piece in pieces for part in _convex(piece, width)]
     room = [_has_room(piece, width) for piece in pieces]
     wide = [piece for piece, fits in zip(pieces, room, strict=True) if fits]
-    planned = iter(_planned(wide, plan_piece, deadline, where))
+    classes = congruence_classes(wide, copies) if copies else _alone(len(wide))
+    planned = iter(_planned(wide, classes, plan_piece, deadline, where))
     flown = []
     for piece, fits in zip(pieces, room, strict=True):  # in the pieces' order
         one = next(planned) if fits else _narrow(piece, width, legs, altitude)
@@ -218,6 +237,7 @@ def fly_mission(
         coverage=covered,
         swept=area,
         pieces=pieces_flown,
+        copies=sum(k != i for i, (k, _) in enumerate(classes)),
         headlands=len(flown) - pieces_flown,
         fields=len(fields(region)),
         transit_length_m=float(sum(_length(r) for r in routes)),
@@ -229,7 +249,35 @@ def _has_room(piece: Polygon, width: float) -> bool:
     return not piece.buffer(-0.5 * width).is_empty
 
 
+def _alone(n: int) -> list[tuple[int, Motion]]:
+    """``n`` pieces each in a class of its own (as :func:`congruence_classes` returns)."""
+    return [(k, Motion(np.eye(2), np.zeros(2))) for k in range(n)]
+
+
 def _planned(
+    pieces: list[Polygon],
+    classes: list[tuple[int, Motion]],
+    plan_piece: PiecePlanner,
+    deadline: Deadline,
+    where: Where,
+) -> list[_Piece]:
+    """The first piece of each class planned (:func:`_planned_firsts`), its plan moved onto
+    the others of its class."""
+    firsts = sorted({k for k, _ in classes})
+    plans = dict(zip(firsts, _planned_firsts([pieces[k] for k in firsts], plan_piece,
+                                             deadline, where), strict=True))  # fmt: skip
+    return [
+        plans[k] if k == i else _moved(plans[k], motion) for i, (k, motion) in enumerate(classes)
+    ]
+
+
+def _moved(piece: _Piece, motion: Motion) -> _Piece:
+    """``piece``'s flight moved by ``motion`` onto its copy."""
+    trajectory = moved(piece.trajectory, motion.rotation, motion.shift)
+    return _Piece(trajectory, motion.apply(piece.waypoints))
+
+
+def _planned_firsts(
     pieces: list[Polygon], plan_piece: PiecePlanner, deadline: Deadline, where: Where
 ) -> list[_Piece]:
     """Each piece planned by ``plan_piece``: one after the other here, or all at once
