@@ -1,0 +1,63 @@
+"""The pseudo-jerk iteration stops when it stalls, and only then (coverage/speed/iteration.py)."""
+
+from __future__ import annotations
+
+import itertools
+from collections.abc import Callable
+
+import numpy as np
+
+from skyquill.coverage.speed.iteration import _pseudo_jerk
+from skyquill.coverage.speed.rows import _Bounds, _ones
+from skyquill.validation import FloatArray
+
+N = 8
+
+
+class _Scripted:
+    """A grid solver whose iterates follow ``answer(k)``; records which solves were rough."""
+
+    def __init__(self, answer: Callable[[int], FloatArray]) -> None:
+        self.answer = answer
+        self.rough: list[bool] = []
+
+    @property
+    def time(self) -> float:
+        return 0.0
+
+    @property
+    def solves(self) -> int:
+        return len(self.rough)
+
+    def solve(self, r: FloatArray, ub: FloatArray, *, rough: bool = False) -> FloatArray:
+        self.rough.append(rough)
+        return self.answer(len(self.rough))
+
+
+def _bounds() -> _Bounds:
+    return _Bounds(np.full(N, np.inf), np.ones(N), 2, *_ones(N))
+
+
+def _run(answer: Callable[[int], FloatArray]) -> tuple[_Scripted, int, list[float]]:
+    solver = _Scripted(answer)
+    log: tuple[list[float], list[float]] = ([], [])
+    _, iterations = _pseudo_jerk(solver, _bounds(), np.full(N, 4.0), stop=(20, 1e-3), log=log)
+    return solver, iterations, log[1]
+
+
+def test_a_cycling_iteration_stops_and_is_certified() -> None:
+    # Two iterates 10 % apart in turn: the change never falls below the tolerance.
+    solver, iterations, changes = _run(lambda k: np.full(N, 1.0 if k % 2 else 1.21))
+    assert iterations < 20
+    assert iterations <= 10  # the damped reference settles between the two, then it stalls
+    assert solver.rough == [True] * iterations + [False]  # the certification LP last
+    assert min(changes) > 1e-3
+
+
+def test_a_converging_iteration_is_not_stopped_early() -> None:
+    # The change shrinks by a third each time, slowly: it runs to the tolerance.
+    solver, iterations, changes = _run(lambda k: np.full(N, 1.0 + 0.6 ** (k + 2)))
+    assert changes[-1] < 1e-3 <= changes[-2]
+    assert iterations == len(changes) > 3
+    assert all(later < earlier for earlier, later in itertools.pairwise(changes))
+    assert solver.rough[-1] is False
