@@ -8,6 +8,8 @@ distances to the holes are taken directly.
 
 from __future__ import annotations
 
+import time
+
 import numpy as np
 import pytest
 import shapely
@@ -229,3 +231,22 @@ def test_pieces_planned_on_a_dask_cluster_give_the_same_flight() -> None:
     region = region_from_vertices(SQUARE, holes=[_round(8, 8, 2.0)])
     here = plan_coverage(region, ZIGZAG)
     _same_flight(here, plan_coverage(region, ZIGZAG, where=Where(scheduler="local")))
+
+
+def test_a_piece_planned_at_once_gets_the_budget_left_when_it_starts() -> None:
+    # A worker that starts a piece late (queued behind others) must not get the budget
+    # left when the pieces were handed out: the mission would run past its time limit.
+    from skyquill.coverage.deadline import Deadline
+    from skyquill.coverage.mission import _planned_alone
+
+    seen: list[float] = []
+
+    def plan_piece(piece: Polygon, deadline: Deadline) -> tuple[object, object]:
+        seen.append(deadline.limit_s)
+        return None, None
+
+    square = Polygon([(0, 0), (1, 0), (1, 1), (0, 1)])
+    _planned_alone(square, plan_piece=plan_piece, ends_at=time.time() + 30.0)  # type: ignore[arg-type]
+    _planned_alone(square, plan_piece=plan_piece, ends_at=time.time() - 5.0)  # type: ignore[arg-type]
+    assert 29.0 < seen[0] <= 30.0
+    assert seen[1] == 0.0  # spent: its first check refuses with the time limit

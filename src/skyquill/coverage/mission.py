@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import functools
 import math
+import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
@@ -281,7 +282,7 @@ def _planned_firsts(
     pieces: list[Polygon], plan_piece: PiecePlanner, deadline: Deadline, where: Where
 ) -> list[_Piece]:
     """Each piece planned by ``plan_piece``: one after the other here, or all at once
-    ``where`` asks (each within the budget left when they start)."""
+    ``where`` asks (each within the budget left when it starts)."""
     if where.here:
         here = []
         for k, piece in enumerate(pieces):
@@ -289,7 +290,8 @@ def _planned_firsts(
             here.append(_Piece(*plan_piece(piece, deadline)))
         return here
     deadline.check(f"{len(pieces)} pieces, planned at once in {where.describe()}")
-    alone = functools.partial(_planned_alone, plan_piece=plan_piece, budget=deadline.remaining())
+    ends_at = time.time() + deadline.remaining()
+    alone = functools.partial(_planned_alone, plan_piece=plan_piece, ends_at=ends_at)
     # The largest first (their planning time grows with the area): the workers finish
     # together instead of one waiting on a large piece started last.
     order = sorted(range(len(pieces)), key=lambda k: -pieces[k].area)
@@ -298,10 +300,15 @@ def _planned_firsts(
 
 
 def _planned_alone(
-    piece: Polygon, *, plan_piece: PiecePlanner, budget: float
+    piece: Polygon, *, plan_piece: PiecePlanner, ends_at: float
 ) -> tuple[Trajectory, FloatArray]:
-    """``piece`` planned within ``budget`` seconds from now (in a worker process)."""
-    return plan_piece(piece, Deadline(budget))
+    """``piece`` planned (in a worker process) within the budget left until ``ends_at``.
+
+    ``ends_at`` is on the wall clock (``time.time()``, s), which the processes share: a
+    piece queued behind others starts later and gets what is left then, not the budget
+    left when the pieces were handed out (which let a mission run past its time limit).
+    """
+    return plan_piece(piece, Deadline(max(ends_at - time.time(), 0.0)))
 
 
 def _narrow(piece: Polygon, width: float, legs: LegLimits, altitude: float) -> _Piece | None:
