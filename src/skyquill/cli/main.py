@@ -142,7 +142,11 @@ def main(
     ] = False,
 ) -> None:
     """skyquill: aerial drawing and painting with quadrotors."""
-    logging.basicConfig(level=logging.INFO if verbose else logging.WARNING)
+    # Without --verbose a warning is one plain line: no level or module names.
+    logging.basicConfig(
+        level=logging.INFO if verbose else logging.WARNING,
+        format=logging.BASIC_FORMAT if verbose else "%(message)s",
+    )
     quiet_warnings(verbose)
 
 

@@ -162,7 +162,8 @@ def spiral_or_zigzag(
         return spiral(piece, share)
     except InfeasibleError as exc:
         deadline.check("a zigzag for a piece whose spiral failed")
-        _log.warning("piece of %.3g m²: spiral failed (%s), zigzag instead", piece.area, exc)
+        # (Not a warning: the mission still meets its coverage and limits, or is refused.)
+        _log.info("piece of %.3g m²: spiral failed (%s), zigzag instead", piece.area, exc)
         return zigzag(piece, deadline)
 
 

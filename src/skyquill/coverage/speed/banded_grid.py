@@ -160,7 +160,7 @@ class BandedGrid:
         if sol.status == "optimal":
             self._last = sol.b
             return sol.b
-        _log.warning("banded interior point did not converge (%s); HiGHS answers", sol.status)
+        _log.info("banded interior point did not converge (%s); HiGHS answers", sol.status)
         if self._lp is None:
             self._lp = self._build_lp()
         return self._lp.solve(r, ub)

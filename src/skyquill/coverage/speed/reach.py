@@ -299,7 +299,7 @@ class ReachPass:
         self.solves += 1
         self.time += time.perf_counter() - start
         if not settled:
-            _log.warning("reachability passes did not settle in %d sweeps", MAX_SWEEPS)
+            _log.info("reachability passes did not settle in %d sweeps", MAX_SWEEPS)
             return None
         return np.maximum(np.asarray(values, dtype=np.float64), 0.0)
 
