@@ -168,4 +168,4 @@ def test_a_kilometre_square_at_a_2_m_swath_is_refused_at_once(tmp_path: Path) ->
     result = CliRunner().invoke(app, ["cover", str(region), "--out", str(tmp_path / "o")])
     assert result.exit_code == 2
     lines = result.output.strip().splitlines()
-    assert len(lines) == 1 and "a path of about 504 km, expected at most 25 km" in lines[0]
+    assert len(lines) == 1 and "a path of about 504 km, expected at most 200 km" in lines[0]

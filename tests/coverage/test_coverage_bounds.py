@@ -6,7 +6,8 @@ import pytest
 from shapely.geometry import box
 
 from skyquill.coverage.paths import contours, zigzag
-from skyquill.coverage.plan import CoverageOptions, plan_coverage, plan_tuned
+from skyquill.coverage.plan import CoverageOptions, plan_coverage
+from skyquill.coverage.plan.pieces import in_pieces
 from skyquill.coverage.plan.tuning import _fitting_epsilons
 from skyquill.coverage.regions import MAX_PATH_LENGTH_M, check_width, estimate_path_length
 from skyquill.errors import InputError
@@ -18,7 +19,7 @@ SQUARE = box(0.0, 0.0, 10.0, 10.0)
 def test_a_kilometre_square_at_a_2_m_swath_is_refused_with_what_would_fit() -> None:
     message = (
         r"^width: got 2 m on a region of 1e\+06 m², i\.e\. a path of about 504 km, expected "
-        r"at most 25 km \(a swath of at least 47\.6 m, or a smaller region: split it into "
+        r"at most 200 km \(a swath of at least 5\.1 m, or a smaller region: split it into "
         r"missions\)$"
     )
     with pytest.raises(InputError, match=message):
@@ -55,10 +56,11 @@ def test_tuning_skips_the_spacings_whose_path_is_too_long() -> None:
     assert 1.0 in fitting and 0.7 not in fitting
 
 
-def test_tuning_is_refused_when_even_its_widest_spacing_is_too_long() -> None:
+def test_a_field_whose_widest_spacing_is_too_long_is_planned_in_cells() -> None:
     region = box(0.0, 0.0, 250.0, 250.0)  # 6.25e4 m² / 2.2 m ~ 28 km at epsilon 1
-    with pytest.raises(InputError, match=r"^width: got 2\.2 m .* expected at most 25 km"):
-        plan_tuned(region, CoverageOptions(width=2.2), 0.97)
+    options = CoverageOptions(width=2.2)
+    assert not _fitting_epsilons(region, options)  # no spacing fits one path
+    assert in_pieces(region, options)  # so it is a mission of cells (tests/coverage/test_cells)
 
 
 @pytest.mark.parametrize("pattern", ["spiral", "zigzag"])

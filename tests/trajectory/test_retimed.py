@@ -30,6 +30,17 @@ def test_chain_rule_matches_central_differences(order: int) -> None:
     np.testing.assert_allclose(traj.evaluate(t, order), numeric, atol=1e-5 * scale)
 
 
+def test_orders_at_once_are_the_orders_one_by_one() -> None:
+    traj = retimed_arc(4.0)
+    t = np.linspace(0.0, 4.0, 41)
+    got = traj.evaluate_orders(t, (4, 1, 0, 3))
+    assert list(got) == [4, 1, 0, 3]
+    for n, values in got.items():
+        np.testing.assert_array_equal(values, traj.evaluate(t, n))
+    with pytest.raises(InputError, match="order"):
+        traj.evaluate_orders(t, (5,))
+
+
 def test_every_derivative_is_finite_and_at_rest_at_both_ends() -> None:
     traj = retimed_arc(3.0)
     ends = np.array([0.0, 3.0])

@@ -46,3 +46,17 @@ def test_join_must_be_continuous_and_at_rest() -> None:
     three = rest_to_rest_leg(np.zeros(3), np.ones(3), 1.0)
     with pytest.raises(InputError, match=r"pieces: got axes \[2, 3\]"):
         RestToRestSequence((a, three))
+
+
+def test_evaluate_orders_is_each_piece_at_its_own_clock() -> None:
+    arc = retimed_arc(4.0)
+    end = arc.evaluate(np.array([4.0]))[0]
+    seq = RestToRestSequence((arc, rest_to_rest_leg(end, end + np.array([0.0, 1.0]), 1.5)))
+    t = np.random.default_rng(7).uniform(0.0, seq.duration, 200)  # not sorted
+    got = seq.evaluate_orders(t, (3, 0, 1))
+    assert list(got) == [3, 0, 1]
+    for n, values in got.items():
+        for i, ti in enumerate(t):
+            k = int(seq.piece_at(np.array([ti]))[0])
+            local = np.array([ti - seq.starts[k]])
+            np.testing.assert_array_equal(values[i], seq.pieces[k].evaluate(local, n)[0])

@@ -17,7 +17,7 @@ import shapely
 from shapely.geometry import LineString, Point, Polygon
 from shapely.geometry.polygon import orient
 
-from skyquill.coverage.regions import check_width
+from skyquill.coverage.regions import MAX_MISSION_PATH_M, check_width
 from skyquill.errors import InputError
 from skyquill.validation import FloatArray
 
@@ -87,7 +87,8 @@ def convex_parts(region: Polygon, width: float) -> list[Polygon]:
         the checks (near-degenerate region).
     """
     polygon = _checked_region(region)
-    w = check_width(polygon, width)
+    # (Its parts' paths are capped when they are planned: a part too long is cut into cells.)
+    w = check_width(polygon, width, max_path_m=MAX_MISSION_PATH_M)
     if _is_convex(polygon):
         return [polygon]
     candidates = [_hertel_mehlhorn(polygon), *_reflex_cut_decompositions(polygon)]

@@ -9,6 +9,7 @@ vertices), solved by scipy's Dijkstra.
 
 from __future__ import annotations
 
+import functools
 import itertools
 from collections.abc import Sequence
 
@@ -47,8 +48,18 @@ def transit_route(
         the way. An end point within half the clearance of a hole (where a
         piece's path ended close to it) may leave and reach it straight.
     """
-    corners, blocks = _graph_geometry(holes, clearance)
-    nodes = np.vstack([begin, end, *corners]) if corners else np.vstack([begin, end])
+    corners, blocks = _graph_geometry(tuple(holes), clearance)
+    straight = np.vstack([begin, end])
+    # Nothing in the way: the shortest route, as the search would find (a mission of n
+    # pieces routes n (n - 1) pairs to order them, most in the open).
+    if _visible_lengths(straight, blocks)[0, 1] > 0.0:
+        return straight
+    return _searched_route(np.vstack([straight, *corners]) if corners else straight, blocks)
+
+
+def _searched_route(nodes: FloatArray, blocks: Sequence[tuple[Polygon, Polygon]]) -> FloatArray:
+    """The shortest route from ``nodes[0]`` to ``nodes[1]`` through the others (K, 2), m,
+    on the legs that cross no block (the two ends alone when none reaches)."""
     weights = _visible_lengths(nodes, blocks)
     _, parents = dijkstra(csr_array(weights), indices=np.array([0]), return_predecessors=True)
     parent = parents[0]
@@ -56,16 +67,21 @@ def transit_route(
     while route[-1] != 0:
         route.append(int(parent[route[-1]]))
         if route[-1] < 0:  # unreachable: only when the ends are walled in by holes
-            return np.vstack([begin, end])
+            return nodes[:2]
     out: FloatArray = nodes[route[::-1]]
     return out
 
 
+@functools.lru_cache(maxsize=16)
 def _graph_geometry(
-    holes: Sequence[Polygon], clearance: float
+    holes: tuple[Polygon, ...], clearance: float
 ) -> tuple[list[FloatArray], list[tuple[Polygon, Polygon]]]:
     """The graph's corner points (each grown hull's vertices) and, per hole, the polygon
-    that blocks legs and the hull itself."""
+    that blocks legs and the hull itself.
+
+    Kept for the last holes seen: a mission routes every pair of its pieces round the
+    same holes (82 pieces of the 100 ha field: 6,642 routes, 2.6 s of it rebuilding this).
+    """
     corners: list[FloatArray] = []
     blocks: list[tuple[Polygon, Polygon]] = []
     for hole in holes:

@@ -14,6 +14,7 @@ so they are finite wherever ``C`` and ``u`` are: everywhere, the ends included.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cached_property
 
@@ -117,28 +118,45 @@ class RetimedPath:
         InputError
             For times outside ``[0, duration]`` or ``order`` above 4.
         """
-        as_int("order", order, low=0, high=MAX_ORDER)
-        u = [self.timing.evaluate(t, n)[:, 0] for n in range(order + 1)]
-        c = [self._curve(u[0], n) for n in range(order + 1)]
-        if order == 0:
-            return c[0]
-        u1 = u[1][:, None]
-        if order == 1:
-            return c[1] * u1
-        u2 = u[2][:, None]
-        if order == 2:
-            return c[2] * u1**2 + c[1] * u2
-        u3 = u[3][:, None]
-        if order == 3:
-            return c[3] * u1**3 + 3.0 * c[2] * u1 * u2 + c[1] * u3
-        u4 = u[4][:, None]
-        return (
-            c[4] * u1**4
-            + 6.0 * c[3] * u1**2 * u2
-            + c[2] * (3.0 * u2**2 + 4.0 * u1 * u3)
-            + c[1] * u4
-        )
+        return self.evaluate_orders(t, [order])[order]
+
+    def evaluate_orders(self, t: FloatArray, orders: Sequence[int]) -> dict[int, FloatArray]:
+        """``{n: self.evaluate(t, n)}`` for each of ``orders``: the timing law and the
+        curve evaluated once for all of them (the dense check asks for three).
+
+        Returns
+        -------
+        dict of numpy.ndarray, shape (N, d) each
+
+        Raises
+        ------
+        InputError
+            For times outside ``[0, duration]`` or an order above 4.
+        """
+        checked = [as_int("order", n, low=0, high=MAX_ORDER) for n in orders]
+        top = max(checked, default=0)
+        u = self.timing.evaluate_orders(t, range(top + 1))
+        c = [self._curve(u[0][:, 0], n) for n in range(top + 1)]
+        return {n: _chain_rule(n, [u[k] for k in range(n + 1)], c) for n in checked}
 
     def sample(self, rate: float) -> Samples:
         """Samples at ``rate`` Hz (position to jerk), including both ends."""
         return sample(self, rate)
+
+
+def _chain_rule(order: int, u: list[FloatArray], c: list[FloatArray]) -> FloatArray:
+    """``d^order / dt^order C(u(t))`` from ``u``'s derivatives ``u[k]`` (N, 1) and the
+    curve's ``c[k]`` (N, d) at ``u(t)``, ``k <= order`` (Faà di Bruno, the module's formulas)."""
+    if order == 0:
+        return c[0]
+    u1 = u[1]
+    if order == 1:
+        return c[1] * u1
+    u2 = u[2]
+    if order == 2:
+        return c[2] * u1**2 + c[1] * u2
+    u3 = u[3]
+    if order == 3:
+        return c[3] * u1**3 + 3.0 * c[2] * u1 * u2 + c[1] * u3
+    u4 = u[4]
+    return c[4] * u1**4 + 6.0 * c[3] * u1**2 * u2 + c[2] * (3.0 * u2**2 + 4.0 * u1 * u3) + c[1] * u4

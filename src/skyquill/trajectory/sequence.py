@@ -15,7 +15,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from skyquill.errors import InputError
-from skyquill.trajectory.base import Samples, Trajectory, evaluation_times, sample
+from skyquill.trajectory.base import Samples, Trajectory, derivatives, evaluation_times, sample
 from skyquill.validation import FloatArray, as_int
 
 #: Largest position gap between consecutive pieces (m), and speed (m/s) and acceleration
@@ -84,16 +84,25 @@ class RestToRestSequence:
 
     def evaluate(self, t: FloatArray, order: int = 0) -> FloatArray:
         """The ``order``-th time derivative at times ``t`` (N,); returns (N, d)."""
-        as_int("order", order, low=0)
+        return self.evaluate_orders(t, [order])[order]
+
+    def evaluate_orders(self, t: FloatArray, orders: Sequence[int]) -> dict[int, FloatArray]:
+        """``{n: self.evaluate(t, n)}`` for each of ``orders``, each piece's times found
+        once and its derivatives taken together (:func:`~.base.derivatives`); (N, d) each."""
+        checked = [as_int("order", n, low=0) for n in orders]
         times = evaluation_times(t, self.duration)
         which = self._locate(times)
-        out = np.empty((times.size, self.dim))
+        out = {n: np.empty((times.size, self.dim)) for n in checked}
         starts = self.starts
-        for k in np.unique(which):
-            mask = which == k
+        # Each piece's times by one stable sort (index runs), not one mask per piece.
+        order = np.argsort(which, kind="stable")
+        bounds = np.searchsorted(which[order], np.arange(len(self.pieces) + 1))
+        for k in np.flatnonzero(np.diff(bounds)):
+            rows = order[bounds[k] : bounds[k + 1]]
             piece = self.pieces[k]
-            local = np.clip(times[mask] - starts[k], 0.0, piece.duration)
-            out[mask] = piece.evaluate(local, order)
+            local = np.clip(times[rows] - starts[k], 0.0, piece.duration)
+            for n, values in derivatives(piece, local, checked).items():
+                out[n][rows] = values
         return out
 
     def sample(self, rate: float) -> Samples:

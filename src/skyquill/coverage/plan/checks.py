@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from shapely.geometry import MultiPolygon, Polygon
 
+from skyquill.coverage.cells import in_cells, path_cap
 from skyquill.coverage.plan.options import CoverageOptions
 from skyquill.coverage.regions import (
     Region,
@@ -24,6 +25,10 @@ MAX_REGION_SIZE_M = 1000.0
 #: 0.7 ms/m (a 316 m square at a 5 m swath, 19.8 km, in 14.5 s on 2 shared cores),
 #: rounded up. A budget below the estimate is refused at once rather than spent.
 PLANNING_S_PER_M = 1e-3
+#: The same for a region planned in cells (:mod:`skyquill.coverage.cells`), s/m: measured
+#: 0.40 ms/m on one worker (the 100 ha field at a 10 m swath, about 102 km, in 41 s; 27 s
+#: on two), rounded up.
+CELLS_PLANNING_S_PER_M = 5e-4
 
 
 def check_region(region: Region, options: CoverageOptions) -> None:
@@ -39,13 +44,16 @@ def check_region(region: Region, options: CoverageOptions) -> None:
             f"region: got a region {maxx - minx:.4g} x {maxy - miny:.4g} m, expected at most "
             f"{MAX_REGION_SIZE_M:g} m across (split it into several missions)"
         )
-    check_width(region, options.width, options.epsilon)
+    # A path too long for one plan is planned in cells, up to the mission's cap.
+    spacing = options.epsilon * options.width
+    check_width(region, options.width, options.epsilon, path_cap(region, spacing))
     _check_budget(region, options)
     if options.target is not None:
-        if has_keepouts(region):
+        if has_keepouts(region) or in_cells(region, options.epsilon * options.width):
             raise InputError(
-                "target: got an upload target for a region with holes or several fields, "
-                "expected none (the re-fit would not keep the spray off over the transits)"
+                "target: got an upload target for a region with holes, several fields or "
+                "a path planned in cells, expected none (the re-fit would not keep the "
+                "spray off over the transits)"
             )
         assert isinstance(region, Polygon)  # no keep-outs: one field
         check_target_path(region, options.width, options.epsilon, options.target)
@@ -53,11 +61,13 @@ def check_region(region: Region, options: CoverageOptions) -> None:
 
 def _check_budget(region: Region, options: CoverageOptions) -> None:
     """Refuse a time limit shorter than the estimated planning time (nothing is built)."""
-    length = estimate_path_length(region, options.epsilon * options.width)
-    need = PLANNING_S_PER_M * length
+    spacing = options.epsilon * options.width
+    length = estimate_path_length(region, spacing)
+    rate = CELLS_PLANNING_S_PER_M if in_cells(region, spacing) else PLANNING_S_PER_M
+    need = rate * length
     if need > options.time_limit:
         raise InputError(
             f"time_limit: got {options.time_limit:g} s, expected at least {need:.3g} s for a "
-            f"path of about {length / 1e3:.3g} km ({1e3 * PLANNING_S_PER_M:g} ms per metre "
+            f"path of about {length / 1e3:.3g} km ({1e3 * rate:g} ms per metre "
             "estimated): allow more time, widen the swath or split the region"
         )
