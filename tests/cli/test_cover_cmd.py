@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import time
 from pathlib import Path
 
 import numpy as np
@@ -169,3 +170,19 @@ def test_a_kilometre_square_at_a_2_m_swath_is_refused_at_once(tmp_path: Path) ->
     assert result.exit_code == 2
     lines = result.output.strip().splitlines()
     assert len(lines) == 1 and "a path of about 504 km, expected at most 200 km" in lines[0]
+
+
+def test_a_flight_too_long_for_its_csv_rate_is_refused_before_planning(tmp_path: Path) -> None:
+    # 100 ha at a 10 m swath and 3 m/s: at least 9 h of flight, 1.6 M rows at 50 Hz.
+    region = EXAMPLES / "holes_100ha.geojson"
+    out = tmp_path / "o"
+    args = ["cover", str(region), "--width", "10", "--out", str(out)]
+    started = time.perf_counter()
+    result = CliRunner().invoke(app, args)
+    assert result.exit_code == 2
+    assert time.perf_counter() - started < 10.0  # nothing planned
+    lines = result.output.strip().splitlines()
+    assert len(lines) == 1
+    assert "--rate: got 50 Hz over a flight of at least 31408.8 s" in lines[0]
+    assert "expected at most 1,000,000 rows in trajectory.csv" in lines[0]
+    assert not out.exists()

@@ -163,8 +163,10 @@ def cover(
         plan_coverage,
         plan_tuned,
     )
+    from skyquill.coverage.plan.checks import least_flight_s
     from skyquill.io.outputs import staged_output
     from skyquill.io.plan_dir import write_plan
+    from skyquill.io.points import check_rows_written
     from skyquill.io.trajectory_json import PlannedTrajectory
     from skyquill.viz.coverage_plot import plot_coverage
 
@@ -198,6 +200,9 @@ def cover(
                 f"--min-coverage: got {min_coverage:g}, expected 0 (fly --epsilon/--delta as "
                 "given) or a fraction in (0, 1]"
             )
+        # trajectory.csv's rows, from the shortest flight that covers enough: before planning.
+        least = least_flight_s(shape, options, min_coverage)
+        check_rows_written(least, rate, "--rate", at_least=True)
         with _BudgetBar() as bar:
             if min_coverage == 0.0:
                 plan = plan_coverage(shape, options, progress=bar.update, where=where)

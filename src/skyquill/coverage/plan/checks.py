@@ -8,6 +8,7 @@ from shapely.geometry import MultiPolygon, Polygon
 
 from skyquill.coverage.cells import in_cells, path_cap
 from skyquill.coverage.plan.options import CoverageOptions
+from skyquill.coverage.plan.timing import MAX_EXCESS
 from skyquill.coverage.regions import (
     Region,
     check_width,
@@ -71,3 +72,15 @@ def _check_budget(region: Region, options: CoverageOptions) -> None:
             f"path of about {length / 1e3:.3g} km ({1e3 * rate:g} ms per metre "
             "estimated): allow more time, widen the swath or split the region"
         )
+
+
+def least_flight_s(region: Region, options: CoverageOptions, coverage: float) -> float:
+    """A lower bound on the flight that sprays ``coverage`` of ``region``, s.
+
+    The swath sweeps at most ``width * speed`` m² a second, and a plan's speed is within
+    :data:`~skyquill.coverage.plan.timing.MAX_EXCESS` of ``vmax``: what the outputs of a
+    plan can be checked against before it is made (a 100 ha field at a 10 m swath and
+    3 m/s: at least 9 h of flight).
+    """
+    sweep = options.width * options.vmax * (1.0 + MAX_EXCESS)
+    return coverage * float(region.area) / sweep
