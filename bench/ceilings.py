@@ -135,6 +135,24 @@ def _cover_path(tmp: Path) -> list[str]:
     ]  # fmt: skip
 
 
+def _cover_cells(tmp: Path) -> list[str]:
+    """``cover`` of the largest region at a swath whose path is estimated just under the
+    cells' ceiling, at a rate whose ``trajectory.csv`` fits (10 Hz: a 19 h flight)."""
+    from skyquill.coverage.plan import MAX_REGION_SIZE_M
+    from skyquill.coverage.regions import MAX_MISSION_PATH_M
+
+    side = MAX_REGION_SIZE_M
+    width = side * side / (0.95 * MAX_MISSION_PATH_M - 4 * side)
+    (tmp / "field.wkt").write_text(
+        f"POLYGON ((0 0, {side:.1f} 0, {side:.1f} {side:.1f}, 0 {side:.1f}, 0 0))",
+        encoding="utf-8",
+    )
+    return [
+        "cover", str(tmp / "field.wkt"), "--width", f"{width:.3f}", "--min-coverage", "0",
+        "--rate", "10", "--time-limit", "600", "--out", str(tmp / "o"),
+    ]  # fmt: skip
+
+
 def _paint_dots(tmp: Path) -> list[str]:
     """``paint`` of the most dots accepted, at a rate whose ``trajectory.csv`` fits (10 Hz).
 
@@ -166,6 +184,7 @@ CASES: dict[str, Callable[[Path], list[str]]] = {
     "check_skyc": _check_skyc,
     "fly_steps": _fly_steps,
     "cover_path": _cover_path,
+    "cover_cells": _cover_cells,
     "paint_dots": _paint_dots,
 }
 

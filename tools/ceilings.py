@@ -45,8 +45,8 @@ def rows() -> list[tuple[str, str, str]]:
         paint_cmd,
         write_cmd,
     )
+    from skyquill.coverage import cells, regions
     from skyquill.coverage import plan as coverage_plan
-    from skyquill.coverage import regions
     from skyquill.export.skybrush import csv_file as skybrush_csv
     from skyquill.export.skybrush import skyc_file
     from skyquill.io import json_read, numbers, setpoints_json, table
@@ -94,12 +94,15 @@ def rows() -> list[tuple[str, str, str]]:
          "calligraphy.show.MAX_DRONES, MAX_SHOW_STROKES"),
         ("`cover`", lambda: f"a region <= {_n(coverage_plan.MAX_REGION_SIZE_M)} m across, "
          f"{_n(regions.MAX_VERTICES)} vertices, a path <= "
-         f"{_n(regions.MAX_PATH_LENGTH_M / 1e3)} km (estimated as area / swath + perimeter "
+         f"{_n(regions.MAX_PATH_LENGTH_M / 1e3)} km planned as one, <= "
+         f"{_n(regions.MAX_MISSION_PATH_M / 1e3)} km in cells (lines >= "
+         f"{_n(cells.MIN_CELL_SPACING_M)} m apart; estimated as area / swath + perimeter "
          f"before any path is built); `--altitude` {_n(alt_lo)} (excluded) to {_n(alt_hi)} m; "
          f"`--origin-alt` {_n(origin_lo)} to {_n(origin_hi)} m; `--delta` <= "
          f"{_n(cover_cmd.DELTA_RANGE_M[1])} m; `--time-limit` <= "
          f"{_n(cover_cmd.TIME_LIMIT_RANGE_S[1])} s; `--workers` <= {_n(main.MAX_WORKERS)}",
-         "coverage.plan.MAX_REGION_SIZE_M, coverage.regions, cli.cover_cmd, cli.main.MAX_WORKERS"),
+         "coverage.plan.MAX_REGION_SIZE_M, coverage.regions, coverage.cells, cli.cover_cmd, "
+         "cli.main.MAX_WORKERS"),
         ("`paint`", lambda: f"{_n(dots.MAX_DOTS)} dots (`--dots` too); `--width` <= "
          f"{_n(paint_cmd.MAX_WIDTH_M)} m; pictures <= "
          f"{_n(dots.MAX_IMAGE_PIXELS / 1e6)} Mpx (from the header, before decoding) and "
