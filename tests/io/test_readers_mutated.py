@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import io
 import json
+import tempfile
 import tracemalloc
 import zipfile
 from collections.abc import Callable
@@ -67,12 +68,11 @@ def _skyc_json() -> bytes:
     from skyquill.trajectory import SplineTrajectory
 
     ctrl = np.column_stack([np.linspace(0, 2, 8), np.zeros(8), np.full(8, 1.0)])
-    path = Path(__file__).with_name("_mutated_seed.skyc")
-    try:
+    # In a folder of its own: every xdist worker builds this at collection, at once.
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / "seed.skyc"
         write_skyc([SkycDrone("d0", skybrush_keyframes(SplineTrajectory(ctrl, 5, 4.0)))], path)
         return zipfile.ZipFile(path).read("show.json")
-    finally:
-        path.unlink(missing_ok=True)
 
 
 def _read_csv(path: Path) -> Any:

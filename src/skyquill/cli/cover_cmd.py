@@ -163,7 +163,8 @@ def cover(
         plan_coverage,
         plan_tuned,
     )
-    from skyquill.coverage.plan.checks import least_flight_s
+    from skyquill.coverage.plan.checks import check_region, least_flight_s
+    from skyquill.coverage.plan.tuning import check_tuned_region
     from skyquill.io.outputs import staged_output
     from skyquill.io.plan_dir import write_plan
     from skyquill.io.points import check_rows_written
@@ -200,7 +201,12 @@ def cover(
                 f"--min-coverage: got {min_coverage:g}, expected 0 (fly --epsilon/--delta as "
                 "given) or a fraction in (0, 1]"
             )
-        # trajectory.csv's rows, from the shortest flight that covers enough: before planning.
+        # Refused before planning: the region, then trajectory.csv's rows over the shortest
+        # flight that covers enough.
+        if min_coverage == 0.0:
+            check_region(shape, options)
+        else:
+            check_tuned_region(shape, options)
         least = least_flight_s(shape, options, min_coverage)
         check_rows_written(least, rate, "--rate", at_least=True)
         with _BudgetBar() as bar:

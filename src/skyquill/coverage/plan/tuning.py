@@ -111,9 +111,7 @@ def plan_tuned(
     goal = as_float("min_coverage", target, positive=True)
     if goal > 1.0:
         raise InputError(f"min_coverage: got {goal:g}, expected a fraction in (0, 1]")
-    # The sparsest spacing must fit the path-length cap and the budget; denser
-    # ones that do not are skipped by the tuning (a 10 ha field at a 5 m swath).
-    check_region(region, replace(options, epsilon=max(TUNING_EPSILONS)))
+    check_tuned_region(region, options)
     deadline = Deadline(options.time_limit, progress)
     if options.target is not None:
         # Trials are compared as planned; only the winner is re-fitted for the target.
@@ -123,6 +121,13 @@ def plan_tuned(
         plan = _tuned(region, options, goal, deadline, where)
     # The whole planning: every candidate and estimate, not only the winner's own plan.
     return replace(plan, planning_time=time.perf_counter() - start)
+
+
+def check_tuned_region(region: Region, options: CoverageOptions) -> None:
+    """Refuse what :func:`plan_tuned` refuses before any work (a region too large, a path too
+    long, a budget too short): the sparsest spacing it tries must fit the path-length cap
+    and the budget; denser ones that do not are skipped (a 10 ha field at a 5 m swath)."""
+    check_region(region, replace(options, epsilon=max(TUNING_EPSILONS)))
 
 
 def _tuned(
