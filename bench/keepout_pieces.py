@@ -17,8 +17,8 @@ refused is recorded with the message.
 
 Run: ``.venv/bin/python bench/keepout_pieces.py [--runs N] [--fields NAME ...]`` ->
 ``bench/results/keepout_pieces.json`` (about 2 minutes for the 1.3 ha fields on two free
-cores, 5 more for the 10 ha field, 3 more for 100 ha). The machine has 2 cores: at once gains only where the
-second core is free (record the load).
+cores, 5 more for the 10 ha field, 3 more for 100 ha). The machine has 2 cores: at once gains
+only where the second core is free (record the load).
 """
 
 from __future__ import annotations

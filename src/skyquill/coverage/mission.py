@@ -471,7 +471,10 @@ def _near_box(points: FloatArray, hole: Polygon, reach: float) -> NDArray[np.boo
     (a cheap superset of the points within ``reach`` of the hole)."""
     minx, miny, maxx, maxy = hole.bounds
     x, y = points[:, 0], points[:, 1]
-    return (x >= minx - reach) & (x <= maxx + reach) & (y >= miny - reach) & (y <= maxy + reach)
+    near: NDArray[np.bool_] = (
+        (x >= minx - reach) & (x <= maxx + reach) & (y >= miny - reach) & (y <= maxy + reach)
+    )
+    return near
 
 
 def _sprayed_area(path: FloatArray, spraying: NDArray[np.bool_], width: float) -> BaseGeometry:
