@@ -190,3 +190,38 @@ def test_piecewise_polynomial_checked_per_piece_where_constant_is_checked_at_eve
     every = _Peaks(limits, (), 3)
     every.add(t, {n: traj.evaluate(t, n) for n in (1, 2, 3, 4)})
     assert verify(traj, limits, guaranteed=False) == every.result(t.size, False)
+
+
+def test_the_jerk_peak_at_a_curve_knot_is_checked() -> None:
+    # A quartic path through a bent polyline, flown rest to rest: its jerk has kinks where
+    # the path crosses the curve's knots, peaks the evenly spaced samples step over.
+    from scipy.interpolate import make_interp_spline
+
+    from skyquill.trajectory import RetimedPath, concatenate
+
+    u = np.linspace(0.0, 1.0, 9)
+    pts = np.column_stack([u, 0.3 * np.abs(np.sin(7.0 * u))])
+    curve = make_interp_spline(u, pts, k=4)
+    t = np.linspace(0.0, 3.0, 7)  # few timing pieces: 20 samples each, far apart
+    x = t / 3.0
+    law = (10 * x**3 - 15 * x**4 + 6 * x**5, (30 * x**2 - 60 * x**3 + 30 * x**4) / 3.0,
+           (60 * x - 180 * x**2 + 120 * x**3) / 9.0)  # fmt: skip
+    traj = RetimedPath.from_samples(curve, t, *law)
+    kinks = traj.kink_times()
+    knots = np.unique(curve.t)[1:-1]
+    np.testing.assert_allclose(traj.timing.evaluate(kinks)[:, 0], knots, atol=1e-12)
+    jerk_at = np.linalg.norm(traj.evaluate(kinks, 3), axis=1)
+    sampled = np.linalg.norm(traj.evaluate(dense_times(traj.breakpoints), 3), axis=1).max()
+    res = verify(traj, [NormLimit(3, 1e-6)])
+    assert res.checks[0].max_value == pytest.approx(max(sampled, jerk_at.max()), rel=1e-12)
+    assert jerk_at.max() > sampled  # the case the kinks are sampled for
+    # In a sequence, on its clock.
+    start = traj.evaluate(np.array([0.0]))[0]
+    seq = concatenate([_hold(start), traj])
+    np.testing.assert_allclose(seq.kink_times(), 1.0 + kinks)
+    assert verify(seq, [NormLimit(3, 1e-6)]).checks[0].max_value >= jerk_at.max()
+
+
+def _hold(at: FloatArray) -> PiecewisePolynomial:
+    """A one-second hold at ``at`` (2-D)."""
+    return PiecewisePolynomial(np.array([0.0, 1.0]), np.zeros((1, 1, 2)) + at)

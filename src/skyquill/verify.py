@@ -19,7 +19,7 @@ from typing import Any, Protocol, runtime_checkable
 import numpy as np
 
 from skyquill.limits import DerivativeLimit
-from skyquill.trajectory.base import Trajectory, dense_times, derivatives
+from skyquill.trajectory.base import Trajectory, check_times, derivatives
 from skyquill.trajectory.polynomial import PiecewisePolynomial
 from skyquill.validation import FloatArray
 
@@ -159,7 +159,7 @@ def verify(
         t = traj.dense_times()
         peaks.add(t, traj.dense_derivatives(orders))
     else:
-        t = dense_times(traj.breakpoints)
+        t = check_times(traj)
         flat = _constant_per_piece(traj, orders)
         per_piece = {} if not flat else derivatives(traj, traj.breakpoints[:-1], flat)
         sampled = [n for n in orders if n not in flat]

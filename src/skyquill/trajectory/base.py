@@ -80,6 +80,30 @@ class ManyOrders(Protocol):
     def evaluate_orders(self, t: FloatArray, orders: Sequence[int]) -> dict[int, FloatArray]: ...
 
 
+@runtime_checkable
+class Kinked(Protocol):
+    """A trajectory whose highest derivatives have kinks inside its pieces (a path curve's
+    knots crossed by a timing law): the dense check samples them too."""
+
+    def kink_times(self) -> FloatArray: ...
+
+
+def check_times(traj: Trajectory) -> FloatArray:
+    """The times the dense check samples ``traj`` at, sorted, s: :func:`dense_times` of its
+    breakpoints and, for a :class:`Kinked` kind, its kinks.
+
+    A jerk peak at a kink lasts well under a millisecond and falls between the evenly
+    spaced samples: on a 1.3 ha field's coverage flight the samples saw 0.9 % over the jerk
+    limit where the kinks reach 2.3 % (200 samples a piece: 2.2 %).
+    """
+    t = dense_times(traj.breakpoints)
+    if isinstance(traj, Kinked):
+        kinks = traj.kink_times()
+        if kinks.size:
+            t = np.sort(np.concatenate([t, kinks]))
+    return t
+
+
 def derivatives(traj: Trajectory, t: FloatArray, orders: Sequence[int]) -> dict[int, FloatArray]:
     """``{n: traj.evaluate(t, n)}`` for each of ``orders``, at once where the kind can
     (:class:`ManyOrders`); shape (N, d) each."""

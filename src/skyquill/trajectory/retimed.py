@@ -96,6 +96,21 @@ class RetimedPath:
         """The timing law's pieces, shape (P + 1,), s."""
         return self.timing.breakpoints
 
+    def kink_times(self) -> FloatArray:
+        """When the path crosses its curve's interior knots, shape (K,), s, increasing.
+
+        There the curve's highest derivative jumps, and the flight's highest one with it
+        (a degree-4 curve: the jerk has a kink, its snap a jump): a peak between the
+        dense check's evenly spaced samples.
+        """
+        return self._kink_times
+
+    @cached_property
+    def _kink_times(self) -> FloatArray:
+        knots = np.unique(np.asarray(self.curve.t, dtype=np.float64))
+        knots = knots[(knots > 0.0) & (knots < 1.0)]
+        return _inverse(self.timing, knots)
+
     @cached_property
     def _curve_derivatives(self) -> tuple[BSpline, ...]:
         k = self.curve.k
@@ -160,3 +175,24 @@ def _chain_rule(order: int, u: list[FloatArray], c: list[FloatArray]) -> FloatAr
         return c[3] * u1**3 + 3.0 * c[2] * u1 * u2 + c[1] * u3
     u4 = u[4]
     return c[4] * u1**4 + 6.0 * c[3] * u1**2 * u2 + c[2] * (3.0 * u2**2 + 4.0 * u1 * u3) + c[1] * u4
+
+
+#: Bisection steps that bring a time to within 2**-60 of its piece (below a double's
+#: resolution of the flight's clock).
+_BISECTIONS = 60
+
+
+def _inverse(timing: PiecewisePolynomial, u: FloatArray) -> FloatArray:
+    """The first times at which the non-decreasing law ``timing`` reaches each of ``u``
+    (K,), s: each bracketed by the law's breakpoints, then bisected there."""
+    breaks = timing.breakpoints
+    at_breaks = timing.evaluate(breaks)[:, 0]
+    piece = np.clip(np.searchsorted(at_breaks, u, side="left") - 1, 0, breaks.size - 2)
+    lo, hi = breaks[piece], breaks[piece + 1]
+    for _ in range(_BISECTIONS):
+        mid = 0.5 * (lo + hi)
+        below = timing.evaluate(mid)[:, 0] < u
+        lo = np.where(below, mid, lo)
+        hi = np.where(below, hi, mid)
+    out: FloatArray = 0.5 * (lo + hi)
+    return out

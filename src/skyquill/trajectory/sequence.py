@@ -15,7 +15,14 @@ import numpy as np
 from numpy.typing import NDArray
 
 from skyquill.errors import InputError
-from skyquill.trajectory.base import Samples, Trajectory, derivatives, evaluation_times, sample
+from skyquill.trajectory.base import (
+    Kinked,
+    Samples,
+    Trajectory,
+    derivatives,
+    evaluation_times,
+    sample,
+)
 from skyquill.validation import FloatArray, as_int
 
 #: Largest position gap between consecutive pieces (m), and speed (m/s) and acceleration
@@ -81,6 +88,15 @@ class RestToRestSequence:
     def _locate(self, times: FloatArray) -> NDArray[np.intp]:
         last = len(self.pieces) - 1
         return np.clip(np.searchsorted(self.starts, times, side="right") - 1, 0, last)
+
+    def kink_times(self) -> FloatArray:
+        """Its pieces' kinks on the sequence's clock (see :class:`~.base.Kinked`), (K,), s."""
+        kinks = [
+            start + piece.kink_times()
+            for start, piece in zip(self.starts, self.pieces, strict=False)
+            if isinstance(piece, Kinked)
+        ]
+        return np.concatenate(kinks) if kinks else np.zeros(0)
 
     def evaluate(self, t: FloatArray, order: int = 0) -> FloatArray:
         """The ``order``-th time derivative at times ``t`` (N,); returns (N, d)."""

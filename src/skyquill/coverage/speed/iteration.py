@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import replace
+from typing import Any
 
 import numpy as np
 
@@ -161,8 +162,10 @@ def _interval_excess(plan: SpeedPlan) -> tuple[FloatArray, FloatArray, FloatArra
     :meth:`SpeedPlan.setpoints` outputs and :meth:`SpeedPlan.verify`
     differences) are evaluated on each interval at ``_SAMPLES`` points, or at
     least every ``control_period / 10`` of its traversal time (the default
-    resolution of :meth:`SpeedPlan.verify`): the peaks at the kinks of the
-    jerk are narrow.  Acceleration and jerk are measured against the limits
+    resolution of :meth:`SpeedPlan.verify`), and at the path's kinks (its
+    curve's knots, :func:`_kinks`): the jerk peaks there, narrowly, between
+    samples (a 1.3 ha field's flight: 0.9 % over the limit on the samples,
+    2.3 % at the kinks).  Acceleration and jerk are measured against the limits
     the caller asked for (per axis, or the norm), not the LP's polygon.
 
     Returns
@@ -180,18 +183,58 @@ def _interval_excess(plan: SpeedPlan) -> tuple[FloatArray, FloatArray, FloatArra
     start = np.concatenate([[0], np.cumsum(m)[:-1]])
     frac = (np.arange(int(m.sum())) - np.repeat(start, m)) / np.repeat(m, m)
     us = np.minimum(np.repeat(sig[:-1], m) + h * frac, 1.0)
+    ex = [np.maximum(np.maximum.reduceat(x, start) - 1.0, 0.0) for x in _ratios(plan, us)]
+    # The path's kinks (its curve's knots): the jerk peaks there, between the samples.
+    kinks = _kinks(plan)
+    if kinks.size:
+        at = np.clip(np.searchsorted(sig, kinks, side="right") - 1, 0, sig.size - 2)
+        for x, per_interval in zip(_ratios(plan, kinks), ex, strict=True):
+            np.maximum.at(per_interval, at, x - 1.0)
+    return ex[0], ex[1], ex[2]
+
+
+def _ratios(plan: SpeedPlan, us: FloatArray) -> list[FloatArray]:
+    """Speed, acceleration and jerk over their limits at the grid parameters ``us`` (M,)."""
     ud, udd, uddd = plan._derivs(us)
     c1, c2, c3 = _derivs3(plan._path, us)
     speed = np.linalg.norm(c1, axis=1) * ud / plan.vmax
     acc = limit_ratio(c2 * (ud**2)[:, None] + c1 * udd[:, None], plan.amax, plan.norm_sides)
-    out = [speed, acc]
-    if plan.jmax is not None:
-        jerk = c3 * (ud**3)[:, None] + 3.0 * c2 * (ud * udd)[:, None] + c1 * uddd[:, None]
-        out.append(limit_ratio(jerk, plan.jmax, plan.norm_sides))
-    else:
-        out.append(np.zeros_like(speed))
-    ex = [np.maximum(np.maximum.reduceat(x, start) - 1.0, 0.0) for x in out]
-    return ex[0], ex[1], ex[2]
+    if plan.jmax is None:
+        return [speed, acc, np.zeros_like(speed)]
+    jerk = c3 * (ud**3)[:, None] + 3.0 * c2 * (ud * udd)[:, None] + c1 * uddd[:, None]
+    return [speed, acc, limit_ratio(jerk, plan.jmax, plan.norm_sides)]
+
+
+def _kinks(plan: SpeedPlan) -> FloatArray:
+    """The grid parameters (K,) of the path's kinks: its curve's interior knots (a B-spline
+    curve's), and on an adaptive grid its map's, where the map takes the curve's there."""
+    knots = _interior_knots(plan.curve)
+    if plan._umap is None:
+        return knots
+    return np.sort(np.concatenate([_preimage(plan._umap, knots), _interior_knots(plan._umap)]))
+
+
+def _interior_knots(spline: object) -> FloatArray:
+    """The distinct knots strictly inside (0, 1) of a B-spline (none for another curve)."""
+    knots = np.unique(np.asarray(getattr(spline, "t", ()), dtype=np.float64))
+    inside: FloatArray = knots[(knots > 0.0) & (knots < 1.0)]
+    return inside
+
+
+def _preimage(umap: Any, u: FloatArray) -> FloatArray:
+    """``sigma`` (K,) in [0, 1] with ``umap(sigma) = u``, the map increasing: by bisection."""
+    lo, hi = np.zeros(u.size), np.ones(u.size)
+    for _ in range(_BISECTIONS):
+        mid = 0.5 * (lo + hi)
+        below = np.asarray(umap(mid), dtype=np.float64) < u
+        lo = np.where(below, mid, lo)
+        hi = np.where(below, hi, mid)
+    out: FloatArray = 0.5 * (lo + hi)
+    return out
+
+
+#: Bisection steps that place a kink to 2**-52 of the grid's parameter range.
+_BISECTIONS = 52
 
 
 def _spread(x: FloatArray, lo: int, hi: int, size: int) -> FloatArray:
