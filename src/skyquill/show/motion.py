@@ -36,7 +36,6 @@ import numpy as np
 from numpy.polynomial import Polynomial
 from numpy.typing import NDArray
 from scipy.interpolate import BSpline, CubicHermiteSpline
-from scipy.optimize import brentq
 
 from skyquill.errors import InputError
 from skyquill.trajectory import (
@@ -267,10 +266,13 @@ def _retimed(traj: RetimedPath) -> tuple[FloatArray, FloatArray]:
     breaks = [0.0]
     pieces: list[FloatArray] = []
     timing = traj.timing
+    kinks = traj.kink_times()  # the knot crossings, increasing
+    first = np.searchsorted(kinks, timing.breaks, side="right")
     for i in range(timing.n_pieces):
         start, width = float(timing.breaks[i]), float(timing.breaks[i + 1] - timing.breaks[i])
         u = Polynomial(timing.coeffs[i, :, 0])
-        for a, b in pairwise(_knot_crossings(u, width, knots)):
+        inner = (kinks[first[i] : first[i + 1]] - start).tolist()
+        for a, b in pairwise(sorted({0.0, *(c for c in inner if 0.0 < c < width), width})):
             local = u(Polynomial([a, 1.0]))  # u on [a, b], in time from a
             pieces.append(_composed(local, 0.5 * (b - a), knots, taylor))
             breaks.append(start + b)
@@ -303,15 +305,6 @@ def _curve_spans(curve: BSpline) -> tuple[FloatArray, FloatArray]:
         np.asarray(d(knots[:-1]), dtype=float) / math.factorial(m) for m, d in enumerate(orders)
     ]
     return knots, np.stack(taylor, axis=1)
-
-
-def _knot_crossings(u: Polynomial, width: float, knots: FloatArray) -> list[float]:
-    """0, the times in ``(0, width)`` where the rising ``u`` crosses a knot, and ``width``."""
-    low, high = float(u(0.0)), float(u(width))
-    inner = knots[(knots > low) & (knots < high)]
-    times = [brentq(lambda x, knot=knot: float(u(x)) - knot, 0.0, width) for knot in inner]
-    cuts = sorted({0.0, width, *times})
-    return [c for c in cuts if 0.0 <= c <= width]
 
 
 def _joined(name: str, seq: RestToRestSequence) -> tuple[FloatArray, FloatArray]:
