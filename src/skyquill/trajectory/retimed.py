@@ -14,7 +14,7 @@ so they are finite wherever ``C`` and ``u`` are: everywhere, the ends included.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from functools import cached_property
 
@@ -109,7 +109,13 @@ class RetimedPath:
     def _kink_times(self) -> FloatArray:
         knots = np.unique(np.asarray(self.curve.t, dtype=np.float64))
         knots = knots[(knots > 0.0) & (knots < 1.0)]
-        return _inverse(self.timing, knots)
+        # Each knot bracketed by the law's breakpoints, then bisected there.
+        breaks = self.timing.breakpoints
+        at_breaks = self.timing.evaluate(breaks)[:, 0]
+        piece = np.clip(np.searchsorted(at_breaks, knots) - 1, 0, breaks.size - 2)
+        return increasing_preimage(
+            lambda t: self.timing.evaluate(t)[:, 0], knots, breaks[piece], breaks[piece + 1]
+        )
 
     @cached_property
     def _curve_derivatives(self) -> tuple[BSpline, ...]:
@@ -177,21 +183,19 @@ def _chain_rule(order: int, u: list[FloatArray], c: list[FloatArray]) -> FloatAr
     return c[4] * u1**4 + 6.0 * c[3] * u1**2 * u2 + c[2] * (3.0 * u2**2 + 4.0 * u1 * u3) + c[1] * u4
 
 
-#: Bisection steps that bring a time to within 2**-60 of its piece (below a double's
-#: resolution of the flight's clock).
+#: Bisection steps: a bracket of the flight's length (or of [0, 1]) narrowed below a
+#: double's resolution.
 _BISECTIONS = 60
 
 
-def _inverse(timing: PiecewisePolynomial, u: FloatArray) -> FloatArray:
-    """The first times at which the non-decreasing law ``timing`` reaches each of ``u``
-    (K,), s: each bracketed by the law's breakpoints, then bisected there."""
-    breaks = timing.breakpoints
-    at_breaks = timing.evaluate(breaks)[:, 0]
-    piece = np.clip(np.searchsorted(at_breaks, u, side="left") - 1, 0, breaks.size - 2)
-    lo, hi = breaks[piece], breaks[piece + 1]
+def increasing_preimage(
+    f: Callable[[FloatArray], FloatArray], y: FloatArray, lo: FloatArray, hi: FloatArray
+) -> FloatArray:
+    """Where the non-decreasing ``f`` first reaches each of ``y`` (K,), bracketed by ``lo``
+    and ``hi`` (K,): by bisection, all at once (``f`` evaluates an array)."""
     for _ in range(_BISECTIONS):
         mid = 0.5 * (lo + hi)
-        below = timing.evaluate(mid)[:, 0] < u
+        below = np.asarray(f(mid), dtype=np.float64) < y
         lo = np.where(below, mid, lo)
         hi = np.where(below, hi, mid)
     out: FloatArray = 0.5 * (lo + hi)

@@ -50,7 +50,7 @@ def check_region(region: Region, options: CoverageOptions) -> None:
     check_width(region, options.width, options.epsilon, path_cap(region, spacing))
     _check_budget(region, options)
     if options.target is not None:
-        if has_keepouts(region) or in_cells(region, options.epsilon * options.width):
+        if has_keepouts(region) or in_cells(region, spacing):
             raise InputError(
                 "target: got an upload target for a region with holes, several fields or "
                 "a path planned in cells, expected none (the re-fit would not keep the "

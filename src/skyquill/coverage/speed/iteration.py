@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import replace
-from typing import Any
 
 import numpy as np
 
@@ -12,6 +11,7 @@ from skyquill.coverage.speed.curve import _derivs3
 from skyquill.coverage.speed.norms import limit_ratio
 from skyquill.coverage.speed.profile import SpeedPlan, _interval_times, _profile_spline
 from skyquill.coverage.speed.rows import GridSolver, _Bounds, _end_caps
+from skyquill.trajectory.retimed import increasing_preimage
 from skyquill.validation import FloatArray
 
 #: Fewest / most points per grid interval at which the refinement checks the plan (the
@@ -211,7 +211,9 @@ def _kinks(plan: SpeedPlan) -> FloatArray:
     knots = _interior_knots(plan.curve)
     if plan._umap is None:
         return knots
-    return np.sort(np.concatenate([_preimage(plan._umap, knots), _interior_knots(plan._umap)]))
+    ones = np.ones(knots.size)
+    sigma = increasing_preimage(plan._umap, knots, 0.0 * ones, ones)
+    return np.sort(np.concatenate([sigma, _interior_knots(plan._umap)]))
 
 
 def _interior_knots(spline: object) -> FloatArray:
@@ -219,22 +221,6 @@ def _interior_knots(spline: object) -> FloatArray:
     knots = np.unique(np.asarray(getattr(spline, "t", ()), dtype=np.float64))
     inside: FloatArray = knots[(knots > 0.0) & (knots < 1.0)]
     return inside
-
-
-def _preimage(umap: Any, u: FloatArray) -> FloatArray:
-    """``sigma`` (K,) in [0, 1] with ``umap(sigma) = u``, the map increasing: by bisection."""
-    lo, hi = np.zeros(u.size), np.ones(u.size)
-    for _ in range(_BISECTIONS):
-        mid = 0.5 * (lo + hi)
-        below = np.asarray(umap(mid), dtype=np.float64) < u
-        lo = np.where(below, mid, lo)
-        hi = np.where(below, hi, mid)
-    out: FloatArray = 0.5 * (lo + hi)
-    return out
-
-
-#: Bisection steps that place a kink to 2**-52 of the grid's parameter range.
-_BISECTIONS = 52
 
 
 def _spread(x: FloatArray, lo: int, hi: int, size: int) -> FloatArray:
