@@ -83,6 +83,7 @@ def test_a_field_too_long_for_one_path_is_planned_in_cells(small_caps: None) -> 
     plan = plan_tuned(region, CoverageOptions(width=2.0), 0.99)
     summary = plan.summary()
     assert summary["pieces"] >= 4
+    assert summary["cells"] == summary["pieces"]  # no holes: every piece is a cell
     assert summary["copies"] >= 1  # equal square cells: planned once, moved onto the others
     assert plan.coverage >= 0.99
     assert plan.limits["max_excess"] <= 0.02

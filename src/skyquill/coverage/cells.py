@@ -41,6 +41,8 @@ CELL_PATH_M = 10_000.0
 #: Narrower spacings over regions this large are held to one path's cap: a 10 m square at
 #: a 1 mm swath would be 10 cells of 1,500 rings each.
 MIN_CELL_SPACING_M = 1.0
+#: Grid the cells are snapped to, as a fraction of the piece's length.
+_SNAP = 1e-12
 #: Cells below this fraction of the piece's area are round-off slivers of the clipping.
 _SLIVER = 1e-9
 
@@ -92,7 +94,10 @@ def split_into_cells(piece: Polygon, spacing: float) -> list[Polygon]:
             corners = np.array([[i, j], [i + 1, j], [i + 1, j + 1], [i, j + 1]], dtype=float)
             corners *= [su, sv]
             boxes.append(Polygon(origin + corners @ axes))
-    clipped = shapely.intersection(np.array(boxes, dtype=object), piece)
+    # Snap-rounded on a grid far below the cells' size: the plain overlay can misplace a
+    # vertex by metres when the piece has one of 1e-23 next to ones of 1e2 (hypothesis).
+    grid = _SNAP * float(lengths[0])
+    clipped = shapely.intersection(np.array(boxes, dtype=object), piece, grid_size=grid)
     cells: list[Polygon] = []
     for geometry in clipped:
         for part in getattr(geometry, "geoms", [geometry]):

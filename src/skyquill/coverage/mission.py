@@ -104,6 +104,9 @@ class Mission:
     copies : int
         Pieces flown by another's plan moved onto them (see ``copies`` of
         :func:`fly_mission`), among ``pieces``.
+    cells : int
+        Pieces that are cells of a piece whose path was too long to plan as one
+        (:mod:`skyquill.coverage.cells`), among ``pieces``; 0 when none was cut.
     headlands : int
         Laps flown round holes (see :func:`_hole_rings`).
     fields : int
@@ -122,6 +125,7 @@ class Mission:
     swept: BaseGeometry
     pieces: int
     copies: int
+    cells: int
     headlands: int
     fields: int
     transit_length_m: float
@@ -133,6 +137,7 @@ class Mission:
             "fields": self.fields,
             "pieces": self.pieces,
             "copies": self.copies,
+            "cells": self.cells,
             "headlands": self.headlands,
             "transit_length_m": self.transit_length_m,
         }
@@ -202,7 +207,8 @@ def fly_mission(
     pieces = hole_free_pieces(region, width)
     if convex:
         pieces = [part for piece in pieces for part in _convex(piece, width)]
-    pieces = [cell for piece in pieces for cell in split_into_cells(piece, width)]
+    cut = [split_into_cells(piece, width) for piece in pieces]
+    pieces = [cell for cells in cut for cell in cells]
     room = [_has_room(piece, width) for piece in pieces]
     wide = [piece for piece, fits in zip(pieces, room, strict=True) if fits]
     classes = congruence_classes(wide, copies) if copies else _alone(len(wide))
@@ -250,6 +256,7 @@ def fly_mission(
         swept=area,
         pieces=pieces_flown,
         copies=sum(k != i for i, (k, _) in enumerate(classes)),
+        cells=sum(len(cells) for cells in cut if len(cells) > 1),
         headlands=len(flown) - pieces_flown,
         fields=len(fields(region)),
         transit_length_m=float(sum(_length(r) for r in routes)),
