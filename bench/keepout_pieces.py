@@ -1,19 +1,19 @@
 """Keep-out fields with their pieces planned at once against one after the other (issue 27 part 3).
 
 A field with holes is flown as a mission of hole-free pieces, each planned on its own; since
-session 35 ``skyquill cover`` plans them at once, one process per CPU (``--workers``, or a
-dask cluster with ``--scheduler``). This runs ``plan_tuned`` (as ``cover`` runs it: the default
+session 35 ``skyquill cover`` plans them at once, one process per CPU (``--workers``, or a dask
+cluster with ``--scheduler``). This runs ``plan_tuned`` (as ``cover`` runs it: the default
 spiral and limits, 99 % coverage, a 5 m swath) on the 1.3 ha fields with two holes of
 ``examples/coverage``, on the 10 ha field with two holes (``holes_10ha``, refused at 98.95 %
 before session 36) and on the 100 ha field with a wood and a pond at a 10 m swath
-(``holes_100ha``, refused before session 37: its path, about 102 km, is planned in cells
-since, :mod:`skyquill.coverage.cells`) with the pieces here (``workers=1``) and at once
-(``workers=2``), alternated (and for 100 ha on a local dask cluster too: the goal is 60 s "on
-dask when asked"), and on the same outline without holes (the goal's reference: a field with
-holes within 2x and 5 s), one timed run each by default. Both placements must give the same flight
-(checked: duration and coverage equal) unless a spiral piece ran out of its budget share in one
-of them and was zigzagged (then both are recorded, ``same_flight`` false). A field that is
-refused is recorded with the message.
+(``holes_100ha``, refused before session 37: its path, about 102 km, is planned as pieces
+within one plan's cap since, :mod:`skyquill.coverage.cells`) with the pieces here
+(``workers=1``) and at once (``workers=2``), alternated (and for 100 ha on a local dask cluster
+too: the goal is 60 s "on dask when asked"), and on the same outline without holes (the goal's
+reference: a field with holes within 2x and 5 s), one timed run each by default. Both
+placements must give the same flight (checked: duration and coverage equal) unless a spiral
+piece ran out of its budget share in one of them and was zigzagged (then both are recorded,
+``same_flight`` false). A field that is refused is recorded with the message.
 
 Run: ``.venv/bin/python bench/keepout_pieces.py [--runs N] [--fields NAME ...]`` ->
 ``bench/results/keepout_pieces.json`` (about 2 minutes for the 1.3 ha fields on two free

@@ -95,7 +95,7 @@ def rows() -> list[tuple[str, str, str]]:
         ("`cover`", lambda: f"a region <= {_n(coverage_plan.MAX_REGION_SIZE_M)} m across, "
          f"{_n(regions.MAX_VERTICES)} vertices, a path <= "
          f"{_n(regions.MAX_PATH_LENGTH_M / 1e3)} km planned as one, <= "
-         f"{_n(regions.MAX_MISSION_PATH_M / 1e3)} km in cells (lines >= "
+         f"{_n(regions.MAX_MISSION_PATH_M / 1e3)} km as pieces within it (lines >= "
          f"{_n(cells.MIN_CELL_SPACING_M)} m apart; estimated as area / swath + perimeter "
          f"before any path is built); `--altitude` {_n(alt_lo)} (excluded) to {_n(alt_hi)} m; "
          f"`--origin-alt` {_n(origin_lo)} to {_n(origin_hi)} m; `--delta` <= "

@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 from shapely.geometry import MultiPoint, Polygon, box
 
 from skyquill.coverage import cells
-from skyquill.coverage.cells import CELL_PATH_M, in_cells, split_into_cells
+from skyquill.coverage.cells import CELL_PATH_M, split_into_cells, too_long_for_one_plan
 from skyquill.coverage.plan import CoverageOptions, plan_coverage, plan_tuned
 from skyquill.coverage.regions import MAX_PATH_LENGTH_M, estimate_path_length, region_from_vertices
 from skyquill.errors import InputError
@@ -21,13 +21,13 @@ from skyquill.targets import CRAZYFLIE
 
 def test_a_piece_within_the_cap_stays_whole() -> None:
     piece = box(0.0, 0.0, 300.0, 300.0)  # 9e4 m² / 5 m + 1.2 km = 19.2 km
-    assert not in_cells(piece, 5.0)
+    assert not too_long_for_one_plan(piece, 5.0)
     assert split_into_cells(piece, 5.0) == [piece]
 
 
 def test_a_long_piece_is_cut_into_equal_cells_each_within_the_cell_path() -> None:
     piece = box(0.0, 0.0, 1000.0, 600.0)  # 6e5 m² / 10 m + 3.2 km = 63 km
-    assert in_cells(piece, 10.0)
+    assert too_long_for_one_plan(piece, 10.0)
     parts = split_into_cells(piece, 10.0)
     assert len(parts) > 1
     assert math.isclose(sum(p.area for p in parts), piece.area, rel_tol=1e-9)
@@ -63,7 +63,7 @@ def test_cells_tile_their_piece_and_are_convex(piece: Polygon, spacing: float) -
     for p in parts:
         assert p.convex_hull.area - p.area <= 1e-9 * piece.area
         assert estimate_path_length(p, spacing) <= CELL_PATH_M * (1 + 1e-9) or len(parts) == 1
-    if not in_cells(piece, spacing):
+    if not too_long_for_one_plan(piece, spacing):
         assert parts == [piece]
 
 
@@ -92,7 +92,7 @@ def test_a_field_too_long_for_one_path_is_planned_in_cells(small_caps: None) -> 
 
 def test_cells_are_refused_an_upload_target(small_caps: None) -> None:
     region = region_from_vertices(SQUARE_40)
-    with pytest.raises(InputError, match=r"^target: .*a path planned in cells"):
+    with pytest.raises(InputError, match=r"^target: .*a path too long for one plan"):
         plan_coverage(region, CoverageOptions(width=2.0, target=CRAZYFLIE))
 
 

@@ -36,8 +36,9 @@ from skyquill.coverage.regions import (
 #: 39,376 / 39,106 s. Smaller cells plan no faster (each speed plan has the same grid) and
 #: add transits and laps; larger ones are long serial computations.
 CELL_PATH_M = 10_000.0
-#: Narrowest line spacing planned in cells, m: a cell of :data:`CELL_PATH_M` then holds at
-#: most 100 lanes or rings across (its side is about ``sqrt(CELL_PATH_M * spacing)``).
+#: Narrowest line spacing at which a path too long for one plan is planned in pieces, m: a
+#: cell of :data:`CELL_PATH_M` then holds at most 100 lanes or rings across (its side is
+#: about ``sqrt(CELL_PATH_M * spacing)``).
 #: Narrower spacings over regions this large are held to one path's cap: a 10 m square at
 #: a 1 mm swath would be 10 cells of 1,500 rings each.
 MIN_CELL_SPACING_M = 1.0
@@ -47,25 +48,27 @@ _SNAP = 1e-12
 _SLIVER = 1e-9
 
 
-def in_cells(region: Region, spacing: float) -> bool:
-    """Whether ``region``'s path at ``spacing`` (m) is planned in cells: too long to plan as
-    one (longer than :data:`~skyquill.coverage.regions.MAX_PATH_LENGTH_M`, estimated), at a
-    spacing of at least :data:`MIN_CELL_SPACING_M`."""
+def too_long_for_one_plan(region: Region, spacing: float) -> bool:
+    """Whether ``region``'s path at ``spacing`` (m) is too long to plan as one (longer than
+    :data:`~skyquill.coverage.regions.MAX_PATH_LENGTH_M`, estimated), at a spacing of at
+    least :data:`MIN_CELL_SPACING_M`: then it is planned as a mission of pieces within that
+    cap (its pieces round holes and their convex parts, cut into cells where one is still
+    over it)."""
     return (
         spacing >= MIN_CELL_SPACING_M and estimate_path_length(region, spacing) > MAX_PATH_LENGTH_M
     )
 
 
 def path_cap(region: Region, spacing: float) -> float:
-    """The longest path accepted for ``region`` at ``spacing`` (m), m: a mission's in cells
-    (:data:`~skyquill.coverage.regions.MAX_MISSION_PATH_M`) where they apply, else one
-    path's."""
-    return MAX_MISSION_PATH_M if in_cells(region, spacing) else MAX_PATH_LENGTH_M
+    """The longest path accepted for ``region`` at ``spacing`` (m), m: a mission's
+    (:data:`~skyquill.coverage.regions.MAX_MISSION_PATH_M`) when it is too long for one
+    plan, else one plan's."""
+    return MAX_MISSION_PATH_M if too_long_for_one_plan(region, spacing) else MAX_PATH_LENGTH_M
 
 
 def split_into_cells(piece: Polygon, spacing: float) -> list[Polygon]:
     """``piece`` itself, or near-square cells of paths of at most :data:`CELL_PATH_M` each
-    when its path is too long to plan as one (:func:`in_cells`).
+    when its path is too long to plan as one (:func:`too_long_for_one_plan`).
 
     Parameters
     ----------
@@ -82,7 +85,7 @@ def split_into_cells(piece: Polygon, spacing: float) -> list[Polygon]:
         of ``nu x nv`` equal rectangles in the frame of its minimum rotated rectangle,
         row by row (boustrophedon order). Cut from a convex piece, every cell is convex.
     """
-    if not in_cells(piece, spacing):
+    if not too_long_for_one_plan(piece, spacing):
         return [piece]
     origin, axes, lengths = _frame(piece)
     nu, nv = _lattice(lengths, spacing, CELL_PATH_M)

@@ -400,10 +400,11 @@ def _check_spikes(ring: FloatArray, name: str) -> None:
 #: ``bench/coverage_scale.py``); 25 km at 3 m/s is also over two hours of
 #: flight, several batteries.
 MAX_PATH_LENGTH_M = 25_000.0
-#: Longest covering path of a region planned in cells (:mod:`skyquill.coverage.cells`), m:
-#: a 1 km square (:data:`~skyquill.coverage.plan.checks.MAX_REGION_SIZE_M`) at a 5 m swath.
-#: A region whose path is longer than :data:`MAX_PATH_LENGTH_M` is cut into cells planned
-#: at once: the 100 ha field at a 10 m swath (about 102 km) plans in 27 s on 2 cores.
+#: Longest covering path of a region too long to plan as one, m: a 1 km square
+#: (:data:`~skyquill.coverage.plan.checks.MAX_REGION_SIZE_M`) at a 5 m swath. Such a region
+#: is planned as a mission of pieces within :data:`MAX_PATH_LENGTH_M`, at once
+#: (:mod:`skyquill.coverage.cells`): the 100 ha field at a 10 m swath (about 102 km) in
+#: 20 s on 2 cores, the bare 1 km square in 16 cells in 7 s.
 MAX_MISSION_PATH_M = 200_000.0
 
 

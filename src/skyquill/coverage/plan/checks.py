@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from shapely.geometry import MultiPolygon, Polygon
 
-from skyquill.coverage.cells import in_cells, path_cap
+from skyquill.coverage.cells import path_cap, too_long_for_one_plan
 from skyquill.coverage.plan.options import CoverageOptions
 from skyquill.coverage.plan.timing import MAX_EXCESS
 from skyquill.coverage.regions import (
@@ -26,10 +26,11 @@ MAX_REGION_SIZE_M = 1000.0
 #: 0.7 ms/m (a 316 m square at a 5 m swath, 19.8 km, in 14.5 s on 2 shared cores),
 #: rounded up. A budget below the estimate is refused at once rather than spent.
 PLANNING_S_PER_M = 1e-3
-#: The same for a region planned in cells (:mod:`skyquill.coverage.cells`), s/m: measured
-#: 0.40 ms/m on one worker (the 100 ha field at a 10 m swath, about 102 km, in 41 s; 27 s
+#: The same for a region too long to plan as one, planned as a mission of pieces within
+#: the cap (:func:`~skyquill.coverage.cells.too_long_for_one_plan`), s/m: measured 0.33 ms/m
+#: on one worker (the 100 ha field at a 10 m swath, about 102 km: 15 pieces in 34 s, 20 s
 #: on two), rounded up.
-CELLS_PLANNING_S_PER_M = 5e-4
+MISSION_PLANNING_S_PER_M = 5e-4
 
 
 def check_region(region: Region, options: CoverageOptions) -> None:
@@ -45,15 +46,15 @@ def check_region(region: Region, options: CoverageOptions) -> None:
             f"region: got a region {maxx - minx:.4g} x {maxy - miny:.4g} m, expected at most "
             f"{MAX_REGION_SIZE_M:g} m across (split it into several missions)"
         )
-    # A path too long for one plan is planned in cells, up to the mission's cap.
+    # A path too long for one plan is planned as pieces within its cap, up to the mission's.
     spacing = options.epsilon * options.width
     check_width(region, options.width, options.epsilon, path_cap(region, spacing))
     _check_budget(region, options)
     if options.target is not None:
-        if has_keepouts(region) or in_cells(region, spacing):
+        if has_keepouts(region) or too_long_for_one_plan(region, spacing):
             raise InputError(
                 "target: got an upload target for a region with holes, several fields or "
-                "a path planned in cells, expected none (the re-fit would not keep the "
+                "a path too long for one plan, expected none (the re-fit would not keep the "
                 "spray off over the transits)"
             )
         assert isinstance(region, Polygon)  # no keep-outs: one field
@@ -64,7 +65,7 @@ def _check_budget(region: Region, options: CoverageOptions) -> None:
     """Refuse a time limit shorter than the estimated planning time (nothing is built)."""
     spacing = options.epsilon * options.width
     length = estimate_path_length(region, spacing)
-    rate = CELLS_PLANNING_S_PER_M if in_cells(region, spacing) else PLANNING_S_PER_M
+    rate = MISSION_PLANNING_S_PER_M if too_long_for_one_plan(region, spacing) else PLANNING_S_PER_M
     need = rate * length
     if need > options.time_limit:
         raise InputError(

@@ -13,7 +13,7 @@ import numpy as np
 from numpy.typing import NDArray
 from shapely.geometry import Polygon
 
-from skyquill.coverage.cells import in_cells
+from skyquill.coverage.cells import too_long_for_one_plan
 from skyquill.coverage.congruent import Motions
 from skyquill.coverage.deadline import Deadline
 from skyquill.coverage.missed import missed_area
@@ -39,11 +39,12 @@ PlanPiece = Callable[[Polygon, Deadline], CoveragePlan]
 
 def in_pieces(region: Region, options: CoverageOptions) -> bool:
     """Whether ``region`` is flown as a mission of pieces: holes, several fields, a path
-    too long to plan as one (cut into cells: :mod:`skyquill.coverage.cells`), or a concave
-    field for the jerk-zigzag (whose lanes need a convex region)."""
+    too long to plan as one (pieces within the cap, cells where needed:
+    :mod:`skyquill.coverage.cells`), or a concave field for the jerk-zigzag (whose lanes
+    need a convex region)."""
     if has_keepouts(region) or not isinstance(region, Polygon):
         return True
-    if in_cells(region, options.epsilon * options.width):
+    if too_long_for_one_plan(region, options.epsilon * options.width):
         return True
     return options.pattern == "zigzag-jerk" and not is_convex(region)
 

@@ -12,7 +12,7 @@ from numpy.typing import NDArray
 from shapely.geometry import Polygon
 
 from skyquill.coverage import DEFAULT_MIN_COVERAGE
-from skyquill.coverage.cells import in_cells
+from skyquill.coverage.cells import too_long_for_one_plan
 from skyquill.coverage.deadline import (
     Deadline,
     Progress,
@@ -200,7 +200,7 @@ def _fitting_epsilons(region: Polygon, options: CoverageOptions) -> list[float]:
     """The tuning's spacings whose estimated path fits one plan's length cap and the budget."""
     fitting = []
     for eps in TUNING_EPSILONS:
-        if in_cells(region, eps * options.width):
+        if too_long_for_one_plan(region, eps * options.width):
             continue
         try:
             check_region(region, replace(options, epsilon=eps))
