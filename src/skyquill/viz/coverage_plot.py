@@ -74,8 +74,9 @@ def plot_coverage(plan: CoveragePlan, path: str | Path) -> None:
     top.set_xlabel("x (m)")
     top.set_ylabel("y (m)")
     missed = "" if plan.missed is None else f", {plan.missed.area_m2:.3g} m²"
+    # Two lines: on one, a long flight's numbers ran past the map's left edge.
     top.set_title(
-        f"{opts.pattern}: {plan.duration:.1f} s, {plan.path_length:.1f} m, "
+        f"{opts.pattern}: {plan.duration:.1f} s, {plan.path_length:.1f} m\n"
         f"coverage {100 * plan.coverage:.1f} % (red: missed{missed})"
     )
     rows = (
