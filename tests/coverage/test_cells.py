@@ -104,3 +104,11 @@ def test_a_mission_past_its_cap_is_refused_with_the_swath_that_fits() -> None:
 
 def test_the_single_path_cap_is_below_the_cells() -> None:
     assert CELL_PATH_M < MAX_PATH_LENGTH_M
+
+
+def test_lines_under_a_metre_apart_keep_one_plans_cap() -> None:
+    # 1e4 m² / 0.3 m ~ 33 km: over one plan's cap, and too fine a spacing for pieces.
+    region = region_from_vertices([(0, 0), (100, 0), (100, 100), (0, 100)])
+    assert not too_long_for_one_plan(region, 0.3)
+    with pytest.raises(InputError, match=r"^width: got 0\.3 m .*expected at most 25 km \("):
+        plan_coverage(region, CoverageOptions(width=0.3))
