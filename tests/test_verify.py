@@ -13,6 +13,7 @@ from scipy.interpolate import make_lsq_spline
 
 from skyquill.limits import BoxLimit, CylinderLimit, NormLimit
 from skyquill.trajectory import PiecewisePolynomial, SplineTrajectory, dense_times
+from skyquill.trajectory.base import check_times
 from skyquill.verify import Verification, _Peaks, verify
 
 FloatArray = NDArray[np.float64]
@@ -186,7 +187,7 @@ def test_piecewise_polynomial_checked_per_piece_where_constant_is_checked_at_eve
         BoxLimit(3, -np.ones(3), np.ones(3)),
         NormLimit(4, 2.0),
     ]
-    t = dense_times(breaks)
+    t = check_times(traj)  # the dense times and each inner breakpoint from the left
     every = _Peaks(limits, (), 3)
     every.add(t, {n: traj.evaluate(t, n) for n in (1, 2, 3, 4)})
     assert verify(traj, limits, guaranteed=False) == every.result(t.size, False)
@@ -225,3 +226,15 @@ def test_the_jerk_peak_at_a_curve_knot_is_checked() -> None:
 def _hold(at: FloatArray) -> PiecewisePolynomial:
     """A one-second hold at ``at`` (2-D)."""
     return PiecewisePolynomial(np.array([0.0, 1.0]), np.zeros((1, 1, 2)) + at)
+
+
+def test_a_jump_at_a_breakpoint_is_checked_from_both_sides() -> None:
+    # Jerk 10 t on the first piece, 0 on the second: its largest value, 10, is the first
+    # piece's end, which the breakpoint's own sample (the second piece's start) never shows.
+    first = np.array([[0.0], [0.0], [0.0], [0.0], [10.0 / 24.0]])  # p = 10 t^4 / 24
+    v, a = 10.0 / 6.0, 10.0 / 2.0  # at t = 1: p' = 10 t^3 / 6, p'' = 10 t^2 / 2
+    second = np.array([[10.0 / 24.0], [v], [a / 2.0], [0.0], [0.0]])
+    traj = PiecewisePolynomial(np.array([0.0, 1.0, 2.0]), np.stack([first, second]))
+    res = verify(traj, [NormLimit(3, 5.0)])
+    assert res.checks[0].max_value == pytest.approx(10.0, rel=1e-9)
+    assert max(res.max_jerk) == pytest.approx(10.0, rel=1e-9)
