@@ -47,6 +47,11 @@ class Motion:
     rotation: FloatArray
     shift: FloatArray
 
+    @classmethod
+    def identity(cls) -> Motion:
+        """The motion that leaves every point where it is."""
+        return cls(np.eye(2), np.zeros(2))
+
     def apply(self, points: FloatArray) -> FloatArray:
         """``points`` (K, 2) moved, m."""
         out: FloatArray = points @ self.rotation.T + self.shift
@@ -81,7 +86,7 @@ def congruence_classes(pieces: list[Polygon], motions: Motions) -> list[tuple[in
                 break
         if found is None:
             firsts.append(len(classes))
-            found = (len(classes), Motion(np.eye(2), np.zeros(2)))
+            found = (len(classes), Motion.identity())
         classes.append(found)
     return classes
 

@@ -270,7 +270,7 @@ def _has_room(piece: Polygon, width: float) -> bool:
 
 def _alone(n: int) -> list[tuple[int, Motion]]:
     """``n`` pieces each in a class of its own (as :func:`congruence_classes` returns)."""
-    return [(k, Motion(np.eye(2), np.zeros(2))) for k in range(n)]
+    return [(k, Motion.identity()) for k in range(n)]
 
 
 def _planned(
@@ -423,10 +423,9 @@ def _gated(
     """The sampled flight ``(M, 2)``, where the spray is on, and its time windows.
 
     On inside a piece's window where the footprint clears every hole by
-    :data:`SPRAY_GUARD` of the margin. The flight is sampled as :func:`_sample_times` says.
+    :data:`SPRAY_GUARD` of the margin. The flight is sampled as :func:`_sampled` says.
     """
-    t = _sample_times(trajectory, keepouts, width, vmax)
-    path: FloatArray = trajectory.evaluate(t)[:, :2]
+    t, path = _sampled(trajectory, keepouts, width, vmax)
     starts, ends = np.array(windows, dtype=np.float64).reshape(-1, 2).T
     # The windows are in flight order and do not overlap: the last one started decides.
     k = np.searchsorted(starts, t, side="right") - 1
@@ -443,10 +442,11 @@ def _gated(
     return path, on, pen
 
 
-def _sample_times(
+def _sampled(
     trajectory: Trajectory, keepouts: list[Polygon], width: float, vmax: float
-) -> FloatArray:
-    """Times at which the flight is sampled, increasing, from 0 to its end, s.
+) -> tuple[FloatArray, FloatArray]:
+    """Times at which the flight is sampled, increasing, from 0 to its end, s, and its
+    positions ``(M, 2)`` there, m (each evaluated once).
 
     At most :data:`SAMPLE_SPACING_M` apart (at ``vmax``) wherever the flight comes
     within reach of a hole: the spray is gated and the keep-out check measured on these
@@ -458,9 +458,9 @@ def _sample_times(
     """
     coarse = max(2, math.ceil(trajectory.duration * vmax / COARSE_SPACING_M) + 1)
     t = np.linspace(0.0, trajectory.duration, coarse)
+    path: FloatArray = trajectory.evaluate(t)[:, :2]
     if not keepouts:
-        return t
-    path = trajectory.evaluate(t)[:, :2]
+        return t, path
     # An interval is refined when either end is within reach of a hole's box.
     reach = 0.5 * width * (1.0 + SPRAY_GUARD) + COARSE_SPACING_M
     near = np.zeros(coarse, dtype=bool)
@@ -470,7 +470,10 @@ def _sample_times(
     per = math.ceil(COARSE_SPACING_M / SAMPLE_SPACING_M)
     step = t[1] - t[0]
     fine = (t[refine, None] + step * (np.arange(1, per) / per)[None, :]).ravel()
-    return np.sort(np.concatenate([t, fine]))
+    times = np.concatenate([t, fine])
+    order = np.argsort(times, kind="stable")
+    positions = np.concatenate([path, trajectory.evaluate(fine)[:, :2]])
+    return times[order], positions[order]
 
 
 def _near_box(points: FloatArray, hole: Polygon, reach: float) -> NDArray[np.bool_]:

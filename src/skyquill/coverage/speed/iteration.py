@@ -211,8 +211,7 @@ def _kinks(plan: SpeedPlan) -> FloatArray:
     knots = _interior_knots(plan.curve)
     if plan._umap is None:
         return knots
-    ones = np.ones(knots.size)
-    sigma = increasing_preimage(plan._umap, knots, 0.0 * ones, ones)
+    sigma = increasing_preimage(plan._umap, knots, np.zeros(knots.size), np.ones(knots.size))
     return np.sort(np.concatenate([sigma, _interior_knots(plan._umap)]))
 
 
