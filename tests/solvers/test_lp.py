@@ -8,7 +8,8 @@ import scipy.sparse as sp
 
 import skyquill.solvers.lp as lp_module
 from skyquill.errors import InputError
-from skyquill.solvers.lp import LinearProgram, highspy_available, resolve_backend
+from skyquill.solvers.lp import LinearProgram, highspy_available, resolve_backend, vertex_basis
+from skyquill.validation import FloatArray
 
 BACKENDS = ["linprog", *(["highspy"] if highspy_available() else [])]
 
@@ -128,3 +129,94 @@ def test_the_first_highs_model_prints_nothing_on_stdout() -> None:
         [sys.executable, "-c", script], capture_output=True, text=True, timeout=120, check=True
     )
     assert done.stdout == ""
+
+
+def _random_lp(seed: int) -> tuple[LinearProgram, FloatArray]:
+    """A random LP with 150 columns and 600 two-sided rows, and a point 1e-9 from its
+    optimum inside it: HiGHS's interior point, stopped before its crossover."""
+    rng = np.random.default_rng(seed)
+    a = sp.random_array((600, 150), density=0.05, rng=rng, format="csr")
+    cost = -rng.uniform(0.5, 1.5, 150)
+    lp = LinearProgram(a, cost, backend="highspy")
+    rows = rng.uniform(0.5, 2.0, 600)
+    lp.update_bounds(row_lower=-rows, row_upper=rows, col_upper=np.full(150, 3.0))
+    interior = LinearProgram(a, cost, backend="highspy")
+    interior.update_bounds(row_lower=-rows, row_upper=rows, col_upper=np.full(150, 3.0))
+    assert interior._highs is not None
+    options = {"solver": "ipm", "run_crossover": "off", "ipm_optimality_tolerance": 1e-10}
+    for option, value in options.items():
+        interior._highs.highs.setOptionValue(option, value)
+    sol = interior.solve()
+    assert sol.status == "optimal" and sol.x is not None
+    return lp, sol.x
+
+
+def _pivots(lp: LinearProgram) -> int:
+    assert lp._highs is not None
+    return int(lp._highs.highs.getInfo().simplex_iteration_count)
+
+
+@pytest.mark.skipif(not highspy_available(), reason="highspy not installed")
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_a_start_near_the_optimum_gives_its_vertex_in_a_few_pivots(seed: int) -> None:
+    lp, near = _random_lp(seed)
+    cold = lp.solve()
+    cold_pivots = _pivots(lp)
+    lp, near = _random_lp(seed)
+    started = lp.solve(start=near)
+    assert started.status == "optimal" and started.x is not None and cold.x is not None
+    assert lp.cost @ started.x == pytest.approx(lp.cost @ cold.x, rel=1e-9)
+    assert _pivots(lp) <= max(5, cold_pivots // 10)
+
+
+@pytest.mark.skipif(not highspy_available(), reason="highspy not installed")
+def test_any_start_gives_the_optimum() -> None:
+    lp, _ = _random_lp(4)
+    cold = lp.solve()
+    assert cold.x is not None
+    for start in (np.zeros(150), np.full(150, 3.0), np.random.default_rng(0).uniform(0, 3, 150)):
+        lp, _ = _random_lp(4)
+        got = lp.solve(start=start)
+        assert got.status == "optimal" and got.x is not None
+        assert lp.cost @ got.x == pytest.approx(lp.cost @ cold.x, rel=1e-9)
+
+
+@pytest.mark.skipif(not highspy_available(), reason="highspy not installed")
+def test_a_basis_highs_cannot_go_on_from_is_dropped_for_the_last_one(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A basis HiGHS stops on ("excessive dual values", "Not Set"): solved from the last."""
+    highspy = pytest.importorskip("highspy")
+    lp, near = _random_lp(5)
+    cold = lp.solve()
+    assert cold.x is not None
+    assert lp._highs is not None
+    runs: list[float] = []
+    real_run = lp._highs._run
+
+    def first_run_fails(limit_s: float) -> object:
+        runs.append(limit_s)
+        status = real_run(limit_s)
+        return highspy.HighsModelStatus.kNotset if len(runs) == 1 else status
+
+    monkeypatch.setattr(lp._highs, "_run", first_run_fails)
+    lp.update_bounds(col_upper=np.full(150, 2.0))
+    got = lp.solve(start=near)
+    assert len(runs) == 2 and got.status == "optimal" and got.x is not None
+    check = LinearProgram(lp.a, lp.cost, backend="highspy")
+    check.update_bounds(row_lower=lp.row_lower, row_upper=lp.row_upper, col_upper=lp.col_upper)
+    ref = check.solve()
+    assert ref.x is not None
+    assert lp.cost @ got.x == pytest.approx(lp.cost @ ref.x, rel=1e-9)
+
+
+def test_no_vertex_where_fewer_bounds_than_columns() -> None:
+    if not highspy_available():
+        pytest.skip("highspy not installed")
+    a = sp.csr_array(np.array([[1.0, 1.0]]))
+    lp = LinearProgram(a, [-1.0, -1.0], backend="highspy")
+    lp.update_bounds(row_upper=np.array([1.0]), col_lower=np.full(2, -np.inf))
+    assert vertex_basis(lp, np.array([0.5, 0.5])) is None
+    sol = lp.solve(start=np.array([0.5, 0.5]))
+    assert sol.status == "optimal" and sol.x is not None
+    assert sol.x.sum() == pytest.approx(1.0)

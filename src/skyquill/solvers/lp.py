@@ -63,6 +63,7 @@ __all__ = [
     "LinearProgram",
     "highspy_available",
     "resolve_backend",
+    "vertex_basis",
 ]
 
 
@@ -201,10 +202,21 @@ class LinearProgram:
                 raise InputError(f"{name}: got shape {new.shape}, expected {old.shape}")
             setattr(self, name, new.copy())
 
-    def solve(self) -> LPSolution:
-        """Solve with the current bounds (hot start from the last basis with highspy)."""
+    def solve(self, start: FloatArray | None = None) -> LPSolution:
+        """Solve with the current bounds (hot start from the last basis with highspy).
+
+        Parameters
+        ----------
+        start : ndarray, shape (n,), optional
+            A point near an optimal vertex (an interior-point method's answer):
+            highspy starts from that vertex's basis (:func:`vertex_basis`)
+            instead of the last one.  Where the bounds changed a lot, this saves
+            the thousands of pivots the last basis needs (a coverage piece's
+            first jerk-limited LP: 4,140 pivots and 0.76 s, against 4 pivots
+            and 0.1 s with the factorisation).  linprog does not use it.
+        """
         if self._highs is not None:
-            sol = self._highs.solve(self, self.time_limit_s)
+            sol = self._highs.solve(self, self.time_limit_s, start)
             if sol is not None:  # None: stalled
                 return self._count(sol)
             logger.info("highspy stalled; linprog for the remaining solves")
@@ -290,12 +302,15 @@ class _HighsModel:
         self.rows = (np.full(m, -np.inf), np.full(m, np.inf))
         self.cols = (np.zeros(n), np.full(n, np.inf))
 
-    def solve(self, lp: LinearProgram, limit_s: float) -> LPSolution | None:
-        """Pass the changed bounds and re-solve within ``limit_s`` s; None when HiGHS stalled."""
+    def solve(
+        self, lp: LinearProgram, limit_s: float, start: FloatArray | None = None
+    ) -> LPSolution | None:
+        """Pass the changed bounds and re-solve within ``limit_s`` s, from the basis of the
+        vertex nearest ``start`` if given; None when HiGHS stalled."""
         assert _highspy is not None
         self._pass_bounds(lp)
         t0 = time.perf_counter()
-        status = self._run(limit_s)
+        status = self._run(limit_s) if start is None else self._run_from(lp, start, limit_s)
         dt = time.perf_counter() - t0
         statuses = _highspy.HighsModelStatus
         if status == statuses.kTimeLimit:
@@ -325,6 +340,28 @@ class _HighsModel:
             self.highs.changeColsBounds(idx.size, idx, _finite(lo[idx], inf), _finite(hi[idx], inf))
         self.cols = (lo.copy(), hi.copy())
 
+    def _run_from(self, lp: LinearProgram, start: FloatArray, limit_s: float) -> Any:
+        """Run from the basis of the vertex nearest ``start``; where HiGHS cannot go on
+        from it (a basis too ill-conditioned: "excessive dual values"), run again from
+        the basis it had."""
+        assert _highspy is not None
+        statuses = _highspy.HighsModelStatus
+        basis = vertex_basis(lp, start)
+        if basis is None:
+            return self._run(limit_s)
+        last = self.highs.getBasis()
+        self.highs.setBasis(basis)
+        status = self._run(limit_s)
+        if status in (statuses.kOptimal, statuses.kInfeasible, statuses.kTimeLimit):
+            return status
+        logger.info("highspy: %s from the vertex's basis; from its last basis",
+                    self.highs.modelStatusToString(status))  # fmt: skip
+        if last.valid:
+            self.highs.setBasis(last)
+        else:
+            self.highs.clearSolver()
+        return self._run(limit_s)
+
     def _run(self, limit_s: float) -> Any:
         """Run HiGHS for at most ``limit_s`` more seconds and the stall's iterations; its
         model status.
@@ -338,6 +375,46 @@ class _HighsModel:
         self.highs.setOptionValue("time_limit", float(self.highs.getRunTime()) + limit_s)
         self.highs.run()
         return self.highs.getModelStatus()
+
+
+def vertex_basis(lp: LinearProgram, x: FloatArray) -> Any | None:
+    """The HiGHS basis of the vertex nearest ``x`` (shape (n,)): the ``n`` rows and columns
+    nearest a bound are nonbasic at it, the others basic.
+
+    "Nearest" is the slack relative to the bound's size (or, for a bound of 0, to
+    ``x``'s largest entry).  From an interior-point answer converged to about
+    1e-9 this is the optimal basis: the slacks of the binding rows are 1e-7 or
+    less, the others 1e-5 or more (at 1e-6 the two overlap, and HiGHS could not
+    go on from the basis picked). HiGHS factorises the basis it is given and
+    repairs a singular one, so a poor guess costs pivots, not the answer.
+    None where fewer than ``n`` bounds are finite (no vertex).
+    """
+    assert _highspy is not None
+    values = np.concatenate([x, lp.a @ x])
+    lower = np.concatenate([lp.col_lower, lp.row_lower])
+    upper = np.concatenate([lp.col_upper, lp.row_upper])
+    size = np.maximum(_finite_abs(lower), _finite_abs(upper))
+    scale = np.maximum(size, max(float(np.max(np.abs(x), initial=0.0)), 1e-300))
+    below, above = (values - lower) / scale, (upper - values) / scale
+    at_upper = above < below
+    slack = np.where(at_upper, above, below)
+    if np.count_nonzero(np.isfinite(slack)) < x.size:
+        return None  # fewer bounds than columns: no vertex
+    nonbasic = np.argpartition(slack, x.size - 1)[: x.size]
+    codes = np.ones(values.size, dtype=np.intp)  # basic
+    codes[nonbasic] = np.where(at_upper[nonbasic], 2, 0)
+    status = _highspy.HighsBasisStatus
+    table = np.array([status.kLower, status.kBasic, status.kUpper], dtype=object)
+    basis = _highspy.HighsBasis()
+    basis.col_status = table[codes[: x.size]].tolist()
+    basis.row_status = table[codes[x.size :]].tolist()
+    basis.valid = True
+    return basis
+
+
+def _finite_abs(x: FloatArray) -> FloatArray:
+    """``|x|``, 0 where ``x`` is infinite."""
+    return np.where(np.isfinite(x), np.abs(x), 0.0)
 
 
 def _finite(x: FloatArray, inf: float) -> FloatArray:

@@ -125,7 +125,7 @@ def plan_speed(
     deadline : Deadline, optional
         A wall-time budget: checked before every LP solve, whose HiGHS time
         limit is what is left of it (see :class:`~skyquill.coverage.deadline.Deadline`).
-    method : {"auto", "reach", "banded", "lp"}, default "auto"
+    method : {"auto", "reach", "warm", "banded", "lp"}, default "auto"
         How the grid problems are solved. ``"reach"``: without a jerk limit,
         by the backward and forward reachability passes (:mod:`.reach`; the
         LP's optimum, in linear time). ``"banded"``: with a jerk limit, the
@@ -133,10 +133,14 @@ def plan_speed(
         banded interior-point method (:mod:`.banded`, linear time per Newton
         step; with a norm limit on the rows of the polygon's directions that
         can bind, :mod:`.active_rows`); without one it is ``"reach"``.
+        ``"warm"``: the jerk-free problems by the passes, the first pseudo-jerk
+        LP by the banded interior point, and every LP after it by HiGHS,
+        started from the basis of that answer's vertex, then from its own
+        (:class:`~.banded_grid.BandedGrid`); without a jerk limit ``"reach"``.
         ``"lp"``: every problem by the HiGHS grid LP (the reference).
-        ``"auto"``: ``"reach"`` without a jerk limit; with one ``"lp"`` below
-        :data:`~.validate.BANDED_FROM_POINTS` grid points (its simplex
-        re-solves from the last basis, which is faster on small grids) and
+        ``"auto"``: ``"reach"`` without a jerk limit; with one ``"warm"`` below
+        :data:`~.validate.BANDED_FROM_POINTS` grid points (the simplex
+        re-solves from its last basis, which is faster on small grids) and
         ``"banded"`` from there (``"reach"`` with a jerk limit is refused:
         its rows couple three nodes).
 
@@ -207,9 +211,9 @@ def plan_speed(
         if solver == "reach":
             lp = ReachGrid(acc, highs, deadline)
         else:
-            assert jlim is not None  # "banded" is "reach" without a jerk limit
+            assert jlim is not None  # "warm" and "banded" are "reach" without a jerk limit
             lp = BandedGrid(acc, banded_rows(acc, (p1, p2, p3), jlim * args.safety, vb), highs,
-                            deadline)  # fmt: skip
+                            deadline, hand_over=solver == "warm")  # fmt: skip
     bounds = _Bounds(ub, None if jlim is None else vb, p1.shape[1], *_ones(n))
     log: tuple[list[float], list[float]] = ([], [])
     stop = (args.jerk_iterations, args.jerk_tol)

@@ -88,7 +88,8 @@ class SpeedPlan:
         ``"uniform"`` or ``"adaptive"`` (see :func:`plan_speed`).
     method : str
         The solver that answered (``method`` of :func:`plan_speed`): ``"reach"`` (the
-        reachability passes solved every problem), ``"banded"`` or ``"lp"``.
+        reachability passes solved every problem), ``"warm"``, ``"banded"`` or ``"lp"``
+        (``"lp"`` also where HiGHS had to answer for the passes or the interior point).
     norm_sides : int or None
         None: ``amax``/``jmax`` hold per axis.  Else they are Euclidean norm
         limits, held in the LP by the inscribed polygon of this many sides

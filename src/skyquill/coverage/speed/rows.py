@@ -202,8 +202,12 @@ class _GridLP:
         """LPs solved."""
         return self.lp.solves
 
-    def solve(self, r: FloatArray, ub: FloatArray, *, rough: bool = False) -> FloatArray:
-        """Solve with row bounds ``-r <= A b <= r`` (``inf`` = free row) and ``b <= ub``.
+    def solve(
+        self, r: FloatArray, ub: FloatArray, *, rough: bool = False, start: FloatArray | None = None
+    ) -> FloatArray:
+        """Solve with row bounds ``-r <= A b <= r`` (``inf`` = free row) and ``b <= ub``; from
+        the basis of the vertex nearest ``start`` (shape (n,)) if given
+        (:meth:`~skyquill.solvers.lp.LinearProgram.solve`).
 
         With a deadline, no solve is started once it is spent, nor given more
         than what is left of it.
@@ -213,7 +217,7 @@ class _GridLP:
             self.deadline.check(step)
             self.lp.time_limit_s = max(self.deadline.remaining(), 1e-3)
         self.lp.update_bounds(row_lower=-r, row_upper=r, col_upper=ub)
-        sol = self.lp.solve()
+        sol = self.lp.solve(start)
         if sol.status == "time_limit" and self.deadline is not None:
             self.deadline.check(step)  # spent: raises with the step's name
             raise InfeasibleError(f"time_limit: stopped at {step}", (TIME_LIMIT,))

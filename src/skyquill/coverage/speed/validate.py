@@ -17,16 +17,19 @@ from skyquill.validation import FloatArray, as_float, as_int, per_axis
 #: Grid kinds of :func:`~skyquill.coverage.speed.plan_speed`.
 GRIDS = ("uniform", "adaptive")
 #: Methods of :func:`~skyquill.coverage.speed.plan_speed`.
-METHODS = ("auto", "reach", "banded", "lp")
+METHODS = ("auto", "reach", "warm", "banded", "lp")
 #: Grid points from which ``method="auto"`` solves jerk-limited problems by the banded
-#: interior point instead of the HiGHS LP. Measured end to end (``plan_speed``, one BLAS
-#: thread, a loaded 2-core machine), the banded method's time over the LP's: on the 10 m
-#: square's spiral 1.45 at 2,000 points per axis (0.7 with the 16-gon), 0.8 / 0.38 at
-#: 4,000, 0.37 / 0.21 at 8,000; a coverage piece re-solved many times (the concave hexagon
-#: of tests/coverage/test_deadline.py, 2,000 points, 16-gon, 54 solves) 2.8: the simplex
-#: re-solves from its last basis, the interior point from scratch. Coverage plans use at
-#: most 4,000 points (the last grid, tried after two failed), where a grid that collapses
-#: cost the interior point 17 s and the LP 6 s (the held-out 1.3 ha outline's spiral).
+#: interior point instead of the HiGHS LP (started at the interior point's first answer,
+#: ``"warm"``). Measured end to end (``plan_speed``, one BLAS thread, 2 cores, one run
+#: each), on the 10 m square's spiral: the banded method's time over the warm-started LP's
+#: 1.34 at 4,000 points per axis (1.12 with the 16-gon), 0.76 / 0.69 at 8,000. Before the
+#: warm start, the banded method's over the LP's was 1.45 at 2,000 points per axis (0.7
+#: with the 16-gon), 0.8 / 0.38 at 4,000, 0.37 / 0.21 at 8,000, and 2.8 on a coverage
+#: piece re-solved many times (the concave hexagon of tests/coverage/test_deadline.py,
+#: 2,000 points, 16-gon, 54 solves): the simplex re-solves from its last basis, the
+#: interior point from scratch. Coverage plans use at most 4,000 points (the last grid,
+#: tried after two failed), where a grid that collapses cost the interior point 17 s and
+#: the LP 6 s (the held-out 1.3 ha outline's spiral).
 BANDED_FROM_POINTS = 8000
 #: Fewest sides of the polygon that holds a norm limit.
 MIN_NORM_SIDES = 4
@@ -121,20 +124,21 @@ def _validate_limits(
 
 
 def _validate_method(method: object, *, jerk: bool, n: int) -> str:
-    """``"reach"``, ``"banded"`` or ``"lp"``: the solver ``method`` names for a problem with or
-    without jerk on ``n`` grid points (without a jerk limit ``"banded"`` is ``"reach"``: the
-    same passes answer; ``"auto"`` with jerk is ``"banded"`` from :data:`BANDED_FROM_POINTS`)."""
+    """``"reach"``, ``"warm"``, ``"banded"`` or ``"lp"``: the solver ``method`` names for a
+    problem with or without jerk on ``n`` grid points (without a jerk limit ``"warm"`` and
+    ``"banded"`` are ``"reach"``: the same passes answer; ``"auto"`` with jerk is ``"warm"``
+    below :data:`BANDED_FROM_POINTS` and ``"banded"`` from there)."""
     if method not in METHODS:
         raise InputError(f"method: got {method!r}, expected one of {METHODS}")
     if method == "reach" and jerk:
         raise InputError(
-            "method: got 'reach' with a jerk limit, expected 'banded', 'lp' or 'auto' (the "
+            "method: got 'reach' with a jerk limit, expected 'warm', 'banded', 'lp' or 'auto' (the "
             "passes hold speed and acceleration; jerk rows couple three nodes)"
         )
     if method == "auto":
         if not jerk:
             return "reach"
-        return "banded" if n >= BANDED_FROM_POINTS else "lp"
-    if method == "banded" and not jerk:
+        return "banded" if n >= BANDED_FROM_POINTS else "warm"
+    if method in ("warm", "banded") and not jerk:
         return "reach"
     return str(method)
