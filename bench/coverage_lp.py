@@ -48,9 +48,10 @@ adaptive grid, which ``plan_speed`` solves, and a uniform one):
    ``acceleration_only`` (vmax 100 m/s); the grid LP (``method="lp"``) as
    the reference up to :data:`LP_MAX_POINTS`; with jerk (jmax 3 m/s^3) the
    pseudo-jerk iteration solved by the banded interior point
-   (``method="banded"``, to 32,000 points) and by the HiGHS LP
-   (``method="lp"``, up to :data:`LP_JERK_MAX_POINTS`), interleaved; ``auto``
-   is whichever of the two ``plan_speed`` picks at that size
+   (``method="banded"``, to 32,000 points), by the HiGHS LP (``method="lp"``)
+   and by the HiGHS LP warm-started at the interior point's first answer
+   (``method="warm"``), both up to :data:`LP_JERK_MAX_POINTS`, interleaved;
+   ``auto`` is whichever ``plan_speed`` picks at that size
    (``BANDED_FROM_POINTS``), and ``jerk_on.over_jerk_off`` its time over the
    jerk-free plan's.
    Log-log slopes from 2,000 to 32,000 points, time ratios ours / toppra,
@@ -381,15 +382,17 @@ def scaling_case(runs: int, points: tuple[int, ...]) -> dict[str, Any]:
 
 
 def jerk_on(curve: Any, n: int, runs: int, jerk_off_s: float) -> dict[str, Any]:
-    """The jerk-limited plan by the banded interior point and (to LP_JERK_MAX_POINTS) the LP."""
+    """The jerk-limited plan by the banded interior point and (to LP_JERK_MAX_POINTS) the LP
+    and the warm-started LP."""
     calls: dict[str, Callable[[], Any]] = {
         "banded": lambda: plan_speed(curve, VMAX, AMAX, JMAX, n=n, method="banded")
     }
     if n <= LP_JERK_MAX_POINTS:
         calls["lp"] = lambda: plan_speed(curve, VMAX, AMAX, JMAX, n=n, method="lp")
+        calls["warm"] = lambda: plan_speed(curve, VMAX, AMAX, JMAX, n=n, method="warm")
     got = _interleaved(calls, runs)
     med, res = got["median_s"], got["results"]
-    auto = "banded" if n >= BANDED_FROM_POINTS else "lp"
+    auto = "banded" if n >= BANDED_FROM_POINTS else "warm"
     entry: dict[str, Any] = {
         "median_s": med,
         "duration_s": {k: v.duration for k, v in res.items()},
@@ -401,6 +404,8 @@ def jerk_on(curve: Any, n: int, runs: int, jerk_off_s: float) -> dict[str, Any]:
     if "lp" in med:
         entry["time_ratio_banded_over_lp"] = med["banded"] / med["lp"]
         entry["duration_ratio_banded_over_lp"] = res["banded"].duration / res["lp"].duration
+        entry["time_ratio_warm_over_lp"] = med["warm"] / med["lp"]
+        entry["duration_ratio_warm_over_lp"] = res["warm"].duration / res["lp"].duration
     return entry
 
 
@@ -447,7 +452,7 @@ def print_scaling(case: dict[str, Any]) -> None:
             j = r["jerk_on"]
             line += f"  jerk on: banded {j['median_s']['banded']:.3f} s"
             if "lp" in j["median_s"]:
-                line += f" lp {j['median_s']['lp']:.3f} s"
+                line += f" lp {j['median_s']['lp']:.3f} s warm {j['median_s']['warm']:.3f} s"
             line += f" (auto = {j['auto']}: x{j['over_jerk_off'] or float('nan'):.1f} jerk off)"
         print(line)
     print(f"log-log slopes from 2,000 points: {case['loglog_slope_2000_up']}")
