@@ -174,6 +174,23 @@ def test_the_warm_start_takes_the_lps_own_answers_in_fewer_pivots(sides: int | N
     assert pivots["warm"] < 0.5 * pivots["lp"]
 
 
+def test_a_stalled_warm_start_starts_again_from_the_interior_point(
+    monkeypatch: pytest.MonkeyPatch, caplog: pytest.LogCaptureFixture
+) -> None:
+    """Every hot re-solve told stalled at once: each starts again from the interior point's
+    vertex, HiGHS keeps answering (not linprog), and the plan is still the LP's."""
+    from skyquill.solvers import lp as lp_module
+
+    lp = plan_speed(square_spiral(), 3.0, 5.0, 3.0, n=500, norm_sides=16, method="lp")
+    monkeypatch.setattr(lp_module, "RESTART_ITERATIONS_PER_COLUMN", 0)
+    with caplog.at_level("INFO", logger="skyquill.solvers.lp"):
+        warm = plan_speed(square_spiral(), 3.0, 5.0, 3.0, n=500, norm_sides=16, method="warm")
+    messages = [r.getMessage() for r in caplog.records]
+    assert any("from the vertex of the restart point" in m for m in messages)
+    assert not any("linprog" in m for m in messages)
+    assert warm.duration == pytest.approx(lp.duration, rel=1e-6)
+
+
 def _count_pivots() -> Callable[[], int]:
     """A counter of the simplex pivots of every HiGHS solve from now on."""
     from skyquill.solvers import lp as lp_module
@@ -181,8 +198,10 @@ def _count_pivots() -> Callable[[], int]:
     total = [0]
     run = lp_module._HighsModel._run
 
-    def counting(self: lp_module._HighsModel, limit_s: float) -> object:
-        status = run(self, limit_s)
+    def counting(
+        self: lp_module._HighsModel, limit_s: float, per_column: float | None = None
+    ) -> object:
+        status = run(self, limit_s, per_column)
         total[0] += max(int(self.highs.getInfo().simplex_iteration_count), 0)
         return status
 

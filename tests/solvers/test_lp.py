@@ -220,3 +220,34 @@ def test_no_vertex_where_fewer_bounds_than_columns() -> None:
     sol = lp.solve(start=np.array([0.5, 0.5]))
     assert sol.status == "optimal" and sol.x is not None
     assert sol.x.sum() == pytest.approx(1.0)
+
+
+@pytest.mark.skipif(not highspy_available(), reason="highspy not installed")
+def test_a_stalled_hot_start_starts_again_from_the_restart_point(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """With a restart point the stall is told early and HiGHS, not linprog, answers."""
+    lp, near = _random_lp(6)
+    lp.solve()
+    moved = lp.row_upper * np.random.default_rng(7).uniform(0.3, 1.0, lp.row_upper.size)
+    lp.update_bounds(row_lower=-moved, row_upper=moved)  # pivots to make from the last basis
+    check = LinearProgram(lp.a, lp.cost, backend="highspy")
+    check.update_bounds(row_lower=lp.row_lower, row_upper=lp.row_upper, col_upper=lp.col_upper)
+    cold = check.solve()
+    assert cold.x is not None
+    monkeypatch.setattr(lp_module, "RESTART_ITERATIONS_PER_COLUMN", 0)
+    asked: list[int] = []
+
+    def restart() -> FloatArray:
+        asked.append(1)
+        return near
+
+    got = lp.solve(restart=restart)
+    assert asked == [1] and got.solver == "highspy" and lp.backend == "highspy"
+    assert got.status == "optimal" and got.x is not None
+    assert lp.cost @ got.x == pytest.approx(lp.cost @ cold.x, rel=1e-9)
+    # No restart point: linprog, for good, as before.
+    moved = lp.row_upper * np.random.default_rng(8).uniform(0.3, 1.0, lp.row_upper.size)
+    lp.update_bounds(row_lower=-moved, row_upper=moved)
+    got = lp.solve(restart=lambda: None)
+    assert got.solver == "linprog" and lp.backend == "linprog"

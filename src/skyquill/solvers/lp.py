@@ -9,7 +9,8 @@ linearisation, a local tightening) keeps one :class:`LinearProgram`:
   optimal basis (tens of pivots instead of a cold solve).  A solve that ends
   neither optimal nor infeasible (a stalled hot start: more simplex
   iterations than :data:`HOT_SOLVE_ITERATIONS_PER_COLUMN` per column) switches
-  the instance to ``"linprog"`` for good. The stall is told by iterations,
+  the instance to ``"linprog"`` for good, unless the caller gives a point to
+  start again from (``restart``). The stall is told by iterations,
   not wall time, so that the same problem takes the same path on a busy
   machine (a 0.5 s limit sent plans to the slow cold solves under load).
 * ``"linprog"`` rebuilds the rows for :func:`scipy.optimize.linprog` (HiGHS,
@@ -53,10 +54,18 @@ LP_BACKENDS = ("auto", "highspy", "linprog")
 #: Simplex iterations per column after which a hot start counts as stalled (cold
 #: solves of the coverage speed LP took 0.6-1.7 per column, hot ones a few in all).
 HOT_SOLVE_ITERATIONS_PER_COLUMN = 20
+#: With a point to start again from (``restart`` of :meth:`LinearProgram.solve`), the
+#: simplex iterations per column after which a hot start is given up for it: 860
+#: warm-started re-solves of the coverage speed LP on three keep-out fields took at most
+#: 0.31 per column; one stalled at 20 (40,000 pivots, 8.6 s, then linprog for every solve
+#: after it) where starting again from the interior point's answer took 0.14 s, about the
+#: time of 500 pivots, so giving up early costs little.
+RESTART_ITERATIONS_PER_COLUMN = 0.5
 
 __all__ = [
     "HOT_SOLVE_ITERATIONS_PER_COLUMN",
     "LP_BACKENDS",
+    "RESTART_ITERATIONS_PER_COLUMN",
     "LPBackend",
     "LPSolution",
     "LPStatus",
@@ -202,7 +211,11 @@ class LinearProgram:
                 raise InputError(f"{name}: got shape {new.shape}, expected {old.shape}")
             setattr(self, name, new.copy())
 
-    def solve(self, start: FloatArray | None = None) -> LPSolution:
+    def solve(
+        self,
+        start: FloatArray | None = None,
+        restart: Callable[[], FloatArray | None] | None = None,
+    ) -> LPSolution:
         """Solve with the current bounds (hot start from the last basis with highspy).
 
         Parameters
@@ -214,9 +227,19 @@ class LinearProgram:
             the thousands of pivots the last basis needs (a coverage piece's
             first jerk-limited LP: 4,140 pivots and 0.76 s, against 4 pivots
             and 0.1 s with the factorisation).  linprog does not use it.
+        restart : callable, optional
+            Gives such a point (or None) where highspy's hot start stalls, told
+            by :data:`RESTART_ITERATIONS_PER_COLUMN`: highspy solves again from
+            its vertex before linprog takes over.
         """
         if self._highs is not None:
-            sol = self._highs.solve(self, self.time_limit_s, start)
+            began = time.perf_counter()
+            per_column = None if restart is None else RESTART_ITERATIONS_PER_COLUMN
+            sol = self._highs.solve(self, self.time_limit_s, start, per_column=per_column)
+            if sol is None and restart is not None and (point := restart()) is not None:
+                logger.info("highspy stalled; from the vertex of the restart point")
+                left = max(self.time_limit_s - (time.perf_counter() - began), 1e-3)
+                sol = self._highs.solve(self, left, point)
             if sol is not None:  # None: stalled
                 return self._count(sol)
             logger.info("highspy stalled; linprog for the remaining solves")
@@ -303,14 +326,23 @@ class _HighsModel:
         self.cols = (np.zeros(n), np.full(n, np.inf))
 
     def solve(
-        self, lp: LinearProgram, limit_s: float, start: FloatArray | None = None
+        self,
+        lp: LinearProgram,
+        limit_s: float,
+        start: FloatArray | None = None,
+        *,
+        per_column: float | None = None,
     ) -> LPSolution | None:
         """Pass the changed bounds and re-solve within ``limit_s`` s, from the basis of the
-        vertex nearest ``start`` if given; None when HiGHS stalled."""
+        vertex nearest ``start`` if given; None when HiGHS stalled (more simplex iterations
+        than ``per_column`` per column, by default :data:`HOT_SOLVE_ITERATIONS_PER_COLUMN`)."""
         assert _highspy is not None
         self._pass_bounds(lp)
         t0 = time.perf_counter()
-        status = self._run(limit_s) if start is None else self._run_from(lp, start, limit_s)
+        if start is None:
+            status = self._run(limit_s, per_column)
+        else:
+            status = self._run_from(lp, start, limit_s)
         dt = time.perf_counter() - t0
         statuses = _highspy.HighsModelStatus
         if status == statuses.kTimeLimit:
@@ -362,15 +394,17 @@ class _HighsModel:
             self.highs.clearSolver()
         return self._run(limit_s)
 
-    def _run(self, limit_s: float) -> Any:
-        """Run HiGHS for at most ``limit_s`` more seconds and the stall's iterations; its
+    def _run(self, limit_s: float, per_column: float | None = None) -> Any:
+        """Run HiGHS for at most ``limit_s`` more seconds and ``per_column`` simplex
+        iterations per column (:data:`HOT_SOLVE_ITERATIONS_PER_COLUMN` by default); its
         model status.
 
         HiGHS's ``time_limit`` counts the instance's run time over all solves,
         so the limit is set relative to the time already spent; its iteration
         count starts again at every run.
         """
-        iterations = HOT_SOLVE_ITERATIONS_PER_COLUMN * max(int(self.highs.getNumCol()), 1)
+        per_column = HOT_SOLVE_ITERATIONS_PER_COLUMN if per_column is None else per_column
+        iterations = math.ceil(per_column * self.highs.getNumCol())
         self.highs.setOptionValue("simplex_iteration_limit", iterations)
         self.highs.setOptionValue("time_limit", float(self.highs.getRunTime()) + limit_s)
         self.highs.run()

@@ -24,7 +24,12 @@ import numpy as np
 
 from skyquill.coverage.deadline import Deadline
 from skyquill.coverage.speed.active_rows import KEEP, solve_active_rows
-from skyquill.coverage.speed.banded import TOLERANCE, BandedRows, solve_banded_lp
+from skyquill.coverage.speed.banded import (
+    TOLERANCE,
+    BandedRows,
+    BandedSolution,
+    solve_banded_lp,
+)
 from skyquill.coverage.speed.reach import AccelerationRows, ReachPass
 from skyquill.coverage.speed.rows import _GridLP, jerk_coefficients
 from skyquill.validation import FloatArray
@@ -156,33 +161,49 @@ class BandedGrid:
         if self.deadline is not None:
             self.deadline.check(f"speed solve {self.solves + 1}")
         if self.hand_over and self._lp is not None:
-            return self._lp.solve(r, ub)
+            return self._lp.solve(r, ub, restart=lambda: self._restart_point(r, ub))
         n = ub.size
         bound = row_bounds(r, n, self.q)
         if not np.any(np.isfinite(bound[2 * self.q :])):
             b = self.passes.solve(r[: n - 1], ub)
             if b is not None:
                 return b
-        start = time.perf_counter()
         # The LP's vertex is read from the answer: only a tight one tells it (vertex_basis).
-        tol = ROUGH_TOLERANCE if rough and not self.hand_over else TOLERANCE
-        if self._last is not None and self.q > KEEP:
-            # A polygon's directions: only the few nearest the vector can bind.
-            sol, solves = solve_active_rows(self.rows, bound, ub, guess=self._last, blocks=3,
-                                            tolerance=tol)  # fmt: skip
-        else:
-            sol, solves = solve_banded_lp(self.rows, bound, ub, np.ones(n), tolerance=tol), 1
-        self.ipm_time += time.perf_counter() - start
-        self.ipm_solves += solves
-        self.ipm_iterations += sol.iterations
+        sol = self._interior(
+            bound, ub, ROUGH_TOLERANCE if rough and not self.hand_over else TOLERANCE
+        )
         if sol.status != "optimal":
             _log.info("banded interior point did not converge (%s); HiGHS answers", sol.status)
             return self._highs(r, ub)
-        self._last = sol.b
         if not self.hand_over:
             return sol.b
         self._lp = self._build_lp()
         return self._lp.solve(r, ub, start=sol.b)
+
+    def _interior(self, bound: FloatArray, ub: FloatArray, tolerance: float) -> BandedSolution:
+        """The interior point's answer for the per-node row bounds ``bound`` (3 q, n)."""
+        start = time.perf_counter()
+        if self._last is not None and self.q > KEEP:
+            # A polygon's directions: only the few nearest the vector can bind.
+            sol, solves = solve_active_rows(self.rows, bound, ub, guess=self._last, blocks=3,
+                                            tolerance=tolerance)  # fmt: skip
+        else:
+            sol, solves = (
+                solve_banded_lp(self.rows, bound, ub, np.ones(ub.size), tolerance=tolerance),
+                1,
+            )
+        self.ipm_time += time.perf_counter() - start
+        self.ipm_solves += solves
+        self.ipm_iterations += sol.iterations
+        if sol.status == "optimal":
+            self._last = sol.b
+        return sol
+
+    def _restart_point(self, r: FloatArray, ub: FloatArray) -> FloatArray | None:
+        """Where HiGHS's hot start stalled: the interior point's answer (None if it has
+        none), whose vertex HiGHS starts again from."""
+        sol = self._interior(row_bounds(r, ub.size, self.q), ub, TOLERANCE)
+        return sol.b if sol.status == "optimal" else None
 
     def _highs(self, r: FloatArray, ub: FloatArray) -> FloatArray:
         """The HiGHS LP's answer where the passes or the interior point gave none."""

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, Protocol
 
@@ -203,10 +204,17 @@ class _GridLP:
         return self.lp.solves
 
     def solve(
-        self, r: FloatArray, ub: FloatArray, *, rough: bool = False, start: FloatArray | None = None
+        self,
+        r: FloatArray,
+        ub: FloatArray,
+        *,
+        rough: bool = False,
+        start: FloatArray | None = None,
+        restart: Callable[[], FloatArray | None] | None = None,
     ) -> FloatArray:
         """Solve with row bounds ``-r <= A b <= r`` (``inf`` = free row) and ``b <= ub``; from
-        the basis of the vertex nearest ``start`` (shape (n,)) if given
+        the basis of the vertex nearest ``start`` (shape (n,)) if given, and from the one
+        nearest ``restart()`` where the hot start stalls
         (:meth:`~skyquill.solvers.lp.LinearProgram.solve`).
 
         With a deadline, no solve is started once it is spent, nor given more
@@ -217,7 +225,7 @@ class _GridLP:
             self.deadline.check(step)
             self.lp.time_limit_s = max(self.deadline.remaining(), 1e-3)
         self.lp.update_bounds(row_lower=-r, row_upper=r, col_upper=ub)
-        sol = self.lp.solve(start)
+        sol = self.lp.solve(start, restart)
         if sol.status == "time_limit" and self.deadline is not None:
             self.deadline.check(step)  # spent: raises with the step's name
             raise InfeasibleError(f"time_limit: stopped at {step}", (TIME_LIMIT,))
