@@ -10,7 +10,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from skyquill.errors import InputError
-from skyquill.painting.wall import Placement, Wall, parse_angles, rot2
+from skyquill.painting.wall import KINK_TOLERANCE_M, Placement, Wall, parse_angles, rot2
 
 
 def test_placement_round_trip_and_eq1() -> None:
@@ -124,7 +124,9 @@ def test_recess_depths() -> None:
 
 
 def _hit_one_by_one(wall: Wall, start: np.ndarray, direction: np.ndarray) -> float:
-    """The ray's hit tried segment by segment (the definition the vectorised one keeps)."""
+    """The ray's hit tried segment by segment (the definition the vectorised one keeps): the
+    first segment whose line the ray meets within that segment, up to round-off."""
+    edges = [-math.inf, *wall.breaks_m.tolist(), math.inf]
     for k in range(wall.n_segments):
         anchor, u = wall.line(k)
         n = np.array([-u[1], u[0]])
@@ -132,9 +134,18 @@ def _hit_one_by_one(wall: Wall, start: np.ndarray, direction: np.ndarray) -> flo
         if along <= 1e-12:
             continue
         t = float((anchor - start) @ n) / along
-        if int(wall.segment_of(np.array([start[0] + t * direction[0]]))[0]) == k:
+        x = start[0] + t * direction[0]
+        if edges[k] - KINK_TOLERANCE_M <= x <= edges[k + 1] + KINK_TOLERANCE_M:
             return t
     return math.inf
+
+
+def test_a_ray_from_a_kink_of_the_wall_hits_it_there() -> None:
+    # Hypothesis: the ray from the kink between a 0 and a 1 deg segment found no wall
+    # (inf): round-off put each line's root just inside the other segment.
+    wall = Wall.segmented([0.0, 0.0, 1.0, 0.0], (-2.0, 2.0))
+    direction = rot2(math.radians(1.0)) @ np.array([0.0, 1.0])
+    assert wall.hit(np.zeros(2), direction) == pytest.approx(0.0, abs=1e-12)
 
 
 @settings(max_examples=60, deadline=None)

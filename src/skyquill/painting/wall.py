@@ -35,6 +35,9 @@ from skyquill.validation import FloatArray, as_array, as_float
 #: Largest segment angle accepted, deg: a steeper segment is no longer a wall in front of the
 #: drone (``y = f(x)`` would not be a function).
 MAX_WALL_ANGLE_DEG = 60.0
+#: How far outside its segment a ray's root on that segment's line still counts as a hit,
+#: m: round-off at a kink of the wall (see :meth:`Wall.hit`).
+KINK_TOLERANCE_M = 1e-9
 
 
 def rot2(angle: float) -> FloatArray:
@@ -309,14 +312,18 @@ class Wall:
         when the ray is parallel to the wall. With segments within +-60 deg and a direction
         within 90 deg of every normal, ``g(t) = y(t) - f(x(t))`` increases with ``t``, so the
         root is unique: each segment's line is tried and the root inside that segment kept.
+        A root within :data:`KINK_TOLERANCE_M` of its segment counts: a ray through a kink
+        of the wall finds it on both segments' lines, and round-off can put each of them
+        just inside the other segment (a ray from the kink itself found no wall).
         """
         along = self._normals @ direction
         facing = along > 1e-12
         with np.errstate(divide="ignore", invalid="ignore"):
             t = np.einsum("kj,kj->k", self._anchors - start, self._normals) / along
-        x = start[0] + t * direction[0]
-        own = facing & (self.segment_of(np.where(facing, x, 0.0)) == np.arange(self.n_segments))
-        hits = np.flatnonzero(own)
+        x = np.where(facing, start[0] + t * direction[0], np.nan)
+        lower = np.concatenate([[-np.inf], self.breaks_m]) - KINK_TOLERANCE_M
+        upper = np.concatenate([self.breaks_m, [np.inf]]) + KINK_TOLERANCE_M
+        hits = np.flatnonzero((x >= lower) & (x <= upper))
         return float(t[hits[0]]) if hits.size else math.inf
 
     def foot(self, p_w: FloatArray) -> FloatArray:
