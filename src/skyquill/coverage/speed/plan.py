@@ -89,8 +89,9 @@ def plan_speed(
     max_excess : float or None, default 0.02
         Target of the local refinement: while the interpolated plan exceeds a
         limit by more than this (relative, measured on the chain-rule
-        derivatives at >= 8 points per grid interval and at least every
-        ``control_period / 10``), the limits of the grid nodes around the
+        derivatives at >= 3 even points per grid interval, 24 up to 2,000
+        points, at its end from the left and at the path's kinks, where the
+        dense check looks), the limits of the grid nodes around the
         excess are divided by ``(1 + excess)**r`` in round ``r = 1, 2, ...``
         and the LP is re-solved from the previous basis.  None disables the
         refinement.  The result is in ``SpeedPlan.excess_estimate``; it may

@@ -79,9 +79,8 @@ class SpeedPlan:
         Rounds of local limit tightening (see ``max_excess`` of :func:`plan_speed`).
     excess_estimate : float
         Largest relative excess of the interpolated plan over a limit, from
-        the chain-rule derivatives at >= 8 points per grid interval and at
-        least every ``control_period / 10`` (what :meth:`verify` measures by
-        finite differences, up to sampling).
+        the chain-rule derivatives where :meth:`verify` looks (see
+        ``max_excess`` of :func:`plan_speed`), up to the timing law it flies.
     lp_solves : int
         Number of LPs solved.
     grid : str
