@@ -415,13 +415,14 @@ def vertex_basis(lp: LinearProgram, x: FloatArray) -> Any | None:
     """The HiGHS basis of the vertex nearest ``x`` (shape (n,)): the ``n`` rows and columns
     nearest a bound are nonbasic at it, the others basic.
 
-    "Nearest" is the slack relative to the bound's size (or, for a bound of 0, to
-    ``x``'s largest entry).  From an interior-point answer converged to about
-    1e-9 this is the optimal basis: the slacks of the binding rows are 1e-7 or
-    less, the others 1e-5 or more (at 1e-6 the two overlap, and HiGHS could not
-    go on from the basis picked). HiGHS factorises the basis it is given and
-    repairs a singular one, so a poor guess costs pivots, not the answer.
-    None where fewer than ``n`` bounds are finite (no vertex).
+    "Nearest" is the slack relative to the larger of the bound's size and ``x``'s
+    largest entry (a bound of 0 has no size of its own).  From an interior-point
+    answer converged to about 1e-9 this is the optimal basis: the slacks of the
+    binding rows are 1e-7 or less, the others 1e-5 or more (at 1e-6 the two
+    overlap, and HiGHS could not go on from the basis picked). HiGHS factorises
+    the basis it is given and repairs a singular one, so a poor guess costs
+    pivots, not the answer. None where fewer than ``n`` bounds are finite (no
+    vertex).
     """
     assert _highspy is not None
     values = np.concatenate([x, lp.a @ x])

@@ -191,7 +191,7 @@ def _interval_excess(plan: SpeedPlan) -> tuple[FloatArray, FloatArray, FloatArra
     even = sig[:-1, None] + (sig[1] - sig[0]) * (np.arange(m) / m)[None, :]
     us = np.column_stack([even, np.nextafter(sig[1:], -np.inf)]).ravel()
     ex = [np.maximum(x.reshape(sig.size - 1, m + 1).max(axis=1) - 1.0, 0.0)
-          for x in _ratios(plan, np.minimum(us, 1.0))]  # fmt: skip
+          for x in _ratios(plan, us)]  # fmt: skip
     # The path's kinks (its curve's knots): the jerk peaks there, between the samples.
     kinks = _kinks(plan)
     if kinks.size:

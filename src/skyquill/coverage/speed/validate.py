@@ -20,16 +20,17 @@ GRIDS = ("uniform", "adaptive")
 METHODS = ("auto", "reach", "warm", "banded", "lp")
 #: Grid points from which ``method="auto"`` solves jerk-limited problems by the banded
 #: interior point instead of the HiGHS LP (started at the interior point's first answer,
-#: ``"warm"``). Measured end to end (``plan_speed``, one BLAS thread, 2 cores, one run
-#: each), on the 10 m square's spiral: the banded method's time over the warm-started LP's
-#: 1.34 at 4,000 points per axis (1.12 with the 16-gon), 0.76 / 0.69 at 8,000. Before the
-#: warm start, the banded method's over the LP's was 1.45 at 2,000 points per axis (0.7
-#: with the 16-gon), 0.8 / 0.38 at 4,000, 0.37 / 0.21 at 8,000, and 2.8 on a coverage
-#: piece re-solved many times (the concave hexagon of tests/coverage/test_deadline.py,
-#: 2,000 points, 16-gon, 54 solves): the simplex re-solves from its last basis, the
-#: interior point from scratch. Coverage plans use at most 4,000 points (the last grid,
-#: tried after two failed), where a grid that collapses cost the interior point 17 s and
-#: the LP 6 s (the held-out 1.3 ha outline's spiral).
+#: ``"warm"``). Measured end to end (``plan_speed``, one BLAS thread, 2 cores), on the
+#: 10 m square's spiral per axis (bench/coverage_lp.py --scaling-only, session 38, 3 runs,
+#: medians): the banded method's time over the warm-started LP's 2.4 at 500 points, 2.3 at
+#: 2,000, 1.27 at 4,000, 0.78 at 8,000 (with the 16-gon, one run each: 1.12 at 4,000,
+#: 0.69 at 8,000). Before the warm start, the banded method's over the LP's was 1.45 at
+#: 2,000 points per axis (0.7 with the 16-gon), 0.8 / 0.38 at 4,000, 0.37 / 0.21 at
+#: 8,000, and 2.8 on a coverage piece re-solved many times (the concave hexagon of
+#: tests/coverage/test_deadline.py, 2,000 points, 16-gon, 54 solves): the simplex
+#: re-solves from its last basis, the interior point from scratch. Coverage plans use at
+#: most 4,000 points (the last grid, tried after two failed), where a grid that collapses
+#: cost the interior point 17 s and the LP 6 s (the held-out 1.3 ha outline's spiral).
 BANDED_FROM_POINTS = 8000
 #: Fewest sides of the polygon that holds a norm limit.
 MIN_NORM_SIDES = 4
