@@ -46,3 +46,16 @@ def test_where_says_where_the_work_runs_in_a_persons_words() -> None:
     assert Where(scheduler="tcp://10.0.0.5:8786").describe() == (
         "the dask cluster at tcp://10.0.0.5:8786"
     )
+
+
+def _blas_threads(_: int) -> int:
+    """The most threads any BLAS or OpenMP library of this process would use."""
+    from threadpoolctl import threadpool_info
+
+    return max((int(pool["num_threads"]) for pool in threadpool_info()), default=1)
+
+
+def test_a_pool_worker_keeps_its_blas_to_one_thread() -> None:
+    # Two workers on two cores with a BLAS thread per core each ran four threads: the
+    # held-out 1.3 ha field planned in 8.7-9.0 s at once against 4.6 s.
+    assert parallel_map(_blas_threads, [0, 1, 2, 3], workers=2) == [1, 1, 1, 1]

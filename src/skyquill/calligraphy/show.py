@@ -34,7 +34,7 @@ from skyquill.calligraphy.mission import (
     plan_writing,
 )
 from skyquill.errors import InputError
-from skyquill.parallel import dask_client
+from skyquill.parallel import dask_client, one_blas_thread
 from skyquill.phases import MIN_ALTITUDE_M, check_min_altitude
 from skyquill.strokes import Strokes
 from skyquill.validation import FloatArray, as_float, as_int
@@ -335,7 +335,7 @@ def _plan_all(
             missions.append(_plan(job))
             steps.planned(i, len(jobs))
         return missions
-    pool = ProcessPoolExecutor(max_workers=workers)
+    pool = ProcessPoolExecutor(max_workers=workers, initializer=one_blas_thread)
     try:
         futures = [pool.submit(_plan, job) for job in jobs]
         return _collect(futures, as_completed(futures), steps)
