@@ -107,8 +107,7 @@ class RetimedPath:
 
     @cached_property
     def _kink_times(self) -> FloatArray:
-        knots = np.unique(np.asarray(self.curve.t, dtype=np.float64))
-        knots = knots[(knots > 0.0) & (knots < 1.0)]
+        knots = interior_knots(self.curve)
         # Each knot bracketed by the law's breakpoints, then bisected there.
         breaks = self.timing.breakpoints
         at_breaks = self.timing.evaluate(breaks)[:, 0]
@@ -181,6 +180,13 @@ def _chain_rule(order: int, u: list[FloatArray], c: list[FloatArray]) -> FloatAr
         return c[3] * u1**3 + 3.0 * c[2] * u1 * u2 + c[1] * u3
     u4 = u[4]
     return c[4] * u1**4 + 6.0 * c[3] * u1**2 * u2 + c[2] * (3.0 * u2**2 + 4.0 * u1 * u3) + c[1] * u4
+
+
+def interior_knots(spline: object) -> FloatArray:
+    """The distinct knots strictly inside (0, 1) of a B-spline (none for another curve)."""
+    knots = np.unique(np.asarray(getattr(spline, "t", ()), dtype=np.float64))
+    inside: FloatArray = knots[(knots > 0.0) & (knots < 1.0)]
+    return inside
 
 
 #: Bisection steps: a bracket of the flight's length (or of [0, 1]) narrowed below a

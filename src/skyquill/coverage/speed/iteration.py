@@ -11,7 +11,7 @@ from skyquill.coverage.speed.curve import _derivs3
 from skyquill.coverage.speed.norms import limit_ratio
 from skyquill.coverage.speed.profile import SpeedPlan, _interval_times, _profile_spline
 from skyquill.coverage.speed.rows import GridSolver, _Bounds, _end_caps
-from skyquill.trajectory.retimed import increasing_preimage
+from skyquill.trajectory.retimed import increasing_preimage, interior_knots
 from skyquill.validation import FloatArray
 
 #: Even points per grid interval at which the refinement checks the plan (the dense check
@@ -216,18 +216,11 @@ def _ratios(plan: SpeedPlan, us: FloatArray) -> list[FloatArray]:
 def _kinks(plan: SpeedPlan) -> FloatArray:
     """The grid parameters (K,) of the path's kinks: its curve's interior knots (a B-spline
     curve's), and on an adaptive grid its map's, where the map takes the curve's there."""
-    knots = _interior_knots(plan.curve)
+    knots = interior_knots(plan.curve)
     if plan._umap is None:
         return knots
     sigma = increasing_preimage(plan._umap, knots, np.zeros(knots.size), np.ones(knots.size))
-    return np.sort(np.concatenate([sigma, _interior_knots(plan._umap)]))
-
-
-def _interior_knots(spline: object) -> FloatArray:
-    """The distinct knots strictly inside (0, 1) of a B-spline (none for another curve)."""
-    knots = np.unique(np.asarray(getattr(spline, "t", ()), dtype=np.float64))
-    inside: FloatArray = knots[(knots > 0.0) & (knots < 1.0)]
-    return inside
+    return np.sort(np.concatenate([sigma, interior_knots(plan._umap)]))
 
 
 def _spread(x: FloatArray, lo: int, hi: int, size: int) -> FloatArray:
