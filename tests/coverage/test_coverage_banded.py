@@ -20,9 +20,9 @@ from scipy.interpolate import BSpline
 from speed_curves import square_spiral, wiggle
 
 from skyquill.coverage.speed import plan_speed
-from skyquill.coverage.speed.active_rows import solve_active_rows
+from skyquill.coverage.speed.active_rows import KEEP, nearest_rows, row_ratios, solve_active_rows
 from skyquill.coverage.speed.banded import BandedRows, solve_banded_lp
-from skyquill.coverage.speed.banded_grid import banded_rows, row_bounds
+from skyquill.coverage.speed.banded_grid import banded_rows, lp_rows, row_bounds
 from skyquill.coverage.speed.curve import _derivs3
 from skyquill.coverage.speed.norms import component_limits, components
 from skyquill.coverage.speed.reach import acceleration_rows
@@ -107,6 +107,31 @@ def test_the_rows_that_bind_give_the_whole_lps_optimum(guess: str) -> None:
                                     tolerance=1e-9)  # fmt: skip
     assert got.status == "optimal" and solves >= 1
     _holds_and_equals_highs(lp, got.b)
+
+
+@pytest.mark.parametrize("guess", ["free", "zero"])
+def test_highs_on_the_rows_that_bind_gives_the_whole_lps_optimum(guess: str) -> None:
+    # HiGHS given the rows nearest their bound at a guess (or, at zero, rows at random):
+    # every answer is checked against all rows and the broken ones added, so the optimum is
+    # the whole LP's, and HiGHS holds fewer rows than it.
+    lp = _pseudo_jerk_lp(square_spiral(), 500, (3.0, 5.0, 3.0), 16, 0.8)
+    a, r, ub, rows = lp
+    start = ub if guess == "free" else np.zeros_like(ub)
+    mask = nearest_rows(row_ratios(rows, row_bounds(r, ub.size, 8), start), 3, KEEP)
+    held = lp_rows(mask, 8)
+    grid = _GridLP(a, backend="highspy", rows=held)
+    _holds_and_equals_highs(lp, grid.solve(r, ub))
+    assert held.size < grid.lp.a.shape[0] < a.shape[0]
+    assert grid.solves > 1  # rows were added and the problem solved again
+
+
+def test_lp_rows_are_the_lps_own() -> None:
+    # The per-node layout's rows map back onto the LP's row bounds (row_bounds' inverse).
+    n, q = 7, 2
+    r = np.arange(2 * q * (n - 1) + q * (n - 2), dtype=float)
+    per_node = row_bounds(r, n, q)
+    mask = np.isfinite(per_node) & (np.arange(n) % 2 == 0)
+    assert np.array_equal(r[lp_rows(mask, q)], np.sort(per_node[mask]))
 
 
 steps = st.tuples(st.floats(-3.0, 3.0), st.floats(-3.0, 3.0)).filter(

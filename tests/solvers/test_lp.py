@@ -51,6 +51,30 @@ def test_re_solve_after_bound_changes(backend: str) -> None:
 
 
 @pytest.mark.parametrize("backend", BACKENDS)
+def test_added_rows_cut_the_last_optimum(backend: str) -> None:
+    lp = _box_lp(backend)
+    lp.solve()  # at (2, 1)
+    lp.add_rows(sp.csr_array(np.array([[1.0, 0.0]])), np.array([-np.inf]), np.array([1.5]))
+    sol = lp.solve()
+    assert sol.x is not None and lp.a.shape == (3, 2)
+    # x <= 1.5 cuts (2, 1) off: y = min(1.5 + 1, (4 - 1.5) / 2) = 1.25.
+    assert np.allclose(sol.x, [1.5, 1.25], atol=1e-9)
+    # The new row's bounds move like the others.
+    lp.update_bounds(row_lower=np.array([-1.0, -np.inf, -np.inf]),
+                     row_upper=np.array([1.0, 4.0, 1.0]))  # fmt: skip
+    sol = lp.solve()
+    assert sol.x is not None and np.allclose(sol.x, [1.0, 1.5], atol=1e-9)
+
+
+def test_added_rows_of_the_wrong_shape_are_refused() -> None:
+    lp = _box_lp("linprog")
+    with pytest.raises(InputError, match="expected"):
+        lp.add_rows(sp.csr_array(np.ones((1, 3))), np.zeros(1), np.ones(1))
+    with pytest.raises(InputError, match="expected"):
+        lp.add_rows(sp.csr_array(np.ones((1, 2))), np.zeros(2), np.ones(2))
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
 def test_infeasible_is_a_status(backend: str) -> None:
     lp = _box_lp(backend)
     lp.update_bounds(row_lower=np.array([-1.0, -np.inf]), row_upper=np.array([1.0, -1.0]))

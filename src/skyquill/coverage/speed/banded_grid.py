@@ -21,9 +21,16 @@ import time
 from collections.abc import Callable
 
 import numpy as np
+from numpy.typing import NDArray
 
 from skyquill.coverage.deadline import Deadline
-from skyquill.coverage.speed.active_rows import KEEP, solve_active_rows
+from skyquill.coverage.speed.active_rows import (
+    KEEP,
+    Mask,
+    nearest_rows,
+    row_ratios,
+    solve_active_rows,
+)
 from skyquill.coverage.speed.banded import (
     TOLERANCE,
     BandedRows,
@@ -88,6 +95,16 @@ def row_bounds(r: FloatArray, n: int, q: int) -> FloatArray:
     return out
 
 
+def lp_rows(mask: Mask, q: int) -> NDArray[np.intp]:
+    """The LP's indices of the rows of ``mask`` (3 q, n), the per-node layout (the inverse of
+    :func:`row_bounds`: ``2 q`` acceleration blocks of ``n - 1`` rows, then ``q`` jerk blocks
+    of ``n - 2``), ascending."""
+    n = mask.shape[1]
+    acc = np.flatnonzero(mask[: 2 * q, :-1])
+    jerk = np.flatnonzero(mask[2 * q :, 1:-1]) + 2 * q * (n - 1)
+    return np.concatenate([acc, jerk])
+
+
 class BandedGrid:
     """The grid problem behind the LP's interface: passes without jerk, the banded interior
     point with it, the HiGHS LP for what neither answers.
@@ -108,7 +125,8 @@ class BandedGrid:
     rows : BandedRows
         Every row in the per-node layout.
     lp : callable
-        Builds the HiGHS grid LP (the fallback; with ``hand_over``, the solver).
+        Builds the HiGHS grid LP (the fallback; with ``hand_over``, the solver) on all
+        rows (None) or on the LP's rows given (:class:`~.rows._GridLP`).
     deadline : Deadline, optional
         Checked before every solve.
     hand_over : bool, default False
@@ -119,7 +137,7 @@ class BandedGrid:
         self,
         acc: AccelerationRows,
         rows: BandedRows,
-        lp: Callable[[], _GridLP],
+        lp: Callable[[NDArray[np.intp] | None], _GridLP],
         deadline: Deadline | None,
         *,
         hand_over: bool = False,
@@ -177,8 +195,16 @@ class BandedGrid:
             return self._highs(r, ub)
         if not self.hand_over:
             return sol.b
-        self._lp = self._build_lp()
+        self._lp = self._build_lp(self._binding_rows(bound, sol.b))
         return self._lp.solve(r, ub, start=sol.b)
+
+    def _binding_rows(self, bound: FloatArray, b: FloatArray) -> NDArray[np.intp] | None:
+        """The LP's rows HiGHS is given at first: with a polygon's directions, the
+        :data:`~.active_rows.KEEP` of each block nearest their bound at ``b`` (per-node
+        bounds ``bound`` (3 q, n)); None (all) otherwise."""
+        if self.q <= KEEP:
+            return None
+        return lp_rows(nearest_rows(row_ratios(self.rows, bound, b), 3, KEEP), self.q)
 
     def _interior(self, bound: FloatArray, ub: FloatArray, tolerance: float) -> BandedSolution:
         """The interior point's answer for the per-node row bounds ``bound`` (3 q, n)."""
@@ -209,5 +235,5 @@ class BandedGrid:
         """The HiGHS LP's answer where the passes or the interior point gave none."""
         self._fell_back = True
         if self._lp is None:
-            self._lp = self._build_lp()
+            self._lp = self._build_lp(None)
         return self._lp.solve(r, ub)

@@ -200,8 +200,8 @@ def plan_speed(
         a = sparse.vstack([a, _jerk_matrix((p1, p2, p3), jlim * args.safety, vb)], format="csr")
     lp: GridSolver
 
-    def highs() -> _GridLP:
-        return _GridLP(a, backend=backend, deadline=deadline)
+    def highs(rows: npt.NDArray[np.intp] | None = None) -> _GridLP:
+        return _GridLP(a, backend=backend, deadline=deadline, rows=rows)
 
     if solver == "lp":
         lp = highs()

@@ -7,6 +7,7 @@ from dataclasses import dataclass
 from typing import Any, Protocol
 
 import numpy as np
+from numpy.typing import NDArray
 from scipy import sparse
 
 from skyquill.coverage.deadline import TIME_LIMIT, Deadline
@@ -187,11 +188,33 @@ class _GridLP:
     One :class:`~skyquill.solvers.lp.LinearProgram` (hot-started with
     highspy) for the whole plan: a pseudo-jerk iteration or a refinement round
     only changes bounds.
+
+    With ``rows``, HiGHS holds only those rows of ``A`` (the ones that can
+    bind); every answer is checked against all of them, and a row it breaks is
+    added and the problem solved again (a dual-simplex hot start), until none
+    is broken: the optimum of the rows held that breaks no other row is the
+    optimum of the whole LP. With a norm limit held by a 16-gon, 3 of its 8
+    directions per node are enough (:mod:`.active_rows`); HiGHS's cost per
+    solve, even one without a pivot (4.7 ms at 48,000 rows), and per pivot
+    grows with its rows.
     """
 
-    def __init__(self, a: Any, *, backend: str, deadline: Deadline | None = None) -> None:
+    def __init__(
+        self,
+        a: Any,
+        *,
+        backend: str,
+        deadline: Deadline | None = None,
+        rows: NDArray[np.intp] | None = None,
+    ) -> None:
         self.deadline = deadline
-        self.lp = LinearProgram(a, -np.ones(a.shape[1]), backend=backend)
+        self.a = sparse.csr_array(a)
+        self.rows = rows
+        held = self.a if rows is None else self.a[rows]
+        self.lp = LinearProgram(held, -np.ones(a.shape[1]), backend=backend)
+        self._outside = None if rows is None else np.ones(a.shape[0], dtype=bool)
+        if self._outside is not None:
+            self._outside[rows] = False
 
     @property
     def time(self) -> float:
@@ -220,11 +243,37 @@ class _GridLP:
         With a deadline, no solve is started once it is spent, nor given more
         than what is left of it.
         """
+        b = self._solve(r, ub, start, restart)
+        while (broken := self._broken(r, b)).size:
+            self.lp.add_rows(self.a[broken], -r[broken], r[broken])
+            self.rows = np.concatenate([self.rows, broken]) if self.rows is not None else None
+            assert self._outside is not None
+            self._outside[broken] = False
+            b = self._solve(r, ub, None, restart)
+        return b
+
+    def _broken(self, r: FloatArray, b: FloatArray) -> NDArray[np.intp]:
+        """The rows HiGHS does not hold that ``b`` breaks by more than its own feasibility
+        tolerance (relative, :data:`ROW_TOLERANCE`)."""
+        if self._outside is None:
+            return np.zeros(0, dtype=np.intp)
+        excess = np.abs(self.a @ b) > r * (1.0 + ROW_TOLERANCE)
+        return np.flatnonzero(excess & self._outside)
+
+    def _solve(
+        self,
+        r: FloatArray,
+        ub: FloatArray,
+        start: FloatArray | None,
+        restart: Callable[[], FloatArray | None] | None,
+    ) -> FloatArray:
+        """One solve on the rows HiGHS holds."""
         step = f"speed LP solve {self.lp.solves + 1}"
         if self.deadline is not None:
             self.deadline.check(step)
             self.lp.time_limit_s = max(self.deadline.remaining(), 1e-3)
-        self.lp.update_bounds(row_lower=-r, row_upper=r, col_upper=ub)
+        held = r if self.rows is None else r[self.rows]
+        self.lp.update_bounds(row_lower=-held, row_upper=held, col_upper=ub)
         sol = self.lp.solve(start, restart)
         if sol.status == "time_limit" and self.deadline is not None:
             self.deadline.check(step)  # spent: raises with the step's name
@@ -234,3 +283,8 @@ class _GridLP:
         if sol.x is None:
             raise SolverError(f"HiGHS failed on the speed-planning LP: {sol.message}")
         return sol.x
+
+
+#: A row HiGHS does not hold counts as broken beyond this excess over its bound, relative
+#: (HiGHS's own primal feasibility tolerance, 1e-7, applies to the rows it holds).
+ROW_TOLERANCE = 1e-7
