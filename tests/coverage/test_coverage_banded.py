@@ -20,9 +20,9 @@ from scipy.interpolate import BSpline
 from speed_curves import square_spiral, wiggle
 
 from skyquill.coverage.speed import plan_speed
-from skyquill.coverage.speed.active_rows import KEEP, nearest_rows, row_ratios, solve_active_rows
+from skyquill.coverage.speed.active_rows import nearest_rows, row_ratios, solve_active_rows
 from skyquill.coverage.speed.banded import BandedRows, solve_banded_lp
-from skyquill.coverage.speed.banded_grid import banded_rows, lp_rows, row_bounds
+from skyquill.coverage.speed.banded_grid import HELD, banded_rows, lp_rows, row_bounds
 from skyquill.coverage.speed.curve import _derivs3
 from skyquill.coverage.speed.norms import component_limits, components
 from skyquill.coverage.speed.reach import acceleration_rows
@@ -117,7 +117,7 @@ def test_highs_on_the_rows_that_bind_gives_the_whole_lps_optimum(guess: str) -> 
     lp = _pseudo_jerk_lp(square_spiral(), 500, (3.0, 5.0, 3.0), 16, 0.8)
     a, r, ub, rows = lp
     start = ub if guess == "free" else np.zeros_like(ub)
-    mask = nearest_rows(row_ratios(rows, row_bounds(r, ub.size, 8), start), 3, KEEP)
+    mask = nearest_rows(row_ratios(rows, row_bounds(r, ub.size, 8), start), 3, HELD)
     held = lp_rows(mask, 8)
     grid = _GridLP(a, backend="highspy", rows=held)
     _holds_and_equals_highs(lp, grid.solve(r, ub))

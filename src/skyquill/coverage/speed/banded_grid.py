@@ -47,6 +47,16 @@ _log = logging.getLogger(__name__)
 ROUGH_TOLERANCE = 1e-6
 
 
+#: Rows of each block per node (of a polygon's directions) HiGHS is given at first with
+#: ``hand_over``; the rows an answer breaks are added (:class:`~.rows._GridLP`). An added
+#: row costs a re-solve of a few pivots, a row held costs every solve: the eleven largest
+#: speed plans of ``holes_1_3ha`` took 3.8 / 3.9 / 4.4 s with 1 / 2 / 3 held (all 8: 5.6 s),
+#: the fifteen of ``holes_10ha`` 5.4 s with 1 and 6.4 s with 3 (the same flights).
+HELD = 1
+#: Decimals of the ratios (row over bound) by which the rows held are picked.
+RATIO_DECIMALS = 6
+
+
 def banded_rows(
     acc: AccelerationRows,
     derivs: tuple[FloatArray, FloatArray, FloatArray],
@@ -200,11 +210,19 @@ class BandedGrid:
 
     def _binding_rows(self, bound: FloatArray, b: FloatArray) -> NDArray[np.intp] | None:
         """The LP's rows HiGHS is given at first: with a polygon's directions, the
-        :data:`~.active_rows.KEEP` of each block nearest their bound at ``b`` (per-node
-        bounds ``bound`` (3 q, n)); None (all) otherwise."""
+        :data:`HELD` of each block nearest their bound at ``b`` (per-node bounds ``bound``
+        (3 q, n)); None (all) otherwise.
+
+        The ratios to the bounds are rounded to :data:`RATIO_DECIMALS` first: the last bits
+        of the interior point's answer depend on the BLAS's threads (its dot products), and
+        where directions tie (a node without acceleration: every ratio is round-off) they
+        would pick the row held, and so the last bits of the plan: a piece planned in a
+        pool worker (one BLAS thread) differed from the same piece planned here.
+        """
         if self.q <= KEEP:
             return None
-        return lp_rows(nearest_rows(row_ratios(self.rows, bound, b), 3, KEEP), self.q)
+        ratio = np.round(row_ratios(self.rows, bound, b), RATIO_DECIMALS)
+        return lp_rows(nearest_rows(ratio, 3, HELD), self.q)
 
     def _interior(self, bound: FloatArray, ub: FloatArray, tolerance: float) -> BandedSolution:
         """The interior point's answer for the per-node row bounds ``bound`` (3 q, n)."""

@@ -193,8 +193,8 @@ class _GridLP:
     bind); every answer is checked against all of them, and a row it breaks is
     added and the problem solved again (a dual-simplex hot start), until none
     is broken: the optimum of the rows held that breaks no other row is the
-    optimum of the whole LP. With a norm limit held by a 16-gon, 3 of its 8
-    directions per node are enough (:mod:`.active_rows`); HiGHS's cost per
+    optimum of the whole LP. With a norm limit held by a 16-gon, few of its 8
+    directions per node can bind (:data:`~.banded_grid.HELD`); HiGHS's cost per
     solve, even one without a pivot (4.7 ms at 48,000 rows), and per pivot
     grows with its rows.
     """
