@@ -238,3 +238,61 @@ def test_a_jump_at_a_breakpoint_is_checked_from_both_sides() -> None:
     res = verify(traj, [NormLimit(3, 5.0)])
     assert res.checks[0].max_value == pytest.approx(10.0, rel=1e-9)
     assert max(res.max_jerk) == pytest.approx(10.0, rel=1e-9)
+
+
+# ------------------------------------------------------------------ sequences and the memo
+def _legs() -> tuple[PiecewisePolynomial, PiecewisePolynomial]:
+    """Two stop-and-go flights meeting at rest."""
+    from skyquill.optimize.legs import LegLimits, stop_and_go
+
+    lim = LegLimits(2.0, 3.0, 10.0)
+    first = stop_and_go(np.array([[0.0, 0.0, 1.0], [4.0, 1.0, 1.0], [4.0, 6.0, 1.0]]), lim)
+    second = stop_and_go(np.array([[4.0, 6.0, 1.0], [0.0, 9.0, 2.0]]), lim)
+    return first.trajectory, second.trajectory
+
+
+LEG_LIMITS = (
+    CylinderLimit(1, 1.9, z_lower=-1.9, z_upper=1.9),
+    CylinderLimit(2, 3.0, z_lower=-3.0, z_upper=3.0),
+    BoxLimit.symmetric(3, 9.0, 3),
+)
+
+
+def test_a_sequence_is_checked_piece_by_piece() -> None:
+    from skyquill.trajectory import RestToRestSequence
+    from skyquill.verify import _checked
+
+    a, b = _legs()
+    whole = verify(RestToRestSequence((a, b)), LEG_LIMITS, guaranteed=False)
+    parts = [verify(p, LEG_LIMITS, guaranteed=False) for p in (a, b)]
+    assert whole.n_samples == sum(p.n_samples for p in parts)
+    assert whole.max_excess == max(p.max_excess for p in parts) > 0.0  # speed and jerk over
+    for i, check in enumerate(whole.checks):
+        assert check.max_value == max(p.checks[i].max_value for p in parts)
+    # The sequence sampled as one: the same peaks (its samples are other times of the same
+    # functions; these legs peak on plateaus that both sample).
+    direct = _checked(RestToRestSequence((a, b)), LEG_LIMITS, (), False)
+    assert whole.max_excess == pytest.approx(direct.max_excess, rel=1e-9)
+    assert whole.max_acc == pytest.approx(direct.max_acc, rel=1e-9)
+    assert whole.max_jerk == pytest.approx(direct.max_jerk, rel=1e-9)
+
+
+def test_a_trajectory_checked_before_is_not_checked_again(monkeypatch: pytest.MonkeyPatch) -> None:
+    import pickle
+
+    import skyquill.verify as verify_module
+
+    a, _ = _legs()
+    first = verify(a, LEG_LIMITS)
+    # The check travels with the trajectory (a coverage piece checked in a worker process).
+    back = pickle.loads(pickle.dumps(a))
+
+    def not_again(*args: object) -> Verification:
+        raise AssertionError("checked again")
+
+    monkeypatch.setattr(verify_module, "_checked", not_again)
+    assert verify(a, LEG_LIMITS) is first
+    assert verify(back, LEG_LIMITS) == first
+    # Other limits are another check.
+    with pytest.raises(AssertionError, match="checked again"):
+        verify(a, LEG_LIMITS[:2])
