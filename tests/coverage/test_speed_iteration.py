@@ -6,7 +6,6 @@ import itertools
 from collections.abc import Callable
 
 import numpy as np
-import pytest
 
 from skyquill.coverage.speed.iteration import _pseudo_jerk
 from skyquill.coverage.speed.rows import _Bounds, _ones
@@ -95,9 +94,7 @@ def test_the_flight_is_within_its_limits_at_the_curve_knots() -> None:
     assert plan.limits["max_excess"] >= worst  # the check saw them
 
 
-def test_the_refinement_samples_every_interval_end_from_the_left(
-    monkeypatch: pytest.MonkeyPatch,
-) -> None:
+def test_the_refinement_samples_every_interval_end_from_the_left() -> None:
     """Where the dense check looks: the side before every node, the path's end included (a
     2.2 ha part of holes_10ha flew 2.3 % over its jerk limit at its rest end, unsampled)."""
     from speed_curves import square_spiral
@@ -105,16 +102,10 @@ def test_the_refinement_samples_every_interval_end_from_the_left(
     from skyquill.coverage.speed import iteration, plan_speed
 
     plan = plan_speed(square_spiral(), 3.0, 5.0, 3.0, n=200, max_excess=None)
-    seen: list[FloatArray] = []
-    ratios = iteration._ratios
-
-    def recording(p: object, us: FloatArray) -> list[FloatArray]:
-        seen.append(us.copy())
-        return ratios(p, us)  # type: ignore[arg-type]
-
-    monkeypatch.setattr(iteration, "_ratios", recording)
-    iteration._interval_excess(plan)
-    sampled = np.concatenate(seen)
+    samples = iteration._Samples.of(plan)
+    sampled = samples.even
     ends = np.nextafter(plan._sigma[1:], -np.inf)
     assert np.isin(ends, sampled).all() and ends[-1] < 1.0 == plan._sigma[-1]
     assert np.isin(plan._sigma[:-1], sampled).all()
+    # The path's derivatives there are evaluated once, for every refinement round.
+    np.testing.assert_array_equal(samples.path_even[2], plan._path(sampled, nu=3))

@@ -4,8 +4,10 @@ from __future__ import annotations
 
 import math
 from dataclasses import replace
+from typing import NamedTuple
 
 import numpy as np
+from numpy.typing import NDArray
 
 from skyquill.coverage.speed.curve import _derivs3
 from skyquill.coverage.speed.norms import limit_ratio
@@ -137,8 +139,9 @@ def _refine(
         pseudo-jerk iterations.
     """
     done = extra = 0
+    samples = _Samples.of(plan)
     while True:
-        excess = _interval_excess(plan)
+        excess = _interval_excess(plan, samples)
         est = float(max(np.max(x) for x in excess))
         if target is None or est <= target or done >= rounds:
             return plan, done, est, extra
@@ -154,16 +157,59 @@ def _refine(
         done += 1
 
 
-def _interval_excess(plan: SpeedPlan) -> tuple[FloatArray, FloatArray, FloatArray]:
+class _Samples(NamedTuple):
+    """Where the refinement checks a plan on its grid, and the path's derivatives there.
+
+    Attributes
+    ----------
+    m
+        Even samples per grid interval (besides its end from the left).
+    even
+        ``m`` even points of every interval, then its end from the left, shape
+        ((n - 1) (m + 1),), on the grid's parameter.
+    kinks
+        The path's kinks, shape (K,) (:func:`_kinks`).
+    at
+        The interval each kink lies in, shape (K,).
+    path_even, path_kinks
+        The path's first three derivatives at ``even`` and at ``kinks``: the same in
+        every refinement round (only the timing changes), evaluated once.
+    """
+
+    m: int
+    even: FloatArray
+    kinks: FloatArray
+    at: NDArray[np.intp]
+    path_even: tuple[FloatArray, FloatArray, FloatArray]
+    path_kinks: tuple[FloatArray, FloatArray, FloatArray]
+
+    @classmethod
+    def of(cls, plan: SpeedPlan) -> _Samples:
+        """The samples of ``plan``'s grid (see :func:`_interval_excess`)."""
+        sig = plan._sigma
+        # _SAMPLES per interval, fewer on a grid finer than _SAMPLE_GRID (the samples stay
+        # as dense along the path), then the interval's end from the left.
+        m = max(_MIN_SAMPLES, min(_SAMPLES, math.ceil(_SAMPLES * _SAMPLE_GRID / sig.size)))
+        even = sig[:-1, None] + (sig[1] - sig[0]) * (np.arange(m) / m)[None, :]
+        us = np.column_stack([even, np.nextafter(sig[1:], -np.inf)]).ravel()
+        kinks = _kinks(plan)
+        at = np.clip(np.searchsorted(sig, kinks, side="right") - 1, 0, sig.size - 2)
+        path = plan._path
+        return cls(m, us, kinks, at, _derivs3(path, us), _derivs3(path, kinks))
+
+
+def _interval_excess(
+    plan: SpeedPlan, samples: _Samples
+) -> tuple[FloatArray, FloatArray, FloatArray]:
     """Relative speed, acceleration and jerk excess of each grid interval.
 
     The chain-rule derivatives of the interpolated plan (what
     :meth:`SpeedPlan.setpoints` outputs and :meth:`SpeedPlan.verify`
     differences) are evaluated where the dense check of the flight
-    (:func:`skyquill.trajectory.base.check_times`) looks: at ``_SAMPLES``
-    even points of each interval, at its end from the left, and at the path's
-    kinks (its curve's knots, :func:`_kinks`).  The interval's end: the
-    profile's jerk jumps at every grid node (``w = b**(3/4)`` is a cubic
+    (:func:`skyquill.trajectory.base.check_times`) looks (``samples``): at
+    ``_SAMPLES`` even points of each interval, at its end from the left, and at
+    the path's kinks (its curve's knots, :func:`_kinks`).  The interval's end:
+    the profile's jerk jumps at every grid node (``w = b**(3/4)`` is a cubic
     spline), and the path's last point, the rest end, was never sampled before
     session 38. The 2.2 ha part of ``examples/coverage/holes_10ha.geojson``
     flew 2.3 % over its jerk limit there while the refinement saw none, was
@@ -185,26 +231,23 @@ def _interval_excess(plan: SpeedPlan) -> tuple[FloatArray, FloatArray, FloatArra
     sig = plan._sigma
     # A plan that stops the vehicle between the rest ends is refused here (InfeasibleError).
     _interval_times(plan._bsig, sig[1] - sig[0], jerk=plan.jmax is not None)
-    # _SAMPLES per interval, fewer on a grid finer than _SAMPLE_GRID (the samples stay as
-    # dense along the path), then the interval's end from the left.
-    m = max(_MIN_SAMPLES, min(_SAMPLES, math.ceil(_SAMPLES * _SAMPLE_GRID / sig.size)))
-    even = sig[:-1, None] + (sig[1] - sig[0]) * (np.arange(m) / m)[None, :]
-    us = np.column_stack([even, np.nextafter(sig[1:], -np.inf)]).ravel()
-    ex = [np.maximum(x.reshape(sig.size - 1, m + 1).max(axis=1) - 1.0, 0.0)
-          for x in _ratios(plan, us)]  # fmt: skip
-    # The path's kinks (its curve's knots): the jerk peaks there, between the samples.
-    kinks = _kinks(plan)
-    if kinks.size:
-        at = np.clip(np.searchsorted(sig, kinks, side="right") - 1, 0, sig.size - 2)
-        for x, per_interval in zip(_ratios(plan, kinks), ex, strict=True):
-            np.maximum.at(per_interval, at, x - 1.0)
+    per_interval = (sig.size - 1, samples.m + 1)
+    ex = [np.maximum(x.reshape(per_interval).max(axis=1) - 1.0, 0.0)
+          for x in _ratios(plan, samples.even, samples.path_even)]  # fmt: skip
+    if samples.kinks.size:
+        ratios = _ratios(plan, samples.kinks, samples.path_kinks)
+        for x, per in zip(ratios, ex, strict=True):
+            np.maximum.at(per, samples.at, x - 1.0)
     return ex[0], ex[1], ex[2]
 
 
-def _ratios(plan: SpeedPlan, us: FloatArray) -> list[FloatArray]:
-    """Speed, acceleration and jerk over their limits at the grid parameters ``us`` (M,)."""
+def _ratios(
+    plan: SpeedPlan, us: FloatArray, path: tuple[FloatArray, FloatArray, FloatArray]
+) -> list[FloatArray]:
+    """Speed, acceleration and jerk over their limits at the grid parameters ``us`` (M,),
+    where the path's first three derivatives are ``path`` (each (M, d))."""
     ud, udd, uddd = plan._derivs(us)
-    c1, c2, c3 = _derivs3(plan._path, us)
+    c1, c2, c3 = path
     speed = np.linalg.norm(c1, axis=1) * ud / plan.vmax
     acc = limit_ratio(c2 * (ud**2)[:, None] + c1 * udd[:, None], plan.amax, plan.norm_sides)
     if plan.jmax is None:
