@@ -31,7 +31,13 @@ METHODS = ("auto", "reach", "warm", "banded", "lp")
 #: re-solves from its last basis, the interior point from scratch. Coverage plans use at
 #: most 4,000 points (the last grid, tried after two failed), where a grid that collapses
 #: cost the interior point 17 s and the LP 6 s (the held-out 1.3 ha outline's spiral).
-BANDED_FROM_POINTS = 8000
+#: Session 39 (HiGHS on the rows that can bind, Devex pricing): the warm-started LP took
+#: 0.74 / 1.37 s at 8,000 / 12,000 points per axis against the banded method's 1.21 / 1.90
+#: s, 2.07 / 3.46 s against 5.16 / 8.21 s with the 16-gon; at 16,000 per axis HiGHS could
+#: not start from the interior point's vertex and solved from scratch (7.6 s against 2.6 s;
+#: with the 16-gon 6.1 s against 11.6 s). One run each of plan_speed on the spiral of
+#: bench/coverage_lp.py, the method forced.
+BANDED_FROM_POINTS = 16000
 #: Fewest sides of the polygon that holds a norm limit.
 MIN_NORM_SIDES = 4
 
