@@ -122,10 +122,19 @@ def test_two_uploads_fit_rest_and_fly_as_planned(
     assert drone["delivered_within_limits"] and "WARNING" not in report.message
     assert summary["delivered"][0]["limit_excess"] == check.limit_excess
     assert report.max_error_m == check.max_error_m
-    # The summary and its files alone give back what the exporter checked (its limits report
-    # is the whole flight's, take-off and landing included: test_fly_replay.py).
+    # The summary and its files alone give back what the exporter checked: the mission's
+    # check from the files, its limits report and excess the worse of it and the whole
+    # flight's (take-off and landing included, "as_played": test_fly_replay.py).
     flown = read_export(tmp_path / "cs.summary.json")["d"]
-    assert replace(check_delivered("d", two_uploads, flown), limits=check.limits) == check
+    mission = check_delivered("d", two_uploads, flown)
+    played = drone["flight"]["as_played"]["relative_excess"]
+    worse = tuple(
+        max(e, played[name])
+        for e, name in zip(mission.excess_by_order, ("speed", "acceleration", "jerk"), strict=True)
+    )
+    whole = replace(mission, limits=check.limits, excess_by_order=worse,
+                    limit_excess=max(mission.limit_excess, *played.values()))  # fmt: skip
+    assert whole == check
 
 
 def test_one_upload_is_one_file_and_drones_are_named(
