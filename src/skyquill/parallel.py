@@ -27,8 +27,9 @@ from skyquill.errors import InputError
 
 #: How long to wait for a ``dask.distributed`` scheduler to answer, s.
 SCHEDULER_TIMEOUT_S = 5.0
-#: Items per task: about this many tasks per worker, so that a slow item does not hold
-#: the others back and a task's overhead (pickling, scheduling) stays small.
+#: Items per dask task: about this many tasks per worker, so that a slow item does not
+#: hold the others back and a task's overhead (scheduling) stays small. A local pool hands
+#: out one item at a time (:func:`parallel_map`).
 TASKS_PER_WORKER = 4
 
 T = TypeVar("T")
@@ -107,7 +108,11 @@ def parallel_map(
         return [fn(item) for item in items]
     count = workers or os.cpu_count() or 1
     with ProcessPoolExecutor(max_workers=count, initializer=one_blas_thread) as pool:
-        return list(pool.map(fn, items, chunksize=_chunk(len(items), count)))
+        # One item at a time: a free worker takes the next, so items given largest first
+        # (a mission's pieces) end together. In pairs, the 10 ha field's two largest pieces
+        # went to one worker, which finished 0.3-0.5 s after the other (4.8-5.0 s in all,
+        # against 5.3 s).
+        return list(pool.map(fn, items))
 
 
 def one_blas_thread() -> None:
