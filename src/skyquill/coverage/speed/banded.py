@@ -256,11 +256,12 @@ def _mehrotra(a: _Scaled, cost: FloatArray, tolerance: float) -> tuple[FloatArra
         w = z / s
         factor = _factor(a, st, w)
         # Predictor (affine scaling), then the corrector with centring and the
-        # second-order term, on the same factorisation.
-        dx, ds, dz = _newton(a, st, factor, sw=(s, w), res=(rd, rp), rc=s * z)
+        # second-order term, on the same factorisation. (rc / s of the predictor is z.)
+        wrp = w * rp
+        dx, ds, dz = _newton(a, st, factor, w=w, res=(rd, rp, wrp), rcs=z)
         sigma = (_affine_mu(s, z, ds, dz) / mu) ** 3
-        rc = s * z + ds * dz - sigma * mu
-        dx, ds, dz = _newton(a, st, factor, sw=(s, w), res=(rd, rp), rc=rc)
+        rcs = z + (ds * dz - sigma * mu) / s
+        dx, ds, dz = _newton(a, st, factor, w=w, res=(rd, rp, wrp), rcs=rcs)
         ap = min(1.0, STEP_FRACTION * _max_step(s, ds))
         ad = min(1.0, STEP_FRACTION * _max_step(z, dz))
         x = x + ap * dx
@@ -283,21 +284,23 @@ def _newton(
     st: _State,
     factor: FloatArray,
     *,
-    sw: tuple[FloatArray, FloatArray],
-    res: tuple[FloatArray, FloatArray],
-    rc: FloatArray,
+    w: FloatArray,
+    res: tuple[FloatArray, FloatArray, FloatArray],
+    rcs: FloatArray,
 ) -> tuple[FloatArray, FloatArray, FloatArray]:
     """The direction of ``G' dz = -rd``, ``G dx + ds = -rp``, ``Z ds + S dz = -rc``.
 
-    With ``dz = W (G dx + rp) - rc / s``: ``G' W G dx = -rd - G' (W rp - rc / s)``.
+    ``w = z / s``, ``res = (rd, rp, w rp)`` and ``rcs = rc / s`` (the predictor and the
+    corrector share all but ``rcs``). With ``v = W rp - rc / s``, ``dz = W G dx + v``:
+    ``G' W G dx = -rd - G' v``.
     """
-    s, w = sw
-    rd, rp = res
-    vu, vl, vb, v0 = st.split(w * rp - rc / s)
+    rd, rp, wrp = res
+    v = wrp - rcs
+    vu, vl, vb, v0 = st.split(v)
     rhs = -rd - (a.transpose(vu - vl) + vb - v0)
     dx = np.asarray(cho_solve_banded((factor, True), rhs, check_finite=False), dtype=np.float64)
     gdx = st.stack(a.apply(dx), dx)
-    dz = w * (gdx + rp) - rc / s
+    dz = w * gdx + v
     ds = -rp - gdx
     return dx, ds, dz
 
@@ -310,7 +313,8 @@ def _affine_mu(s: FloatArray, z: FloatArray, ds: FloatArray, dz: FloatArray) -> 
 
 
 def _max_step(v: FloatArray, dv: FloatArray) -> float:
-    """The largest ``alpha <= 1`` with ``v + alpha dv >= 0``."""
-    with np.errstate(divide="ignore", invalid="ignore"):
-        ratio = np.where(dv < 0.0, -v / dv, np.inf)
-    return min(1.0, float(np.min(ratio)))
+    """The largest ``alpha <= 1`` with ``v + alpha dv >= 0``, for ``v > 0`` (the slacks and
+    duals stay strictly positive): ``1 / max(-dv / v)`` over the entries that decrease, in
+    two passes over the arrays instead of five."""
+    least = float(np.min(dv / v))
+    return 1.0 if least >= -1.0 else -1.0 / least
