@@ -7,7 +7,6 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt
 import numpy as np
 import shapely
 from matplotlib.axes import Axes
@@ -15,7 +14,7 @@ from shapely.geometry import MultiPolygon, Polygon
 
 from skyquill.coverage.plan import CoveragePlan
 from skyquill.coverage.regions import swept as swept_area
-from skyquill.viz.figures import figure_style, save_png
+from skyquill.viz.figures import figure_style, new_figure, save_png
 
 #: Most setpoints drawn as dots (a 10 ha field has 370k; the figure cannot show more).
 MAX_DOTS = 40_000
@@ -48,13 +47,19 @@ def plot_coverage(plan: CoveragePlan, path: str | Path) -> None:
     sp = plan.samples()
     # A fixed layout: constrained layout draws the figure twice to measure it.
     with figure_style():
-        fig = plt.figure(figsize=(13, 6.5))
+        fig = new_figure((13, 6.5))
         grid = fig.add_gridspec(
             3, 2, width_ratios=(1.1, 1.0), left=0.06, right=0.98, bottom=0.08, top=0.9,
             hspace=0.45, wspace=0.18,
         )  # fmt: skip
         top = fig.add_subplot(grid[:, 0])
-        panels = [fig.add_subplot(grid[k, 1]) for k in range(3)]
+        # One time axis for the three stacked panels, ticked and labelled once at the
+        # bottom: matplotlib's ticks are most of the picture's time (with 100 dpi, not
+        # 110: the L-shaped field's picture took 0.128 s instead of 0.145 s).
+        first = fig.add_subplot(grid[0, 1])
+        panels = [first, *(fig.add_subplot(grid[k, 1], sharex=first) for k in (1, 2))]
+        for ax in panels[:2]:
+            ax.tick_params(bottom=False, labelbottom=False)
     sprayed = None if plan.mission is None else plan.mission.swept  # spray off on transits
     # The planner's own simplified sweep: the raw buffer of a 20 km path's 1 M
     # points took a minute.
@@ -94,5 +99,4 @@ def plot_coverage(plan: CoveragePlan, path: str | Path) -> None:
         if values.shape[1] > 1:
             ax.legend(loc="upper right", fontsize=8)
     ax.set_xlabel("t (s)")
-    save_png(fig, path, dpi=110)
-    plt.close(fig)
+    save_png(fig, path, dpi=100)
