@@ -168,3 +168,41 @@ def test_a_reversal_becomes_a_u_turn_not_a_cusp() -> None:
     curve = spiral_curve(with_corner_points(there_and_back, 0.4))
     speed = np.linalg.norm(curve(np.linspace(0.0, 1.0, 20001), 1), axis=1)
     assert speed.min() > 0.01 * speed.max()  # a cusp would have |C'| = 0 (here 0.023)
+
+
+#: Random convex regions (hypothesis, tests/coverage/test_plan.py) with a vertex a
+#: micrometre or less off a straight edge: their spirals could not be timed on any grid.
+BENT_BY_ROUND_OFF = (
+    [(0.0, 1.4881591259435156), (0.0, 8.814815439974618),
+     (2.714295001734623e-169, 12.569412626410816), (6.131868215140549, 22.39524653616589),
+     (16.729332049106187, 13.892435772459239)],
+    [(2.8175667347736576e-190, 17.08421457290478), (13.201536343068545, 27.996168988311503),
+     (24.68258407006851, 25.297967769199264), (27.874030793804348, 9.400424882218244),
+     (19.733189139216947, 1.6182670598244044), (1.4087833673868288e-6, 0.6044902039165497),
+     (2.8175667347736575e-169, 14.444495305198167)],
+)  # fmt: skip
+
+
+@pytest.mark.parametrize("vertices", BENT_BY_ROUND_OFF)
+def test_a_vertex_where_the_edge_goes_on_straight_is_no_corner(
+    vertices: list[tuple[float, float]],
+) -> None:
+    from skyquill.coverage.plan import CoverageOptions, plan_coverage
+
+    region = region_from_vertices(vertices)
+    rings = contours(region, 2.0)
+    assert len(rings[0]) == len(vertices) - 1  # the straight vertex is not a corner
+    plan = plan_coverage(region, CoverageOptions(pattern="spiral", delta=0.5, grid=600))
+    assert plan.limits["max_excess"] <= 0.02
+
+
+def test_only_vertices_where_a_ring_goes_on_straight_are_dropped() -> None:
+    from skyquill.coverage.paths import STRAIGHT_TURN_RAD, _without_straight
+
+    square = np.array([[0.0, 0.0], [2.0, 0.0], [4.0, 0.0], [4.0, 4.0], [0.0, 4.0]])
+    np.testing.assert_array_equal(_without_straight(square), square[[0, 2, 3, 4]])
+    bent = square.copy()
+    bent[1, 1] = -2.0 * np.tan(10 * STRAIGHT_TURN_RAD)  # a turn ten times the tolerance
+    np.testing.assert_array_equal(_without_straight(bent), bent)
+    spike = np.array([[0.0, 0.0], [2.0, 0.0], [1.0, 0.0], [1.0, 1.0]])  # turns back: kept
+    np.testing.assert_array_equal(_without_straight(spike), spike)
