@@ -316,5 +316,6 @@ def _max_step(v: FloatArray, dv: FloatArray) -> float:
     """The largest ``alpha <= 1`` with ``v + alpha dv >= 0``, for ``v > 0`` (the slacks and
     duals stay strictly positive): ``1 / max(-dv / v)`` over the entries that decrease, in
     two passes over the arrays instead of five."""
-    least = float(np.min(dv / v))
-    return 1.0 if least >= -1.0 else -1.0 / least
+    with np.errstate(divide="ignore", invalid="ignore"):  # (a slack that underflowed to 0)
+        least = float(np.min(dv / v))
+    return 1.0 if not least < -1.0 else -1.0 / least

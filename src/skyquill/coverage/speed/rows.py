@@ -245,12 +245,16 @@ class _GridLP:
         """
         b = self._solve(r, ub, start, restart)
         while (broken := self._broken(r, b)).size:
-            self.lp.add_rows(self.a[broken], -r[broken], r[broken])
-            self.rows = np.concatenate([self.rows, broken]) if self.rows is not None else None
-            assert self._outside is not None
-            self._outside[broken] = False
+            self._hold(broken, r)
             b = self._solve(r, ub, None, restart)
         return b
+
+    def _hold(self, rows: NDArray[np.intp], r: FloatArray) -> None:
+        """Give HiGHS the rows ``rows`` of ``A`` too, with their bounds in ``r``."""
+        assert self.rows is not None and self._outside is not None
+        self.lp.add_rows(self.a[rows], -r[rows], r[rows])
+        self.rows = np.concatenate([self.rows, rows])
+        self._outside[rows] = False
 
     def _broken(self, r: FloatArray, b: FloatArray) -> NDArray[np.intp]:
         """The rows HiGHS does not hold that ``b`` breaks by more than its own feasibility
