@@ -161,16 +161,18 @@ def verify(
         Whether the planner imposed these limits through the convex hull (an
         approximate planner, such as the coverage speed LP, passes False).
     """
-    if isinstance(traj, RestToRestSequence) and not corridors:
+    if corridors:  # their windows are on this trajectory's clock: sampled as a whole
+        return _checked(traj, limits, corridors, guaranteed)
+    if isinstance(traj, RestToRestSequence):
         # At rest where its pieces meet, each piece's check covers its side of every join:
         # the pieces' checks are the sequence's (each as dense or denser), and a piece
         # checked before (a coverage piece in the worker that planned it) is not again.
         return _merged([verify(p, limits, guaranteed=guaranteed) for p in traj.pieces])
-    memo = None if corridors else _memo(traj)
+    memo = _memo(traj)
     key = pickle.dumps((tuple(limits), guaranteed))
     if memo is not None and key in memo:
         return memo[key]
-    check = _checked(traj, limits, corridors, guaranteed)
+    check = _checked(traj, limits, (), guaranteed)
     if memo is not None:
         memo[key] = check
     return check

@@ -14,7 +14,7 @@ from shapely.geometry import MultiPolygon, Polygon
 
 from skyquill.coverage.plan import CoveragePlan
 from skyquill.coverage.regions import swept as swept_area
-from skyquill.viz.figures import figure_style, new_figure, save_png
+from skyquill.viz.figures import figure_style, new_figure, save_png, stack_time_panels
 
 #: Most setpoints drawn as dots (a 10 ha field has 370k; the figure cannot show more).
 MAX_DOTS = 40_000
@@ -53,13 +53,11 @@ def plot_coverage(plan: CoveragePlan, path: str | Path) -> None:
             hspace=0.45, wspace=0.18,
         )  # fmt: skip
         top = fig.add_subplot(grid[:, 0])
-        # One time axis for the three stacked panels, ticked and labelled once at the
-        # bottom: matplotlib's ticks are most of the picture's time (with 100 dpi, not
-        # 110: the L-shaped field's picture took 0.128 s instead of 0.145 s).
-        first = fig.add_subplot(grid[0, 1])
-        panels = [first, *(fig.add_subplot(grid[k, 1], sharex=first) for k in (1, 2))]
-        for ax in panels[:2]:
-            ax.tick_params(bottom=False, labelbottom=False)
+        # One time axis for the three stacked panels, ticked only at the bottom:
+        # matplotlib's ticks are most of the picture's time (their marks above, 7 ms).
+        panels = stack_time_panels(fig, grid[:, 1].get_position(fig).bounds, 3, hspace=0.45)
+        for ax in panels[:-1]:
+            ax.tick_params(bottom=False)
     sprayed = None if plan.mission is None else plan.mission.swept  # spray off on transits
     # The planner's own simplified sweep: the raw buffer of a 20 km path's 1 M
     # points took a minute.
@@ -99,4 +97,4 @@ def plot_coverage(plan: CoveragePlan, path: str | Path) -> None:
         if values.shape[1] > 1:
             ax.legend(loc="upper right", fontsize=8)
     ax.set_xlabel("t (s)")
-    save_png(fig, path, dpi=100)
+    save_png(fig, path, dpi=100)  # (110 before: 0.145 s for the L-shaped field, now 0.13 s)
