@@ -109,3 +109,26 @@ def test_the_refinement_samples_every_interval_end_from_the_left() -> None:
     assert np.isin(plan._sigma[:-1], sampled).all()
     # The path's derivatives there are evaluated once, for every refinement round.
     np.testing.assert_array_equal(samples.path_even[2], plan._path(sampled, nu=3))
+
+
+def test_the_refinement_reads_the_profile_as_the_spline_evaluates_it() -> None:
+    """The timing's rates at the even samples, from each interval's coefficients times one
+    matrix, are the profile spline's own (with a jerk limit a cubic in ``b**(3/4)``, without
+    one linear in ``b``), the interval ends from the left included."""
+    from speed_curves import square_spiral
+
+    from skyquill.coverage.speed import iteration, plan_speed
+
+    for jmax in (3.0, None):
+        plan = plan_speed(square_spiral(), 3.0, 5.0, jmax, n=300, max_excess=None)
+        samples = iteration._Samples.of(plan)
+        for blended, evaluated in zip(samples.rates(plan), plan._derivs(samples.even), strict=True):
+            # To round-off, but at the rest ends, where w = 0 and the cube root of w's
+            # round-off is read: the blend gives the end itself from the left and the
+            # spline the point an ulp before it (w ~ 1e-12); at the start the blend's
+            # w = (-w_1 + w_1) / 6 is 4e-14 (rates of ~1e-7 against limits of 1-5).
+            scale = max(1.0, float(np.abs(evaluated).max()))
+            inner = slice(1, -1)
+            np.testing.assert_allclose(blended[inner], evaluated[inner], rtol=0, atol=1e-9 * scale)
+            ends = [0, -1]
+            np.testing.assert_allclose(blended[ends], evaluated[ends], rtol=0, atol=1e-6 * scale)

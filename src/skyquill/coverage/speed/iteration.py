@@ -11,7 +11,13 @@ from numpy.typing import NDArray
 
 from skyquill.coverage.speed.curve import _derivs3
 from skyquill.coverage.speed.norms import limit_ratio
-from skyquill.coverage.speed.profile import SpeedPlan, _interval_times, _profile_spline
+from skyquill.coverage.speed.profile import (
+    SpeedPlan,
+    _interval_times,
+    _profile_spline,
+    rates_of_b,
+    rates_of_w,
+)
 from skyquill.coverage.speed.rows import GridSolver, _Bounds, _end_caps
 from skyquill.trajectory.retimed import increasing_preimage, interior_knots
 from skyquill.validation import FloatArray
@@ -174,6 +180,10 @@ class _Samples(NamedTuple):
     path_even, path_kinks
         The path's first three derivatives at ``even`` and at ``kinks``: the same in
         every refinement round (only the timing changes), evaluated once.
+    blend
+        The profile's spline and its derivatives at ``even`` as weights of its
+        coefficients: ``(k + 1, m + 1)`` each, for a spline of degree ``k`` on the
+        uniform grid (:func:`_blend`).
     """
 
     m: int
@@ -182,6 +192,7 @@ class _Samples(NamedTuple):
     at: NDArray[np.intp]
     path_even: tuple[FloatArray, FloatArray, FloatArray]
     path_kinks: tuple[FloatArray, FloatArray, FloatArray]
+    blend: tuple[FloatArray, ...]
 
     @classmethod
     def of(cls, plan: SpeedPlan) -> _Samples:
@@ -195,7 +206,42 @@ class _Samples(NamedTuple):
         kinks = _kinks(plan)
         at = np.clip(np.searchsorted(sig, kinks, side="right") - 1, 0, sig.size - 2)
         path = plan._path
-        return cls(m, us, kinks, at, _derivs3(path, us), _derivs3(path, kinks))
+        blend = _blend(m, sig[1] - sig[0], jerk=plan.jmax is not None)
+        return cls(m, us, kinks, at, _derivs3(path, us), _derivs3(path, kinks), blend)
+
+    def rates(self, plan: SpeedPlan) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """``plan``'s ``u_dot``, ``u_ddot``, ``u_dddot`` at :attr:`even`, each
+        ((n - 1) (m + 1),).
+
+        The profile is a spline on the uniform grid whose intervals are all sampled at
+        the same local points, so its values there are each interval's coefficients
+        times one matrix (:attr:`blend`): a small product where the B-spline's own
+        evaluation searched the knots of 50,000 points three times a refinement round
+        (a fifth of a 2,000-point jerk-limited plan). The same polynomials: they agree
+        with it to round-off (``tests/coverage/speed/test_iteration.py``).
+        """
+        coef = plan._bspline.c
+        windows = np.lib.stride_tricks.sliding_window_view(coef, len(self.blend[0]))
+        values = [np.dot(windows[: plan._sigma.size - 1], w).ravel() for w in self.blend]
+        if plan.jmax is None:
+            return rates_of_b(values[0], values[1])
+        return rates_of_w(values[0], values[1], values[2])
+
+
+def _blend(m: int, h: float, *, jerk: bool) -> tuple[FloatArray, ...]:
+    """Weights of a uniform spline's coefficients at ``t = 0, 1/m, ..., (m - 1)/m`` and
+    ``t = 1`` (the end from the left) of each interval of width ``h``: the value and its
+    first two derivatives in ``u`` of a cubic (``jerk``; shapes (4, m + 1), the uniform
+    cubic B-spline's blending functions), else the value and the slope of a linear spline
+    ((2, m + 1))."""
+    t = np.append(np.arange(m) / m, 1.0)
+    if not jerk:
+        return np.stack([1.0 - t, t]), np.stack([-np.ones_like(t), np.ones_like(t)]) / h
+    s = 1.0 - t
+    value = np.stack([s**3, 3 * t**3 - 6 * t**2 + 4, -3 * t**3 + 3 * t**2 + 3 * t + 1, t**3])
+    slope = np.stack([-3 * s**2, 9 * t**2 - 12 * t, -9 * t**2 + 6 * t + 3, 3 * t**2])
+    curvature = np.stack([6 * s, 18 * t - 12, -18 * t + 6, 6 * t])
+    return value / 6.0, slope / (6.0 * h), curvature / (6.0 * h * h)
 
 
 def _interval_excess(
@@ -232,21 +278,24 @@ def _interval_excess(
     # A plan that stops the vehicle between the rest ends is refused here (InfeasibleError).
     _interval_times(plan._bsig, sig[1] - sig[0], jerk=plan.jmax is not None)
     per_interval = (sig.size - 1, samples.m + 1)
-    ex = [np.maximum(x.reshape(per_interval).max(axis=1) - 1.0, 0.0)
-          for x in _ratios(plan, samples.even, samples.path_even)]  # fmt: skip
+    even = _ratios(plan, samples.rates(plan), samples.path_even)
+    ex = [np.maximum(x.reshape(per_interval).max(axis=1) - 1.0, 0.0) for x in even]
     if samples.kinks.size:
-        ratios = _ratios(plan, samples.kinks, samples.path_kinks)
+        ratios = _ratios(plan, plan._derivs(samples.kinks), samples.path_kinks)
         for x, per in zip(ratios, ex, strict=True):
             np.maximum.at(per, samples.at, x - 1.0)
     return ex[0], ex[1], ex[2]
 
 
 def _ratios(
-    plan: SpeedPlan, us: FloatArray, path: tuple[FloatArray, FloatArray, FloatArray]
+    plan: SpeedPlan,
+    rates: tuple[FloatArray, FloatArray, FloatArray],
+    path: tuple[FloatArray, FloatArray, FloatArray],
 ) -> list[FloatArray]:
-    """Speed, acceleration and jerk over their limits at the grid parameters ``us`` (M,),
-    where the path's first three derivatives are ``path`` (each (M, d))."""
-    ud, udd, uddd = plan._derivs(us)
+    """Speed, acceleration and jerk over their limits at M points where the timing's
+    ``rates`` are ``u_dot``, ``u_ddot``, ``u_dddot`` (each (M,)) and the path's first
+    three derivatives ``path`` (each (M, d))."""
+    ud, udd, uddd = rates
     c1, c2, c3 = path
     speed = np.linalg.norm(c1, axis=1) * ud / plan.vmax
     acc = limit_ratio(c2 * (ud**2)[:, None] + c1 * udd[:, None], plan.amax, plan.norm_sides)

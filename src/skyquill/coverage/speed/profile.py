@@ -201,15 +201,8 @@ class SpeedPlan:
         ``u_dddot = (2/9) w'**2 + (2/3) w w''`` are all bounded.
         """
         if self.jmax is None:
-            b = np.maximum(self._b_eval(u, 0), 0.0)
-            return np.sqrt(b), 0.5 * self._b_eval(u, 1), np.zeros_like(u)
-        w = np.maximum(self._b_eval(u, 0), 0.0)
-        w1 = self._b_eval(u, 1)
-        w2 = self._b_eval(u, 2)
-        ud = w ** (2.0 / 3.0)
-        udd = (2.0 / 3.0) * np.cbrt(w) * w1
-        uddd = (2.0 / 9.0) * w1**2 + (2.0 / 3.0) * w * w2
-        return ud, udd, uddd
+            return rates_of_b(self._b_eval(u, 0), self._b_eval(u, 1))
+        return rates_of_w(self._b_eval(u, 0), self._b_eval(u, 1), self._b_eval(u, 2))
 
     def _samples(self, uarr: FloatArray, T: float) -> Setpoints:
         t = T * np.arange(uarr.size, dtype=np.float64)
@@ -255,6 +248,24 @@ def _norm_limit(order: int, bound: float, dim: int) -> CylinderLimit:
     if dim == 3:
         return CylinderLimit(order, bound, z_lower=-bound, z_upper=bound)
     return CylinderLimit(order, bound)
+
+
+def rates_of_b(b: FloatArray, b1: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """``u_dot``, ``u_ddot``, ``u_dddot`` (each like ``b``) of a profile linear in ``b``
+    (no jerk limit), from ``b`` and ``b' = db/du``: ``sqrt(b)``, ``b' / 2`` and 0."""
+    return np.sqrt(np.maximum(b, 0.0)), 0.5 * b1, np.zeros_like(b)
+
+
+def rates_of_w(
+    w: FloatArray, w1: FloatArray, w2: FloatArray
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """``u_dot``, ``u_ddot``, ``u_dddot`` (each like ``w``) of a jerk-limited profile, from
+    ``w = b**(3/4)`` and its first two derivatives in ``u`` (see :meth:`SpeedPlan._derivs`)."""
+    w = np.maximum(w, 0.0)
+    ud = w ** (2.0 / 3.0)
+    udd = (2.0 / 3.0) * np.cbrt(w) * w1
+    uddd = (2.0 / 9.0) * w1**2 + (2.0 / 3.0) * w * w2
+    return ud, udd, uddd
 
 
 def _profile_spline(sig: FloatArray, b: FloatArray, *, jerk: bool) -> BSpline:
