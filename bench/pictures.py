@@ -15,8 +15,8 @@ A command run from the shell also starts Python and imports skyquill (a few seco
 this machine, more than ``fit`` plans in), and, when it draws, matplotlib (inside the
 pictures' time). So the short commands (:data:`FRESH`) are also run as a user runs them,
 ``skyquill ...`` in a fresh process, alternated the same way: ``fresh_process`` holds
-their shares of that wall time. There ``fit``, ``fly`` and ``write`` draw in the picture
-worker (:mod:`skyquill.viz.worker`) when a core is free as they start:
+their shares of that wall time. There ``fit``, ``fly``, ``write`` and ``cover`` draw in the
+picture worker (:mod:`skyquill.viz.worker`) when a core is free as they start:
 ``runs_drawn_in_the_worker`` counts those runs. In the same loop each is also run with
 the worker always started (``worker_always``) and never (``worker_never``), the A/B of
 the worker under the same load (``always_over_never``: the ratio of their wall times).
@@ -67,7 +67,7 @@ WORKLOADS: dict[str, list[str]] = {
     "show small": ["show", str(EXAMPLES / "show_small.toml"), "--out", "{out}"],
 }  # fmt: skip
 #: Workloads also run in a fresh process: those whose planning takes under a second here.
-FRESH = ("fit spiral", "fly spiral", "write Hi")
+FRESH = ("fit spiral", "fly spiral", "write Hi", "cover l_field")
 #: The console script a user runs, and BLAS on one thread in its process too.
 SKYQUILL = Path(sys.executable).with_name("skyquill")
 ONE_THREAD = {name: "1" for name in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")}

@@ -103,13 +103,19 @@ def test_only_drawing_commands_start_it() -> None:
     assert _will_draw(["write", "Hi", "--out", "o"])
     assert not _will_draw(["fit", "a.csv", "--out", "o", "--no-pictures"])
     assert not _will_draw(["fly", "--help"])
-    assert not _will_draw(["cover", "field.geojson", "--out", "o"])
+    assert _will_draw(["cover", "field.geojson", "--out", "o"])
+    assert not _will_draw(["show", "show.toml", "--out", "o"])
     assert not _will_draw([])
     assert isinstance(a_core_is_free(), bool)
 
 
 @pytest.mark.timeout(180)
-def test_fit_from_the_console_script_draws_in_the_worker(tmp_path: Path) -> None:
+@pytest.mark.parametrize(
+    "command",
+    [("fit", "spiral.csv"), ("cover", "coverage/l_field.geojson")],
+    ids=lambda command: command[0],
+)
+def test_the_console_script_draws_in_the_worker(tmp_path: Path, command: tuple[str, str]) -> None:
     """As a user runs it (a core taken as free: the machine running the tests may be busy)."""
     script = (
         "import atexit, sys; import skyquill.viz.worker as w; w.a_core_is_free = lambda: True; "
@@ -118,7 +124,7 @@ def test_fit_from_the_console_script_draws_in_the_worker(tmp_path: Path) -> None
     )
     out = tmp_path / "o"
     done = subprocess.run(
-        [sys.executable, "-c", script, "fit", str(EXAMPLES / "spiral.csv"), "--out", str(out)],
+        [sys.executable, "-c", script, command[0], str(EXAMPLES / command[1]), "--out", str(out)],
         capture_output=True,
         text=True,
         check=False,

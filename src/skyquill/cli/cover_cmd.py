@@ -33,6 +33,7 @@ from skyquill.errors import InputError
 from skyquill.limits import VehicleLimits
 from skyquill.parallel import Where
 from skyquill.phases import MIN_ALTITUDE_M, check_altitude
+from skyquill.viz.worker import Drawing
 
 if TYPE_CHECKING:
     from rich.progress import Progress, TaskID
@@ -169,7 +170,6 @@ def cover(
     from skyquill.io.plan_dir import write_plan
     from skyquill.io.points import check_rows_written
     from skyquill.io.trajectory_json import PlannedTrajectory
-    from skyquill.viz.coverage_plot import plot_coverage
 
     with user_errors():
         check_out(out)
@@ -239,7 +239,7 @@ def cover(
                 # The refit for a target holds the limits through the hull; the LP does not.
                 guaranteed=plan.delivered is not None,
                 summary=fields,
-                plot=drawn.plot(lambda path: plot_coverage(plan, path)),
+                plot=drawn.sampled(lambda: _coverage_drawing(plan)),
                 min_altitude_m=floor,
             )
     uploads = "" if plan.delivered is None else f", {len(plan.delivered.budget.uploads)} upload(s)"
@@ -248,6 +248,14 @@ def cover(
         f"coverage {plan.coverage:.4f}, max excess {summary['plan']['max_excess']:.4f}, "
         f"planned in {plan.planning_time:.2f} s -> {out}"
     )
+
+
+def _coverage_drawing(plan: CoveragePlan) -> Drawing:
+    """``plot.png``: matplotlib is imported where it is drawn (the picture worker, or here),
+    only when drawn, inside the pictures' time (:class:`~skyquill.cli.pictures.Pictures`)."""
+    from skyquill.viz.sampled import sample_coverage
+
+    return Drawing("skyquill.viz.coverage_plot", "draw_coverage", sample_coverage(plan))
 
 
 def _write_geojson(

@@ -17,7 +17,7 @@ import sys
 #: Exit status of an interrupted command (128 + SIGINT); the same as the app's.
 INTERRUPTED = 130
 #: The commands whose ``plot.png`` the picture worker draws (``--no-pictures`` skips it).
-DRAWN_BY_THE_WORKER = ("fit", "fly", "write")
+DRAWN_BY_THE_WORKER = ("cover", "fit", "fly", "write")
 
 
 def run() -> None:

@@ -7,7 +7,7 @@ takes ``--no-pictures``. Either way ``summary.json`` says what happened, under
 ``pictures``: ``drawn`` (false with ``--no-pictures``), the ``files`` drawn and
 ``time_s``, the time spent drawing them, s (so a user sees what they cost).
 
-Run from a shell with a core free, ``fit``, ``fly`` and ``write`` draw ``plot.png`` in
+Run from a shell with a core free, ``fit``, ``fly``, ``write`` and ``cover`` draw ``plot.png`` in
 the picture worker (:mod:`skyquill.viz.worker`), started by the console script before
 the program's imports, so that matplotlib's import and the fonts' loading are done on
 the free core while the command plans. ``process`` then says ``"worker"``, and

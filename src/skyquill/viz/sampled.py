@@ -1,4 +1,4 @@
-"""What ``fit``'s, ``fly``'s and ``write``'s figures show, sampled into plain arrays.
+"""What ``fit``'s, ``fly``'s, ``write``'s and ``cover``'s figures show, sampled into plain arrays.
 
 Sampling a plan (evaluating its trajectories, finding its pen-down stretches) needs
 skyquill's core; drawing the samples needs only numpy and matplotlib. Kept apart, the
@@ -22,7 +22,10 @@ import numpy as np
 from skyquill.validation import FloatArray
 
 if TYPE_CHECKING:
+    from shapely.geometry.base import BaseGeometry
+
     from skyquill.calligraphy.mission import Mission
+    from skyquill.coverage.plan import CoveragePlan
     from skyquill.limits import DerivativeLimit
     from skyquill.optimize.fit import PointFit
     from skyquill.sim.result import Flight
@@ -32,6 +35,9 @@ FIT_SAMPLES = 2000
 #: Samples per drone of ``write``'s board view and of its derivative panels.
 BOARD_SAMPLES = 4000
 CURVE_SAMPLES = 1500
+#: Most setpoints ``cover``'s figure draws as dots (a 10 ha field has 370k; the figure
+#: cannot show more).
+MAX_DOTS = 40_000
 #: Gap between two boards of ``write``'s board view, in units of the board's size.
 BOARD_GAP = 0.25
 
@@ -105,6 +111,39 @@ class WritingSamples:
     board_title: str
     norms: tuple[NormPanel, ...]
     duration_s: float
+    title: str
+
+
+@dataclass(frozen=True)
+class Area:
+    """A polygon to fill: its outer ring and its holes' rings, each (K, 2), m."""
+
+    exterior: FloatArray
+    holes: tuple[FloatArray, ...]
+
+
+@dataclass(frozen=True)
+class CoverageSamples:
+    """``cover``'s figure: the field from above, the flight's derivatives against time.
+
+    ``covered`` and ``missed`` the areas to fill, ``boundaries`` the rings of the fields'
+    shells and holes (K, 2); ``dots`` (M, 2) setpoints, m, coloured by ``dot_speed`` (M,),
+    m/s; ``waypoints`` (W, 2), m. Against ``t`` (N,) s: ``speed`` (N,) m/s and the
+    horizontal components' magnitudes ``acceleration`` (N, 2) m/s² and ``jerk`` (N, 2)
+    m/s³, with their ``limits`` (speed, acceleration, jerk).
+    """
+
+    covered: tuple[Area, ...]
+    missed: tuple[Area, ...]
+    boundaries: tuple[FloatArray, ...]
+    dots: FloatArray
+    dot_speed: FloatArray
+    waypoints: FloatArray
+    t: FloatArray
+    speed: FloatArray
+    acceleration: FloatArray
+    jerk: FloatArray
+    limits: tuple[float, float, float]
     title: str
 
 
@@ -215,3 +254,52 @@ def _norm_panel(missions: list[Mission], order: int) -> NormPanel:
         float(lim.upper.max()) if isinstance(lim, BoxLimit) else float(lim.radius) for lim in limits
     )
     return NormPanel(tuple(curves), bounds, per_axis)
+
+
+def sample_coverage(plan: CoveragePlan) -> CoverageSamples:
+    """What ``cover``'s figure of ``plan`` draws (see :class:`CoverageSamples`)."""
+    import shapely  # the core: not imported by the worker
+
+    from skyquill.coverage.regions import swept as swept_area
+
+    opts = plan.options
+    sp = plan.samples()
+    sprayed = None if plan.mission is None else plan.mission.swept  # spray off on transits
+    # The planner's own simplified sweep: the raw buffer of a 20 km path's 1 M
+    # points took a minute.
+    swept = swept_area(plan.path, opts.width) if sprayed is None else sprayed
+    speed = np.linalg.norm(sp.v, axis=1)
+    every = max(1, speed.size // MAX_DOTS)
+    missed = "" if plan.missed is None else f", {plan.missed.area_m2:.3g} m²"
+    return CoverageSamples(
+        covered=_areas(plan.region.intersection(swept)),
+        missed=_areas(plan.region.difference(swept)),
+        boundaries=tuple(
+            np.asarray(ring.coords)[:, :2] for ring in shapely.get_parts(plan.region.boundary)
+        ),
+        dots=sp.p[::every, :2],
+        dot_speed=speed[::every],
+        waypoints=np.asarray(plan.waypoints)[:, :2],
+        t=sp.t,
+        speed=speed,
+        acceleration=np.abs(sp.a[:, :2]),
+        jerk=np.abs(sp.j[:, :2]),
+        limits=(float(opts.vmax), float(opts.amax), float(opts.jmax)),
+        # Two lines: on one, a long flight's numbers ran past the map's left edge.
+        title=f"{opts.pattern}: {plan.duration:.1f} s, {plan.path_length:.1f} m\n"
+        f"coverage {100 * plan.coverage:.1f} % (red: missed{missed})",
+    )
+
+
+def _areas(shape: BaseGeometry) -> tuple[Area, ...]:
+    """The polygons of ``shape`` (a polygon or a collection), as rings to fill."""
+    from shapely.geometry import Polygon
+
+    return tuple(
+        Area(
+            np.asarray(part.exterior.coords)[:, :2],
+            tuple(np.asarray(hole.coords)[:, :2] for hole in part.interiors),
+        )
+        for part in getattr(shape, "geoms", [shape])
+        if isinstance(part, Polygon) and not part.is_empty
+    )

@@ -1,6 +1,6 @@
 """The picture worker: a second process that imports matplotlib while the command plans.
 
-Run from a shell, ``skyquill fit`` (or ``fly``, ``write``) spends about a second
+Run from a shell, ``skyquill fit`` (or ``fly``, ``write``, ``cover``) spends about a second
 importing skyquill and a fraction of one planning; its picture then costs matplotlib's
 import (about 0.5 s of CPU, paid once per process) and the drawing (0.4-0.5 s). Both are
 CPU work under the GIL: a thread would only take turns with the command. A process runs
@@ -50,6 +50,7 @@ if TYPE_CHECKING:
 
 #: The modules that draw in the worker (imported there before any drawing is asked for).
 DRAWING_MODULES = (
+    "skyquill.viz.coverage_plot",
     "skyquill.viz.fit_plot",
     "skyquill.viz.flight_plot",
     "skyquill.viz.writing_plot",
