@@ -21,6 +21,7 @@ from skyquill.coverage.regions import (
     holes,
     load_region,
     region_from_vertices,
+    vertex_turns,
 )
 from skyquill.errors import InputError
 
@@ -315,3 +316,15 @@ def test_random_bytes_give_an_input_error(raw: bytes, suffix: str) -> None:
         path.write_bytes(raw)
         with pytest.raises(InputError, match=r"raw\."):
             load_region(path)
+
+
+def test_vertex_turns_give_each_vertex_its_turn() -> None:
+    # Counter-clockwise: a left turn of 90° at each corner, straight on at (5, 0), back
+    # along the edge at the spike's tip (12, 5).
+    ring = np.array([[0, 0], [5, 0], [10, 0], [10, 5], [12, 5], [10, 5], [10, 10], [0, 10]], float)
+    cross, dot, scale = vertex_turns(ring)
+    sine = cross / scale
+    np.testing.assert_allclose(sine[[0, 2, 6, 7]], 1.0)
+    assert sine[1] == 0.0 and dot[1] > 0.0  # straight on
+    assert sine[4] == 0.0 and dot[4] < 0.0  # the spike turns back
+    np.testing.assert_allclose(scale[1], 25.0)

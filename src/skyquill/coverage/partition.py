@@ -17,7 +17,7 @@ import shapely
 from shapely.geometry import LineString, Point, Polygon
 from shapely.geometry.polygon import orient
 
-from skyquill.coverage.regions import MAX_MISSION_PATH_M, check_width
+from skyquill.coverage.regions import MAX_MISSION_PATH_M, check_width, vertex_turns
 from skyquill.errors import InputError
 from skyquill.validation import FloatArray
 
@@ -189,11 +189,8 @@ def _reflex_cut_decompositions(region: Polygon) -> list[list[Polygon]]:
 
 def _reflex_vertices(ring: FloatArray) -> FloatArray:
     """The vertices ``(R, 2)`` of a counter-clockwise ring with an interior angle > 180°."""
-    into = ring - np.roll(ring, 1, axis=0)
-    out = np.roll(ring, -1, axis=0) - ring
-    cross = into[:, 0] * out[:, 1] - into[:, 1] * out[:, 0]
-    scale = np.linalg.norm(into, axis=1) * np.linalg.norm(out, axis=1)
-    turn_back = np.einsum("ij,ij->i", into, out) < 0.0  # a zero-width spike turns 360°
+    cross, dot, scale = vertex_turns(ring)
+    turn_back = dot < 0.0  # a zero-width spike turns 360°
     reflex: FloatArray = ring[
         (cross < -_LEN_TOL * scale)
         | ((cross <= 0.0) & turn_back & (np.abs(cross) <= _LEN_TOL * scale))

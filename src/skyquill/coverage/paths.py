@@ -31,7 +31,7 @@ from shapely.geometry import LineString, MultiPolygon, Polygon
 from shapely.geometry.base import BaseGeometry
 from shapely.geometry.polygon import orient
 
-from skyquill.coverage.regions import check_width
+from skyquill.coverage.regions import check_width, vertex_turns
 from skyquill.errors import InputError
 from skyquill.validation import as_array, as_float, as_int
 
@@ -151,12 +151,8 @@ def _without_straight(ring: FloatArray) -> FloatArray:
     """
     if len(ring) <= 3:
         return ring
-    into = ring - np.roll(ring, 1, axis=0)
-    out = np.roll(ring, -1, axis=0) - ring
-    cross = into[:, 0] * out[:, 1] - into[:, 1] * out[:, 0]
-    scale = np.linalg.norm(into, axis=1) * np.linalg.norm(out, axis=1)
-    forward = np.einsum("ij,ij->i", into, out) > 0.0
-    straight = forward & (np.abs(cross) <= STRAIGHT_TURN_RAD * scale)
+    cross, dot, scale = vertex_turns(ring)
+    straight = (dot > 0.0) & (np.abs(cross) <= STRAIGHT_TURN_RAD * scale)
     kept = ring[~straight]
     return kept if len(kept) >= 3 else ring
 

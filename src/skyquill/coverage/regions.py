@@ -77,6 +77,18 @@ def has_keepouts(region: Region) -> bool:
     return isinstance(region, Polygon) and bool(region.interiors)
 
 
+def vertex_turns(ring: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """How the closed ``ring`` (K, 2), m, turns at each of its vertices, each (K,):
+    ``cross`` and ``dot``, the cross (z) and dot products of the edges into and out of
+    the vertex, and ``scale``, the product of their lengths (m²): ``cross / scale`` is
+    the sine of the turn (> 0 to the left), ``dot > 0`` goes on forward."""
+    into = ring - np.roll(ring, 1, axis=0)
+    out = np.roll(ring, -1, axis=0) - ring
+    cross = into[:, 0] * out[:, 1] - into[:, 1] * out[:, 0]
+    scale = np.linalg.norm(into, axis=1) * np.linalg.norm(out, axis=1)
+    return cross, np.einsum("ij,ij->i", into, out), scale
+
+
 def load_region(source: str | Path, project: Callable[[Any, str], Any] | None = None) -> Region:
     """Read a region: a ``.geojson``/``.json`` file (Polygon, Feature or one-feature
     FeatureCollection), a ``.wkt`` file, or a WKT string.
