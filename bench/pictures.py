@@ -22,9 +22,9 @@ the worker always started (``worker_always``) and never (``worker_never``), the 
 the worker under the same load (``always_over_never``: the ratio of their wall times).
 
 Written to ``bench/results/pictures.json``. Run: ``.venv/bin/python bench/pictures.py``
-(about 2 minutes on two free cores with ``--runs 3``, the default: 1.5 in session 40); ``--runs 1`` on a busy
-machine (``runs`` is recorded), ``--only write`` for the workloads whose name starts with that
-(written to ``pictures_quick.json``).
+(about 2 minutes on two free cores with ``--runs 3``, the default: 1.5 in session 40);
+``--runs 1`` on a busy machine (``runs`` is recorded), ``--only write`` for the workloads whose
+name starts with that (written to ``pictures_quick.json``).
 """
 
 from __future__ import annotations

@@ -336,7 +336,13 @@ def _tighten(
     where the interpolant's jerk is not proportional to the grid's (short
     features, rest ends) a plain ``1 / (1 + excess)`` converges only
     geometrically.  The rest-end caps on ``b_1``, ``b_{n-2}`` are jerk limits
-    too (``b_1**1.5`` scales like the jerk) and follow the end intervals.
+    too (``b_1**1.5`` scales like the jerk) and follow the worst of the three
+    intervals each shapes (``0 .. 2``, ``n - 4 .. n - 2``): following the end
+    interval alone, the 2,000-point spiral of the 10 m square kept 4-6 % of
+    jerk excess in interval ``n - 3`` through three rounds (its cap, which that
+    interval's cubic reads, never moved) and took four rounds (0.17 s); now one
+    (0.12 s, a 0.14 % shorter flight; elsewhere the flights moved by at most
+    0.06 %, the rounds not at all).
     """
     ev, ea, ej = excess
     n = bounds.ub.size
@@ -344,4 +350,5 @@ def _tighten(
     bounds.jerk = bounds.jerk / (1.0 + _spread(ej, -1, 2, n)) ** power
     bounds.acc = bounds.acc / (1.0 + _spread(ea, -1, 1, n - 1)) ** power
     # speed**2 multiplies the column bound, so b scales like (1 + e)**(-2/3).
-    bounds.speed[[1, n - 2]] /= (1.0 + ej[[0, n - 2]]) ** (power / 3.0)
+    ends = np.array([ej[:3].max(), ej[-3:].max()])
+    bounds.speed[[1, n - 2]] /= (1.0 + ends) ** (power / 3.0)
