@@ -81,17 +81,15 @@ def show(
         show_script = load_script(script)
         stages: dict[str, float] = {}
         plan = _plan(show_script, workers, scheduler)
-        clock = time.perf_counter()
-        with console.status(f"checking {len(plan.drones)} drones"):
-            report = _check(plan, show_script)
-        stages["check"] = time.perf_counter() - clock
-        with (
-            staged_output(out, "show", force=force, inputs=[script]) as stage,
-            _out_of_collectors_sight(),
-        ):
-            drawn = Pictures(not no_pictures)
-            where = Where(workers, scheduler)
-            summary = _write(stage, plan, show_script, report, stages, drawn, floor, where)
+        with _out_of_collectors_sight():
+            clock = time.perf_counter()
+            with console.status(f"checking {len(plan.drones)} drones"):
+                report = _check(plan, show_script)
+            stages["check"] = time.perf_counter() - clock
+            with staged_output(out, "show", force=force, inputs=[script]) as stage:
+                drawn = Pictures(not no_pictures)
+                where = Where(workers, scheduler)
+                summary = _write(stage, plan, show_script, report, stages, drawn, floor, where)
     say_done(
         f"{out}: {summary['drones']} drones, {summary['duration_s']:.1f} s, no two closer than "
         f"{summary['min_separation_m']['guaranteed']:.3f} m (guaranteed; "
@@ -103,8 +101,8 @@ def show(
 
 @contextmanager
 def _out_of_collectors_sight() -> Iterator[None]:
-    """The objects alive now (the plan and its check) frozen out of the cyclic garbage
-    collector's sight while the files are written, unfrozen after.
+    """The objects alive now (the plan) frozen out of the cyclic garbage collector's sight
+    while the plan is checked and its files are written, unfrozen after.
 
     They live to the end of the command anyway, and the exports allocate millions of small
     objects (keyframe lists, JSON, CSV rows), each full collection walking every object
