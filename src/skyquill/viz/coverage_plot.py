@@ -1,8 +1,8 @@
 """The figure of a coverage plan: region, path and covered area; speed, acceleration, jerk.
 
 :func:`draw_coverage` draws :func:`~skyquill.viz.sampled.sample_coverage`'s arrays with
-numpy and matplotlib only, so that ``cover`` can have the picture worker
-(:mod:`skyquill.viz.worker`) draw it while the command writes its plan.
+numpy and matplotlib only, so that ``cover`` can hand them to the picture worker
+(:mod:`skyquill.viz.worker`), which imported matplotlib while the command planned.
 """
 
 from __future__ import annotations

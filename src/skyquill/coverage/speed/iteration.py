@@ -218,7 +218,7 @@ class _Samples(NamedTuple):
         times one matrix (:attr:`blend`): a small product where the B-spline's own
         evaluation searched the knots of 50,000 points three times a refinement round
         (a fifth of a 2,000-point jerk-limited plan). The same polynomials: they agree
-        with it to round-off (``tests/coverage/speed/test_iteration.py``).
+        with it to round-off (``tests/coverage/test_speed_iteration.py``).
         """
         coef = plan._bspline.c
         windows = np.lib.stride_tricks.sliding_window_view(coef, len(self.blend[0]))
