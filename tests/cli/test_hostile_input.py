@@ -609,6 +609,8 @@ ISSUE25 = [
     Case("fit --vmax 1_0", _fit("--vmax", "1_0"), "--vmax: got '1_0'"),
     Case("fit --degree 1.5", _fit("--degree", "1.5"), "--degree: got '1.5', expected a whole"),
     Case("fit --bogus", _fit("--bogus"), "--bogus: got an option skyquill fit does not have"),
+    Case("an extra argument (was 'got Got unexpected')", _fit("crazyswarm"),
+         "skyquill fit: got unexpected extra argument(s) (crazyswarm), expected its usage"),
     Case("fit without --out", ["fit", SPIRAL], "--out: got nothing"),
     Case("no such command", ["paint-by-numbers"], "got the command 'paint-by-numbers'"),
     Case("fly --rate 1e-320 (was control_period: got inf)", _fly("--rate", "1e-320"),

@@ -267,7 +267,9 @@ def click_line(exc: Any) -> str:
         names = ", ".join(ctx.command.list_commands(ctx))
         wrong = message.removeprefix("No such command").strip(" .")
         return f"{command}: got the command {wrong}, expected one of {names}"
-    return f"{command}: got {message}, expected its usage ({see})"
+    # Click's own sentences may start with the word this line starts with ("Got unexpected
+    # extra argument (x)"): said once.
+    return f"{command}: got {message.removeprefix('Got ')}, expected its usage ({see})"
 
 
 def _hint(exc: Any) -> str:
