@@ -357,10 +357,10 @@ def test_a_leg_too_long_is_refused_alike_whether_or_not_the_legs_share_a_limit(
 
 
 def test_a_chain_copies_its_phase_durations_from_the_longest_chain_so_far() -> None:
-    # One norm limit: each chain's breaks start as 0 then the shared profile's durations once
-    # a leg (the cruise 0, filled in per leg), copied from an array kept for the longest
-    # chain so far, grown as longer ones come: a new array each time, whatever came before.
-    # Chains longer than KEPT_LEGS tile their own.
+    # One norm limit: each chain's phase durations start as 0 then the shared profile's
+    # durations once a leg (the cruise 0, filled in per leg), copied from an array kept for
+    # the longest chain so far, grown as longer ones come: a new array each time, whatever
+    # came before. Chains longer than KEPT_LEGS tile their own.
     from skyquill.optimize.double_s import cruise
     from skyquill.optimize.legs import KEPT_LEGS, _Shared
 
@@ -369,12 +369,12 @@ def test_a_chain_copies_its_phase_durations_from_the_longest_chain_so_far() -> N
     shared = _Shared(profile, 3)
     handed = []
     for k in (3, 1, 10, 4, 25, 11, 60, 2, KEPT_LEGS, KEPT_LEGS + 1, 1000, KEPT_LEGS - 1, 7):
-        breaks = shared.breaks(k)
-        np.testing.assert_array_equal(breaks, np.r_[0.0, np.tile(profile.durations, k)])
-        assert breaks.flags.writeable and breaks.flags.c_contiguous
-        assert not any(np.shares_memory(breaks, other) for other in handed)
-        handed.append(breaks)
-        breaks[:] = -1.0  # its owner sums it in place: the next chain is not affected
+        durations = shared.durations(k)
+        np.testing.assert_array_equal(durations, np.r_[0.0, np.tile(profile.durations, k)])
+        assert durations.flags.writeable and durations.flags.c_contiguous
+        assert not any(np.shares_memory(durations, other) for other in handed)
+        handed.append(durations)
+        durations[:] = -1.0  # its owner fills in the cruises: the next chain is not affected
 
 
 # A chain's legs: cruising, too short to cruise, repeated points, and on the boundaries of
@@ -454,3 +454,16 @@ def test_waypoints_without_axes_or_finite_coordinates_are_refused_in_plain_words
         stop_and_go([[np.nan, 0.0], [1.0, np.inf]], lim)
     with pytest.raises(InputError, match=r"^waypoints: got 1 NaN or infinite value"):
         stop_and_go([[np.nan, 0.0]], lim)  # (before the count of points, as before)
+
+
+def test_a_repeat_is_a_step_within_1e_9_of_the_largest_coordinate_not_of_their_bound() -> None:
+    # The threshold is REPEAT_TOLERANCE times the largest magnitude (2,990 m here); the
+    # root of the sum of squares that stands in for it when no step is near (about 45 km)
+    # would take the 5e-6 m step for a repeat: it is a leg, and the 5e-7 m one is skipped.
+    far = np.tile([1000.0, -1000.0, 1000.0], (400, 1))
+    far[1:, 0] -= np.arange(1, 400) * 10.0  # legs of 10 m
+    for step, flown in ((5e-6, True), (5e-7, False)):
+        pts = np.insert(far, 1, far[0] + [0.0, 0.0, step], axis=0)
+        arrivals = stop_and_go(pts, LegLimits(2.0, 3.0, 10.0)).arrivals
+        assert bool(arrivals[1] > 0.0) is flown
+        assert arrivals.size == pts.shape[0]

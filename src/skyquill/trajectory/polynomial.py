@@ -68,9 +68,12 @@ class PiecewisePolynomial:
         poly = object.__new__(cls)
         breaks.setflags(write=False)
         coeffs.setflags(write=False)
-        object.__setattr__(poly, "breaks", breaks)
-        object.__setattr__(poly, "coeffs", coeffs)
-        object.__setattr__(poly, "yaw_coeffs", None)
+        # (The fields written into the instance's dict, as the frozen dataclass's own
+        # __init__ would leave them: a third cheaper than three object.__setattr__ calls.)
+        fields = poly.__dict__
+        fields["breaks"] = breaks
+        fields["coeffs"] = coeffs
+        fields["yaw_coeffs"] = None
         return poly
 
     @property
