@@ -7,6 +7,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from shapely.geometry import Polygon, shape
+from shapely.ops import transform
 from typer.testing import CliRunner
 
 from skyquill.cli.main import app
@@ -94,3 +96,37 @@ def test_out_of_range_coordinates_are_one_line_and_status_2(tmp_path: Path) -> N
         app, ["cover", str(field), "--out", str(tmp_path / "o"), "--crs", "EPSG:0"]
     )
     assert result.exit_code == 2 and "crs: got 'EPSG:0'" in result.output
+
+
+def test_the_covered_area_of_a_field_with_holes_is_what_the_spray_sweeps(tmp_path: Path) -> None:
+    # The mission's spray is off on its transits and within half a swath of the holes: the
+    # GeoJSON's covered area is the sprayed one, as coverage_fraction counts it (it was the
+    # whole path's swath, transits included, until session 41).
+    local = Polygon(
+        [(-12.0, -8.0), (12.0, -8.0), (12.0, 8.0), (-12.0, 8.0)],
+        [
+            [(-7.0, -3.0), (-4.0, -3.0), (-4.0, 1.0), (-7.0, 1.0)],
+            [(3.0, -1.0), (7.0, -1.0), (5.0, 3.0)],
+        ],
+    )
+
+    def lonlat(ring: object) -> list[list[float]]:
+        lon, lat = FRAME.to_geo(*np.asarray(ring).T)
+        return np.column_stack([lon, lat]).tolist()
+
+    rings = [lonlat(local.exterior.coords)] + [lonlat(h.coords) for h in local.interiors]
+    field = tmp_path / "field.geojson"
+    field.write_text(json.dumps({"type": "Polygon", "coordinates": rings}))
+    out = tmp_path / "plan"
+    args = ["cover", str(field), "--out", str(out), "--width", "2", "--time-limit", "600"]
+    result = CliRunner().invoke(app, [*args, "--no-pictures"])
+    assert result.exit_code == 0, result.output
+    summary = json.loads((out / "summary.json").read_text())
+    data = json.loads((out / "path.geojson").read_text())
+    covered_ll = shape(
+        next(f for f in data["features"] if f["properties"]["kind"] == "covered")["geometry"]
+    )
+    origin = summary["geo"]["origin"]
+    frame = GeoFrame(origin["lon_deg"], origin["lat_deg"])
+    covered = transform(frame.to_local, covered_ll)
+    assert covered.area / local.area == pytest.approx(summary["coverage_fraction"], abs=1e-4)

@@ -262,10 +262,9 @@ def _write_geojson(
     stage: Path, frame: GeoFrame, plan: CoveragePlan, planned: PlannedTrajectory
 ) -> dict[str, Any]:
     """``path.geojson`` (flown path and covered area in lon/lat), read back and checked."""
-    from skyquill.coverage.regions import swept
     from skyquill.export.geojson import write_path_geojson
 
-    covered = plan.region.intersection(swept(plan.path, plan.options.width))
+    covered = plan.region.intersection(plan.sprayed())
     check = write_path_geojson(stage / "path.geojson", frame, planned, covered, plan.region)
     return {"file": "path.geojson"} | check.as_dict()
 

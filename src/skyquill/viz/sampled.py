@@ -260,14 +260,9 @@ def sample_coverage(plan: CoveragePlan) -> CoverageSamples:
     """What ``cover``'s figure of ``plan`` draws (see :class:`CoverageSamples`)."""
     import shapely  # the core: not imported by the worker
 
-    from skyquill.coverage.regions import swept as swept_area
-
     opts = plan.options
     sp = plan.samples()
-    sprayed = None if plan.mission is None else plan.mission.swept  # spray off on transits
-    # The planner's own simplified sweep: the raw buffer of a 20 km path's 1 M
-    # points took a minute.
-    swept = swept_area(plan.path, opts.width) if sprayed is None else sprayed
+    swept = plan.sprayed()
     speed = np.linalg.norm(sp.v, axis=1)
     every = max(1, speed.size // MAX_DOTS)
     missed = "" if plan.missed is None else f", {plan.missed.area_m2:.3g} m²"

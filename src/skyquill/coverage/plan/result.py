@@ -9,12 +9,13 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
+from shapely.geometry.base import BaseGeometry
 
 from skyquill.coverage.missed import Missed
 from skyquill.coverage.mission import Mission
 from skyquill.coverage.plan.covering import path_length
 from skyquill.coverage.plan.options import CoverageOptions
-from skyquill.coverage.regions import Region
+from skyquill.coverage.regions import Region, swept
 from skyquill.coverage.speed import SpeedPlan
 from skyquill.coverage.target import DeliveredPath
 from skyquill.limits import BoxLimit, CylinderLimit, DerivativeLimit
@@ -100,6 +101,18 @@ class CoveragePlan:
     def path_length(self) -> float:
         """Length of the flown path, m."""
         return path_length(self.path)
+
+    def sprayed(self) -> BaseGeometry:
+        """The area the spray sweeps, m: the mission's (off on its transits and within half a
+        swath of the holes), or the whole path's swath (a polygon is sprayed throughout).
+
+        What ``coverage`` counts within the region; the GeoJSON's covered area and the
+        figure draw the same. A polygon's is the planner's simplified sweep (the raw buffer
+        of a 20 km path's million points takes a minute).
+        """
+        if self.mission is not None:
+            return self.mission.swept
+        return swept(self.path, self.options.width)
 
     def summary(self) -> dict[str, Any]:
         """What ``summary.json`` holds (JSON-ready)."""
