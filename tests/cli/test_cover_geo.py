@@ -112,7 +112,7 @@ def test_the_covered_area_of_a_field_with_holes_is_what_the_spray_sweeps(tmp_pat
 
     def lonlat(ring: object) -> list[list[float]]:
         lon, lat = FRAME.to_geo(*np.asarray(ring).T)
-        return np.column_stack([lon, lat]).tolist()
+        return [[float(a), float(b)] for a, b in zip(lon, lat, strict=True)]
 
     rings = [lonlat(local.exterior.coords)] + [lonlat(h.coords) for h in local.interiors]
     field = tmp_path / "field.geojson"
