@@ -683,8 +683,7 @@ def _states(t: FloatArray, jerk: FloatArray, v0: FloatArray | None = None) -> _P
     return _Phases(t, jerk, p, v, a)
 
 
-@dataclass(frozen=True)
-class StopAndGo:
+class StopAndGo(NamedTuple):
     """Legs flown back to back.
 
     Attributes
@@ -717,7 +716,10 @@ def stop_and_go(waypoints: FloatArray, limits: LegLimits | Sequence[LegLimits]) 
         Bad waypoints or limits, or a leg Ruckig cannot time (longer than
         :data:`RUCKIG_MAX_DURATION_S` at its speed limit).
     """
-    pts = as_array("waypoints", waypoints, ndim=2, finite=False)  # (checked finite below)
+    if type(waypoints) is np.ndarray and waypoints.dtype == np.float64 and waypoints.ndim == 2:
+        pts = waypoints  # (not copied: nothing here writes it, nothing returned holds it)
+    else:
+        pts = as_array("waypoints", waypoints, ndim=2, finite=False)  # (checked finite below)
     if pts.shape[0] < 2:
         largest_magnitude("waypoints", pts)  # (a coordinate that is not finite named first)
         raise InputError(f"waypoints: got {pts.shape[0]} point(s), expected at least 2")
