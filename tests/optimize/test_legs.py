@@ -488,11 +488,15 @@ def test_a_repeat_is_a_step_within_1e_9_of_the_largest_coordinate_not_of_their_b
 def test_the_waypoints_array_is_neither_written_nor_held() -> None:
     # A float64 array is taken as it is (not copied, for the ten-leg chain's cost): the
     # flight must not change when the caller writes it afterwards, nor the array itself.
-    pts = np.random.default_rng(3).uniform(0.0, 20.0, size=(11, 3))
-    strided = np.repeat(pts, 2, axis=0)[::2]  # the same points, not contiguous
-    kept = pts.copy()
-    for waypoints in (pts, strided):
-        flown = stop_and_go(waypoints, LegLimits(2.0, 3.0, 10.0))
+    # Every path: legs that all cruise, one too short to (1 mm), a limit per leg, a view.
+    cruising = np.random.default_rng(3).uniform(0.0, 20.0, size=(11, 3))
+    short = cruising.copy()
+    short[1] = short[0] + 1e-3
+    lim = LegLimits(2.0, 3.0, 10.0)
+    cases = ((cruising, lim), (short, lim), (short, [lim] * 10), (np.repeat(short, 2, 0)[::2], lim))
+    for waypoints, limits in cases:
+        kept = waypoints.copy()
+        flown = stop_and_go(waypoints, limits)
         np.testing.assert_array_equal(waypoints, kept)
         before = flown.trajectory.evaluate(flown.arrivals).copy()
         waypoints[...] = 0.0
