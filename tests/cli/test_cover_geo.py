@@ -7,8 +7,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import shapely
 from shapely.geometry import Polygon, shape
-from shapely.ops import transform
 from typer.testing import CliRunner
 
 from skyquill.cli.main import app
@@ -128,5 +128,7 @@ def test_the_covered_area_of_a_field_with_holes_is_what_the_spray_sweeps(tmp_pat
     )
     origin = summary["geo"]["origin"]
     frame = GeoFrame(origin["lon_deg"], origin["lat_deg"])
-    covered = transform(frame.to_local, covered_ll)
+    covered = shapely.transform(
+        covered_ll, lambda lonlat: np.column_stack(frame.to_local(lonlat[:, 0], lonlat[:, 1]))
+    )
     assert covered.area / local.area == pytest.approx(summary["coverage_fraction"], abs=1e-4)
