@@ -264,7 +264,7 @@ def _write_geojson(
     """``path.geojson`` (flown path and covered area in lon/lat), read back and checked."""
     from skyquill.export.geojson import write_path_geojson
 
-    covered = plan.region.intersection(plan.sprayed())
+    covered = plan.region.intersection(plan.sprayed)
     check = write_path_geojson(stage / "path.geojson", frame, planned, covered, plan.region)
     return {"file": "path.geojson"} | check.as_dict()
 

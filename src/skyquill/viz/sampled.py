@@ -262,7 +262,7 @@ def sample_coverage(plan: CoveragePlan) -> CoverageSamples:
 
     opts = plan.options
     sp = plan.samples()
-    swept = plan.sprayed()
+    swept = plan.sprayed
     speed = np.linalg.norm(sp.v, axis=1)
     every = max(1, speed.size // MAX_DOTS)
     missed = "" if plan.missed is None else f", {plan.missed.area_m2:.3g} m²"

@@ -4,6 +4,7 @@ its limits report.
 
 from __future__ import annotations
 
+import functools
 from dataclasses import asdict, dataclass
 from typing import Any
 
@@ -102,13 +103,15 @@ class CoveragePlan:
         """Length of the flown path, m."""
         return path_length(self.path)
 
+    @functools.cached_property
     def sprayed(self) -> BaseGeometry:
         """The area the spray sweeps, m: the mission's (off on its transits and within half a
         swath of the holes), or the whole path's swath (a polygon is sprayed throughout).
 
         What ``coverage`` counts within the region; the GeoJSON's covered area and the
         figure draw the same. A polygon's is the planner's simplified sweep (the raw buffer
-        of a 20 km path's million points takes a minute).
+        of a 20 km path's million points takes a minute; this one 0.2 s for a 10 ha field's
+        1.1 M points: computed once).
         """
         if self.mission is not None:
             return self.mission.swept
