@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+import fcntl
 import hashlib
 import json
 import os
 import shutil
+import stat
 import subprocess
 import sys
 from pathlib import Path
@@ -15,6 +17,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from skyquill.errors import InputError
+from skyquill.io import outputs
 from skyquill.io.outputs import MANIFEST, STAGING_PREFIX, shown_path, staged_output
 
 
@@ -222,6 +225,37 @@ def test_a_live_runs_staging_folder_is_left_alone(tmp_path: Path) -> None:
         assert stage.is_dir()
         (stage / "trajectory.csv").write_text("t")
     assert (out / "trajectory.csv").read_text() == "t"
+
+
+def test_a_run_whose_new_folder_another_cleanup_took_stages_in_another(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # The race two runs into one folder hit (a CI run of session 41): a run has created its
+    # staging folder's lock file but not locked it yet when the other run's cleanup takes
+    # the folder for a dead run's and removes it; the run wrote into a folder that was gone.
+    # Played here in order: the cleanup runs right before the run's first lock.
+    out = tmp_path / "o"
+    out.mkdir()
+    taken: list[Path] = []
+
+    class CleanupFirst:
+        LOCK_EX, LOCK_NB = fcntl.LOCK_EX, fcntl.LOCK_NB
+
+        @staticmethod
+        def flock(fd: int, operation: int) -> None:
+            is_file = stat.S_ISREG(os.fstat(fd).st_mode)  # (not the folder's own lock)
+            if not taken and is_file and not operation & fcntl.LOCK_NB:
+                taken.extend(p for p in out.iterdir() if p.name.startswith(STAGING_PREFIX))
+                outputs._clear_leftovers(out)
+            fcntl.flock(fd, operation)
+
+    monkeypatch.setattr(outputs, "fcntl", CleanupFirst)
+    with staged_output(out, "fit") as stage:
+        assert stage.is_dir() and stage not in taken
+        (stage / "trajectory.csv").write_text("whole")
+    assert len(taken) == 1 and not taken[0].exists()
+    assert (out / "trajectory.csv").read_text() == "whole"
+    assert not [p.name for p in out.iterdir() if p.name.startswith(STAGING_PREFIX)]
 
 
 def test_staging_paths_are_shown_as_the_out_folders() -> None:

@@ -63,6 +63,9 @@ LAST = "summary.json"
 STAGING_PREFIX = ".staging-"
 #: The lock file a run holds in its staging folder while it lives.
 _LOCK = ".lock"
+#: Appended to a staging folder's name while it is removed (it still starts with the prefix:
+#: a cleanup killed half way is finished by the next).
+_REMOVED = ".removed"
 #: A staging folder without a lock (made by an older skyquill) is removed once this old, s.
 _ORPHAN_AGE_S = 3600.0
 #: Largest manifest read, bytes; a larger one is ignored (the folder is then nobody's).
@@ -108,14 +111,31 @@ def staged_output(
     check_folder(out)
     out.mkdir(parents=True, exist_ok=True)
     _clear_leftovers(out)
-    staging = Path(tempfile.mkdtemp(prefix=STAGING_PREFIX, dir=out))
-    try:
-        with _held(staging / _LOCK, create=True):
+    with _own_staging(out) as staging:
+        try:
             yield staging
             with _folder_locked(out):
                 _commit(staging, out, command, force, inputs)
-    finally:
-        shutil.rmtree(staging, ignore_errors=True)
+        finally:
+            shutil.rmtree(staging, ignore_errors=True)
+
+
+@contextlib.contextmanager
+def _own_staging(out: Path) -> Iterator[Path]:
+    """A new staging folder in ``out``, its lock held until the run ends.
+
+    Between creating its lock file and locking it, another run's cleanup can take the
+    folder for a dead run's (it locks the file first) and move it aside
+    (:func:`_claimed`): the folder is then gone once the lock is ours, and another is
+    made. Two runs into one folder lost a file so (``trajectory.csv`` written into a
+    staging folder being removed: a CI run of session 41).
+    """
+    while True:
+        staging = Path(tempfile.mkdtemp(prefix=STAGING_PREFIX, dir=out))
+        with _held(staging / _LOCK, create=True):
+            if (staging / _LOCK).exists():
+                yield staging
+                return
 
 
 def check_folder(out: Path, name: str = "out") -> None:
@@ -270,24 +290,33 @@ def _clear_leftovers(out: Path) -> None:
         if not entry.name.startswith(STAGING_PREFIX) or not entry.is_dir(follow_symlinks=False):
             continue
         folder = Path(entry.path)
-        if _run_has_ended(folder):
-            shutil.rmtree(folder, ignore_errors=True)
+        if (aside := _claimed(folder)) is not None:
+            shutil.rmtree(aside, ignore_errors=True)
             logger.info("removed %s, left by an interrupted run", folder)
 
 
-def _run_has_ended(folder: Path) -> bool:
-    """Whether no live run holds ``folder``'s lock (one without a lock: when it is old)."""
-    lock = folder / _LOCK
+def _claimed(folder: Path) -> Path | None:
+    """``folder`` moved aside to be removed, if no live run holds its lock (one without a
+    lock: when it is old); None if a run holds it, or another cleanup took it first.
+
+    Moved while its lock is held here, so that a run which had created the lock but not
+    yet locked it finds its folder gone and makes another (:func:`_own_staging`).
+    """
+    aside = folder.with_name(folder.name + _REMOVED)
     try:
-        with _held(lock, create=False, wait=False):
-            return True
+        with _held(folder / _LOCK, create=False, wait=False):
+            folder.rename(aside)
+            return aside
     except FileNotFoundError:
         try:
-            return time.time() - folder.stat().st_mtime > _ORPHAN_AGE_S
+            if time.time() - folder.stat().st_mtime > _ORPHAN_AGE_S:
+                folder.rename(aside)
+                return aside
         except OSError:
-            return False
+            pass
+        return None
     except OSError:  # held by a live run
-        return False
+        return None
 
 
 @contextlib.contextmanager
