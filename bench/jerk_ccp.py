@@ -18,7 +18,14 @@ one pseudo-jerk iteration, tangent LPs (scipy's HiGHS, solved cold: their times 
 comparable, their counts and answers are) until ``sqrt(b)`` changes by less than the
 iteration's own tolerance. Every answer's grid jerk over its limit is recorded.
 
-Run: ``.venv/bin/python bench/jerk_ccp.py`` -> ``bench/results/jerk_ccp.json`` (about 30 s).
+Then the same in the banded interior point, timed (``method="banded"``, one BLAS thread, one
+run after a warm-up): the tangent row ``|J_i b| + c_i b_i <= R_i`` (``c_i b_i >= 0``) is the
+pair of symmetric rows ``|(J_i + c_i e_i) b| <= R_i`` and ``|(J_i - c_i e_i) b| <= R_i``
+(each one's other side is implied), so the interior point takes it as it is, with ``q`` rows
+more per node.
+
+Run: ``.venv/bin/python bench/jerk_ccp.py`` -> ``bench/results/jerk_ccp.json`` (about a
+minute).
 """
 
 from __future__ import annotations
@@ -36,16 +43,22 @@ from scipy.optimize import linprog
 from common import jsonable, machine_info, one_blas_thread
 from coverage_lp import AMAX, JMAX, VMAX, spiral
 from skyquill.coverage.speed import plan as speed_plan
+from skyquill.coverage.speed.banded import BandedRows, solve_banded_lp
+from skyquill.coverage.speed.banded_grid import row_bounds
 from skyquill.coverage.speed.profile import _duration
 
 RESULTS = Path(__file__).parent / "results" / "jerk_ccp.json"
 GRIDS = (500, 2000, 8000)
+#: Grids timed in the banded interior point.
+BANDED_GRIDS = (2000, 8000, 32000)
 TOLERANCE = 1e-3  # the pseudo-jerk iteration's default jerk_tol
 MAX_STEPS = 10
 
 
-def _certified(curve: Any, n: int, iterations: int) -> tuple[Any, Any, np.ndarray, Any]:
-    """The LP path's plan after ``iterations`` pseudo-jerk LPs and its certification, the
+def _certified(
+    curve: Any, n: int, iterations: int, method: str = "lp"
+) -> tuple[Any, Any, np.ndarray, Any]:
+    """The plan by ``method`` after ``iterations`` pseudo-jerk LPs and its certification, the
     grid problem it solved, and the rows' bounds (captured from the planner)."""
     captured: dict[str, Any] = {}
     original = speed_plan._initial_solve
@@ -57,7 +70,7 @@ def _certified(curve: Any, n: int, iterations: int) -> tuple[Any, Any, np.ndarra
 
     speed_plan._initial_solve = capture
     try:
-        plan = speed_plan.plan_speed(curve, VMAX, AMAX, JMAX, n=n, method="lp", refine_rounds=0,
+        plan = speed_plan.plan_speed(curve, VMAX, AMAX, JMAX, n=n, method=method, refine_rounds=0,
                                      max_excess=None, jerk_iterations=iterations)  # fmt: skip
     finally:
         speed_plan._initial_solve = original
@@ -107,16 +120,67 @@ def tangent_steps(n: int) -> dict[str, Any]:
     }  # fmt: skip
 
 
+def _tangent_rows(grid: Any, bounds: Any, ref: np.ndarray) -> tuple[BandedRows, np.ndarray]:
+    """The banded rows and per-node bounds of the tangent LP at ``ref``: the acceleration
+    rows, then the jerk rows with ``+ c_i b_i``, then with ``- c_i b_i``."""
+    rows, q, n = grid.rows, grid.q, ref.size
+    height = np.sqrt(bounds.jerk_ref / ref)
+    slope = np.zeros((q, n))
+    slope[:, 1:-1] = (0.5 * height / ref)[1:-1]
+    acc, jerk = slice(0, 2 * q), slice(2 * q, 3 * q)
+    tangent = BandedRows(
+        lower=np.vstack([rows.lower[acc], rows.lower[jerk], rows.lower[jerk]]),
+        centre=np.vstack([rows.centre[acc], rows.centre[jerk] + slope, rows.centre[jerk] - slope]),
+        upper=np.vstack([rows.upper[acc], rows.upper[jerk], rows.upper[jerk]]),
+    )
+    jerk_bound = np.full((q, n), np.inf)
+    jerk_bound[:, 1:-1] = 1.5 * height[1:-1]
+    acc_bound = row_bounds(bounds.rows(None), n, q)[acc]
+    return tangent, np.vstack([acc_bound, jerk_bound, jerk_bound])
+
+
+def banded_timing(n: int) -> dict[str, Any]:
+    """The banded method to its tolerance against one pseudo-jerk LP, its certification and
+    tangent LPs in the same interior point, timed (no refinement)."""
+    curve = spiral(1.0)
+    _certified(curve, n, 20, "banded")  # warm-up
+    start = time.perf_counter()
+    full, _, _, _ = _certified(curve, n, 20, "banded")
+    full_s = time.perf_counter() - start
+    start = time.perf_counter()
+    _, grid, b, bounds = _certified(curve, n, 1, "banded")
+    ub, steps = bounds.cols(), 0
+    while steps < MAX_STEPS:
+        rows, bound = _tangent_rows(grid, bounds, np.maximum(b, 1e-12 * float(ub.max())))
+        x = solve_banded_lp(rows, bound, ub, np.ones(n)).b
+        steps += 1
+        change = float(np.max(np.abs(np.sqrt(x) - np.sqrt(b))) / np.sqrt(x).max())
+        b = x
+        if change < TOLERANCE:
+            break
+    tangents_s = time.perf_counter() - start
+    return {
+        "grid_points": n,
+        "banded_pseudo_jerk": {"seconds": full_s, "iterations": full.iterations,
+                               "duration_s": full.duration},
+        "banded_one_then_tangents": {"seconds": tangents_s, "tangent_steps": steps,
+                                     "duration_s": _duration(b, 1.0 / (n - 1), jerk=True)},
+        "time_ratio_tangents_over_pseudo_jerk": tangents_s / full_s,
+    }  # fmt: skip
+
+
 def main() -> None:
     start = time.perf_counter()
     with one_blas_thread():
         cases = [tangent_steps(n) for n in GRIDS]
+        banded = [banded_timing(n) for n in BANDED_GRIDS]
     result = {
         "schema": 1,
         "generated_utc": datetime.now(UTC).isoformat(timespec="seconds"),
         "total_wall_s": time.perf_counter() - start,
         "machine": machine_info(("scipy", "highspy")),
         "cases": cases,
+        "banded": banded,
     }
     RESULTS.parent.mkdir(exist_ok=True)
     RESULTS.write_text(json.dumps(jsonable(result), indent=2) + "\n")
@@ -126,6 +190,12 @@ def main() -> None:
               f"({pj['lp_solves']} LPs) {pj['duration_s']:.4f} s; one iteration, its "
               f"certification, then {len(steps)} tangent LPs {steps[-1]['duration_s']:.4f} s "
               f"(x{c['duration_ratio_tangents_over_pseudo_jerk']:.5f})")  # fmt: skip
+    for c in banded:
+        pj, tg = c["banded_pseudo_jerk"], c["banded_one_then_tangents"]
+        print(f"{c['grid_points']:>6} points, banded: pseudo-jerk {pj['seconds']:.3f} s "
+              f"{pj['duration_s']:.4f} s; one, certification, {tg['tangent_steps']} tangents "
+              f"{tg['seconds']:.3f} s {tg['duration_s']:.4f} s "
+              f"({c['time_ratio_tangents_over_pseudo_jerk']:.2f}x the time)")  # fmt: skip
     print(f"wrote {RESULTS}")
 
 
