@@ -77,6 +77,21 @@ def _certified(
     return plan, captured["lp"], captured["b"], captured["bounds"]
 
 
+def _tangent(scale: np.ndarray, b: np.ndarray, ub: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The tangent of each jerk row's bound ``h(b) = sqrt(scale / b)`` at ``b`` (a column at
+    0 taken at 1e-12 of the largest bound ``ub``): its value at ``b = 0``, ``1.5 h``, and
+    the slope ``-h' = h / (2 b)`` that multiplies ``b_i`` on the row's side."""
+    ref = np.maximum(b, 1e-12 * float(ub.max()))
+    height = np.sqrt(scale / ref)
+    return 1.5 * height, 0.5 * height / ref
+
+
+def _change(new: np.ndarray, old: np.ndarray) -> float:
+    """How far ``sqrt(b)`` moved, relative to its largest: the pseudo-jerk iteration's own
+    stop criterion (:data:`TOLERANCE`)."""
+    return float(np.max(np.abs(np.sqrt(new) - np.sqrt(old))) / np.sqrt(new).max())
+
+
 def tangent_steps(n: int) -> dict[str, Any]:
     curve = spiral(1.0)
     full, lp, b_full, bounds = _certified(curve, n, 20)
@@ -96,15 +111,13 @@ def tangent_steps(n: int) -> dict[str, Any]:
 
     steps = []
     for _ in range(MAX_STEPS):
-        ref = np.maximum(b, 1e-12 * float(ub.max()))[node]
-        height = np.sqrt(scale / ref)
-        slope = sparse.csr_array((0.5 * height / ref, (np.arange(node.size), node)),
-                                 shape=(node.size, n))  # fmt: skip
+        top, c = _tangent(scale, b[node], ub)
+        slope = sparse.csr_array((c, (np.arange(node.size), node)), shape=(node.size, n))
         rows = sparse.vstack([acc, -acc, jerk + slope, -jerk + slope], format="csr")
-        bound = np.concatenate([r_acc, r_acc, 1.5 * height, 1.5 * height])
+        bound = np.concatenate([r_acc, r_acc, top, top])
         res = linprog(-np.ones(n), A_ub=rows, b_ub=bound,
                       bounds=np.column_stack([np.zeros(n), ub]), method="highs")  # fmt: skip
-        change = float(np.max(np.abs(np.sqrt(res.x) - np.sqrt(b))) / np.sqrt(res.x).max())
+        change = _change(res.x, b)
         b = res.x
         steps.append({"duration_s": _duration(b, h, jerk=True), "change": change,
                       "grid_jerk_over_limit": over(b)})  # fmt: skip
@@ -120,13 +133,13 @@ def tangent_steps(n: int) -> dict[str, Any]:
     }  # fmt: skip
 
 
-def _tangent_rows(grid: Any, bounds: Any, ref: np.ndarray) -> tuple[BandedRows, np.ndarray]:
-    """The banded rows and per-node bounds of the tangent LP at ``ref``: the acceleration
+def _tangent_rows(grid: Any, bounds: Any, b: np.ndarray) -> tuple[BandedRows, np.ndarray]:
+    """The banded rows and per-node bounds of the tangent LP at ``b``: the acceleration
     rows, then the jerk rows with ``+ c_i b_i``, then with ``- c_i b_i``."""
-    rows, q, n = grid.rows, grid.q, ref.size
-    height = np.sqrt(bounds.jerk_ref / ref)
+    rows, q, n = grid.rows, grid.q, b.size
+    top, c = _tangent(bounds.jerk_ref, b, bounds.cols())
     slope = np.zeros((q, n))
-    slope[:, 1:-1] = (0.5 * height / ref)[1:-1]
+    slope[:, 1:-1] = c[1:-1]
     acc, jerk = slice(0, 2 * q), slice(2 * q, 3 * q)
     tangent = BandedRows(
         lower=np.vstack([rows.lower[acc], rows.lower[jerk], rows.lower[jerk]]),
@@ -134,7 +147,7 @@ def _tangent_rows(grid: Any, bounds: Any, ref: np.ndarray) -> tuple[BandedRows, 
         upper=np.vstack([rows.upper[acc], rows.upper[jerk], rows.upper[jerk]]),
     )
     jerk_bound = np.full((q, n), np.inf)
-    jerk_bound[:, 1:-1] = 1.5 * height[1:-1]
+    jerk_bound[:, 1:-1] = top[1:-1]
     acc_bound = row_bounds(bounds.rows(None), n, q)[acc]
     return tangent, np.vstack([acc_bound, jerk_bound, jerk_bound])
 
@@ -151,10 +164,10 @@ def banded_timing(n: int) -> dict[str, Any]:
     _, grid, b, bounds = _certified(curve, n, 1, "banded")
     ub, steps = bounds.cols(), 0
     while steps < MAX_STEPS:
-        rows, bound = _tangent_rows(grid, bounds, np.maximum(b, 1e-12 * float(ub.max())))
+        rows, bound = _tangent_rows(grid, bounds, b)
         x = solve_banded_lp(rows, bound, ub, np.ones(n)).b
         steps += 1
-        change = float(np.max(np.abs(np.sqrt(x) - np.sqrt(b))) / np.sqrt(x).max())
+        change = _change(x, b)
         b = x
         if change < TOLERANCE:
             break
