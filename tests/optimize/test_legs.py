@@ -472,6 +472,24 @@ def test_waypoints_without_axes_or_finite_coordinates_are_refused_in_plain_words
         stop_and_go([[np.nan, 0.0]], lim)  # (before the count of points, as before)
 
 
+@pytest.mark.filterwarnings("error")
+def test_waypoints_too_far_apart_for_their_squares_are_refused_without_a_warning() -> None:
+    # Squares of 1e156 m overflow: numpy warned, and the leg was "inf m long". Now its own
+    # length and duration (not 157 digits), and a step past the largest float by name.
+    lim = LegLimits(2.0, 1.0, 1.0)
+    with pytest.raises(
+        InputError, match=r"^waypoints: got the leg from waypoint 0 to 1, 1\.41421e\+200 m "
+        r"long, which takes 7\.07e\+199 s at a speed limit of 2 m/s, expected moves of at "
+        r"most 7,600 s",
+    ):  # fmt: skip
+        stop_and_go([[0.0, 0.0], [1e200, 1e200]], lim)
+    with pytest.raises(InputError, match=r"^waypoints: got the leg from waypoint 1 to 2 longer "
+                       r"than the largest number \(1\.8e308 m\)"):  # fmt: skip
+        stop_and_go([[0.0, 0.0], [-1.7e308, 0.0], [1.7e308, 0.0]], lim)
+    with pytest.raises(InputError, match=r"^waypoints: got 1 NaN or infinite value"):
+        stop_and_go([[0.0, 0.0], [1e200, np.inf]], lim)
+
+
 def test_a_repeat_is_a_step_within_1e_9_of_the_largest_coordinate_not_of_their_bound() -> None:
     # The threshold is REPEAT_TOLERANCE times the largest magnitude (2,990 m here); the
     # root of the sum of squares that stands in for it when no step is near (about 45 km)

@@ -584,7 +584,7 @@ class UntimeableLegError(InputError):
     ) -> None:
         self.leg, self.length, self.vmax, self.duration = leg, length, vmax, duration
         super().__init__(
-            f"{argument}: got {what} {length:.6g} m long, which takes {duration:,.0f} s at a "
+            f"{argument}: got {what} {length:.6g} m long, which takes {_seconds(duration)} s at a "
             f"speed limit of {vmax:g} m/s, expected moves of at most "
             f"{RUCKIG_MAX_DURATION_S:,.0f} s (the longest Ruckig times): add waypoints along "
             "it or raise vmax"
@@ -734,13 +734,19 @@ def stop_and_go(waypoints: FloatArray, limits: LegLimits | Sequence[LegLimits]) 
             )
         for lim in {id(lim): lim for lim in limits}.values():
             _check(lim, pts.shape[1])
-    delta = pts[1:] - pts[:-1]
-    steps = np.sqrt(np.vecdot(delta, delta))  # numpy.linalg.norm(axis=1), cheaper
+    # The sum of squares bounds every coordinate and every step's square (by twice itself):
+    # below _SAFE_SQUARES no step's square overflows.
+    squares = float(np.vdot(pts, pts))
+    if squares < _SAFE_SQUARES:
+        delta = pts[1:] - pts[:-1]
+        steps = np.sqrt(np.vecdot(delta, delta))  # numpy.linalg.norm(axis=1), cheaper
+    else:
+        delta, steps = _huge_steps(pts)
     idx = None  # the legs flown, if not all: repeated points are skipped
     starts, ends = pts[:-1], pts[1:]
     # (Python's min is cheaper on a short list, numpy's past about 20 numbers.)
     shortest = min(steps.tolist()) if steps.size <= 16 else float(np.minimum.reduce(steps))
-    repeat = _repeat_threshold(pts, shortest)
+    repeat = _repeat_threshold(pts, squares, shortest)
     if shortest <= repeat:
         idx = np.flatnonzero(steps > repeat)
         if not idx.size:
@@ -757,9 +763,38 @@ def stop_and_go(waypoints: FloatArray, limits: LegLimits | Sequence[LegLimits]) 
     return StopAndGo(trajectory, arrived if idx is None else _arrivals(pts.shape[0], idx, arrived))
 
 
-def _repeat_threshold(pts: FloatArray, shortest: float) -> float:
+#: A sum of squares of the waypoints below which no step's square overflows (twice it is
+#: below the largest float, 1.8e308).
+_SAFE_SQUARES = 1e300
+
+
+def _huge_steps(pts: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """The steps between the waypoints ``pts`` (K, d), m, and their lengths (K - 1,), m,
+    where their squares could overflow (coordinates of 1e150 m and more); refuses
+    waypoints that are not finite, and a step longer than the largest float."""
+    largest_magnitude("waypoints", pts)
+    with np.errstate(over="ignore"):
+        delta = pts[1:] - pts[:-1]
+        steps = np.hypot.reduce(delta, axis=1)
+    if not np.all(np.isfinite(steps)):
+        k = int(np.flatnonzero(~np.isfinite(steps))[0])
+        raise InputError(
+            f"waypoints: got the leg from waypoint {k} to {k + 1} longer than the largest "
+            "number (1.8e308 m), expected legs a flight can take: bring the waypoints closer"
+        )
+    return delta, steps
+
+
+def _seconds(duration: float) -> str:
+    """A duration, s, for a message: grouped digits up to a billion seconds, else e-notation
+    (a leg 1e156 m long took 157 digits)."""
+    return f"{duration:,.0f}" if duration < 1e9 else f"{duration:.3g}"
+
+
+def _repeat_threshold(pts: FloatArray, squares: float, shortest: float) -> float:
     """How short a step between the waypoints ``pts`` (K, d), m, must be to be a repeat, m,
-    their shortest being ``shortest``; refuses waypoints that are not finite.
+    their sum of squares being ``squares``, m², and their shortest step ``shortest``;
+    refuses waypoints that are not finite.
 
     :data:`REPEAT_TOLERANCE` times their largest magnitude (at least 1 m). Their sum of
     squares, one dot product, bounds that magnitude from above and is finite only if every
@@ -767,7 +802,6 @@ def _repeat_threshold(pts: FloatArray, shortest: float) -> float:
     is computed only when the shortest step is within the bound's threshold, so the
     threshold returned is exact whenever a step is within it.
     """
-    squares = float(np.vdot(pts, pts))
     if squares < math.inf:
         bound = REPEAT_TOLERANCE * max(1.0, math.sqrt(squares))
         if shortest > bound:
