@@ -365,24 +365,27 @@ def test_a_leg_too_long_is_refused_alike_whether_or_not_the_legs_share_a_limit(
 
 
 def test_a_chain_copies_its_phase_durations_from_the_longest_chain_so_far() -> None:
-    # One norm limit: each chain's phase durations start as 0 then the shared profile's
-    # durations once a leg (the cruise 0, filled in per leg), copied from an array kept for
-    # the longest chain so far, grown as longer ones come: a new array each time, whatever
-    # came before. Chains longer than KEPT_LEGS tile their own.
+    # One norm limit: each chain's phase durations are 0, then the shared profile's once a
+    # leg with each leg's own cruise, from a copy of an array kept for the longest chain so
+    # far, grown as longer ones come: a new array each time, whatever came before. Chains
+    # longer than KEPT_LEGS tile their own.
     from skyquill.optimize.double_s import cruise
     from skyquill.optimize.legs import KEPT_LEGS, _Shared
 
     profile = cruise(2.0, 3.0, 10.0)
     assert profile is not None
-    shared = _Shared(profile, 3)
+    shared = _Shared(profile, 2.0, 3)
     handed = []
     for k in (3, 1, 10, 4, 25, 11, 60, 2, KEPT_LEGS, KEPT_LEGS + 1, 1000, KEPT_LEGS - 1, 7):
-        durations = shared.durations(k)
-        np.testing.assert_array_equal(durations, np.r_[0.0, np.tile(profile.durations, k)])
+        lengths = np.random.default_rng(k).uniform(0.1, 20.0, k)
+        durations = shared.durations(lengths)
+        expected = np.tile(profile.durations, (k, 1))
+        expected[:, profile.at_cruise] = lengths / 2.0 - profile.ramp_s
+        np.testing.assert_array_equal(durations, np.r_[0.0, expected.ravel()])
         assert durations.flags.writeable and durations.flags.c_contiguous
         assert not any(np.shares_memory(durations, other) for other in handed)
         handed.append(durations)
-        durations[:] = -1.0  # its owner fills in the cruises: the next chain is not affected
+        durations[:] = -1.0  # its owner writes the short legs' own: the next is not affected
 
 
 # A chain's legs: cruising, too short to cruise, repeated points, and on the boundaries of
@@ -460,6 +463,31 @@ def test_chains_under_one_limit_are_their_legs_timed_one_by_one(
             reference = ruckig_move(float(length), *limits) if took > 0.0 else None
             if reference is not None:
                 assert took == pytest.approx(float(reference.duration), rel=1e-9)
+
+
+def test_a_chain_longer_than_a_mixing_block_is_its_legs_timed_one_by_one() -> None:
+    # Legs too short to cruise at the first and last legs of each block of MIX_BLOCK legs
+    # (the pieces are mixed a block at a time, straight into the result) and at the chain's
+    # ends, the rest long: the same flight as with a LegLimits per leg.
+    from skyquill.optimize.legs import MIX_BLOCK
+
+    limits = (2.0, 3.0, 10.0)
+    kinds = ["long"] * (2 * MIX_BLOCK + 3)
+    for k in (0, MIX_BLOCK - 1, MIX_BLOCK, 2 * MIX_BLOCK - 1, 2 * MIX_BLOCK, len(kinds) - 1):
+        kinds[k] = "short"
+    pts = _chain_points(kinds, 5, limits)
+    lim = LegLimits(*limits)
+    shared, apart = stop_and_go(pts, lim), stop_and_go(pts, [lim] * len(kinds))
+    np.testing.assert_allclose(shared.arrivals, apart.arrivals, rtol=1e-12, atol=1e-12)
+    t = np.linspace(0.0, shared.trajectory.duration, 20001)
+    scale = float(np.abs(pts).max())
+    for n, size in enumerate((scale, *limits)):
+        np.testing.assert_allclose(
+            shared.trajectory.evaluate(t, n),
+            apart.trajectory.evaluate(t, n),
+            rtol=0,
+            atol=1e-9 * size,
+        )
 
 
 def test_waypoints_without_axes_or_finite_coordinates_are_refused_in_plain_words() -> None:

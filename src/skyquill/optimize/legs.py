@@ -247,7 +247,7 @@ def _cruising(
     delta: FloatArray,
     lengths: FloatArray,
     *,
-    shortest: float | None,
+    shortest: float,
     limits: LegLimits | Sequence[LegLimits],
 ) -> _Cruising | None:
     """Legs from rest to rest under one norm limit that all reach its speed: the cheap case.
@@ -256,8 +256,7 @@ def _cruising(
     pieces are that profile's, mixed from each leg's direction, start and end, in a handful
     of numpy calls whatever the number of legs (no phase to drop, each quantity one call).
     None if the limits are per leg or per axis, or a leg (the ``shortest``, m) is too short
-    to cruise (then :func:`_partly_cruising` replaces those). Without ``shortest`` every leg
-    is taken as cruising: the caller replaces those that do not. The caller checks the legs'
+    to cruise (then :func:`_partly_cruising` times them). The caller checks the legs'
     durations (:meth:`_Cruising.check`).
     """
     if not isinstance(limits, LegLimits) or limits.per_axis:
@@ -268,21 +267,19 @@ def _cruising(
     if shared is None:
         return None
     profile = shared.profile
-    # (The same float operations as on every leg below: the shortest cruises least.)
-    if shortest is not None and shortest / vmax - profile.ramp_s <= MIN_PHASE_S:
+    # (The same float operations as on every leg in durations: the shortest cruises least.)
+    if shortest / vmax - profile.ramp_s <= MIN_PHASE_S:
         return None
-    k, n = lengths.size, profile.durations.size
-    durations = shared.durations(k)
-    # (One ufunc writes each cruise into its strided slot: dividing there, then subtracting
-    # in place, cost 0.3 us more, numpy's overlap check.)
-    np.subtract(lengths / vmax, profile.ramp_s, out=durations[1 + profile.at_cruise :: n])
+    durations = shared.durations(lengths)
     # Each leg's unit direction, start and end, (K, 3 d), mixed into every phase's
     # coefficients, (K, 4 n d), by one matrix product.
     basis = np.concatenate((delta / lengths[:, None], starts, ends), axis=1)
     coeffs = np.dot(basis, shared.mixer)  # (the matmul operator's dispatch costs more)
+    n = profile.durations.size
     return _Cruising(
-        durations, coeffs.reshape(k * n, 4, dim), n, profile.at_cruise, limits, profile.ramp_s
-    )
+        durations, coeffs.reshape(lengths.size * n, 4, dim), n, profile.at_cruise, limits,
+        profile.ramp_s,
+    )  # fmt: skip
 
 
 class _Shared:
@@ -292,37 +289,47 @@ class _Shared:
     ----------
     profile
         :func:`double_s.cruise` of the limits.
+    vmax
+        Their speed limit, m/s.
     mixer
         Its :attr:`~double_s.Cruise.mix` for legs in ``dim`` axes: ``kron(mix.T, eye(dim))``,
         (3 dim, 4 n dim), so that a leg's direction, start and end in a row (3 dim,) times it
         are its phases' coefficients (4 n dim,).
     """
 
-    def __init__(self, profile: Cruise, dim: int) -> None:
+    def __init__(self, profile: Cruise, vmax: float, dim: int) -> None:
         self.profile = profile
+        self.vmax = vmax
         self.mixer = np.asarray(np.kron(profile.mix.T, np.eye(dim)), dtype=np.float64)
         self.mixer.setflags(write=False)
         self._kept = np.zeros(1)
 
-    def durations(self, k: int) -> FloatArray:
-        """0, then the profile's ``n`` phase durations ``k`` times over, (k n + 1,), s: a new
-        array, for the caller to fill in each leg's cruise (0 here) and sum.
+    def durations(self, lengths: FloatArray) -> FloatArray:
+        """0, then the phase durations of legs of ``lengths`` (K,), m, each as if it cruised
+        (``L / vmax - ramp_s``: negative for a leg too short to), (K n + 1,), s: a new array,
+        for the caller to sum.
 
         Up to :data:`KEPT_LEGS` legs, copied from an array kept for the longest chain so far
         (grown by doubling): one numpy call instead of the five that fill it in (about 1 us
         of the 15-20 us a chain of ten legs takes). Longer chains tile their own (the copy
         saves nothing there).
         """
-        n = self.profile.durations.size
+        profile = self.profile
+        k, n = lengths.size, profile.durations.size
         if k > KEPT_LEGS:
-            return np.concatenate(([0.0], np.tile(self.profile.durations, k)))
-        kept = self._kept
-        if kept.size < k * n + 1:
-            legs = min(KEPT_LEGS, max(k, 2 * (kept.size - 1) // n))
-            kept = np.concatenate(([0.0], np.tile(self.profile.durations, legs)))
-            kept.setflags(write=False)
-            self._kept = kept  # (one reference replaced: safe between threads)
-        return kept[: k * n + 1].copy()
+            durations = np.concatenate(([0.0], np.tile(profile.durations, k)))
+        else:
+            kept = self._kept
+            if kept.size < k * n + 1:
+                legs = min(KEPT_LEGS, max(k, 2 * (kept.size - 1) // n))
+                kept = np.concatenate(([0.0], np.tile(profile.durations, legs)))
+                kept.setflags(write=False)
+                self._kept = kept  # (one reference replaced: safe between threads)
+            durations = kept[: k * n + 1].copy()
+        # (One ufunc writes each cruise into its strided slot: dividing there, then
+        # subtracting in place, cost 0.3 us more, numpy's overlap check.)
+        np.subtract(lengths / self.vmax, profile.ramp_s, out=durations[1 + profile.at_cruise :: n])
+        return durations
 
 
 #: The longest chain whose phase durations are copied from an array kept per shared profile
@@ -335,7 +342,7 @@ def _shared(vmax: float, amax: float, jmax: float, dim: int) -> _Shared | None:
     """The :class:`_Shared` profile of the limits (m/s, m/s^2, m/s^3) for legs in ``dim`` axes,
     or None where :func:`double_s.cruise` has none."""
     profile = cruise(vmax, amax, jmax)
-    return None if profile is None else _Shared(profile, dim)
+    return None if profile is None else _Shared(profile, vmax, dim)
 
 
 def _partly_cruising(
@@ -349,35 +356,90 @@ def _partly_cruising(
 
     Every leg is timed through the shared profile (:func:`_cruising`), then the phases of
     those too short to cruise are replaced by their own (the closed form, in the same
-    phase slots), and the phases of no length dropped: one pass over the pieces more than
-    if all legs cruised. None if the limits are per leg or per axis.
+    phase slots), and the phases of no length dropped. The pieces are mixed
+    :data:`MIX_BLOCK` legs at a time straight into the result (:func:`_mixed`). None if the
+    limits are per leg or per axis.
     """
-    cruising = _cruising(starts, ends, delta, lengths, shortest=None, limits=limits)
-    if cruising is None:
+    if not isinstance(limits, LegLimits) or limits.per_axis:
         return None
-    k, n, dim = lengths.size, cruising.phases, delta.shape[1]
-    durations = cruising.durations[1:].reshape(k, n)
-    short = np.flatnonzero(durations[:, cruising.at_cruise] <= MIN_PHASE_S)
-    slots = _SLOTS[n]
-    bounds = np.array([[cruising.limits.vmax, cruising.limits.amax, cruising.limits.jmax]])
+    shared = _shared(limits.vmax, float(limits.amax), float(limits.jmax), delta.shape[1])
+    if shared is None:
+        return None
+    phases = shared.durations(lengths)
+    k, n = lengths.size, shared.profile.durations.size
+    durations = phases[1:].reshape(k, n)
+    short = np.flatnonzero(durations[:, shared.profile.at_cruise] <= MIN_PHASE_S)
+    bounds = np.array([[limits.vmax, limits.amax, limits.jmax]])
     ph = _rest_to_rest(lengths.take(short), np.repeat(bounds, short.size, axis=0))
     if n < 7 and np.any(ph.t[:, [1, 5]] > MIN_PHASE_S):  # (a hold the profile has not)
         return None
-    durations[short] = ph.t[:, slots]
+    durations[short] = ph.t[:, _SLOTS[n]]
+    leg_durations = durations.sum(axis=1)
+    _refuse_long(lengths, limits, leg_durations)
+    kept = np.flatnonzero(phases[1:] > MIN_PHASE_S)
+    coeffs = _mixed(starts, ends, delta, lengths, shared=shared, short_legs=(short, ph), kept=kept)
+    return Legs(phases[1:].take(kept), coeffs, leg_durations)
+
+
+def _mixed(
+    starts: FloatArray,
+    ends: FloatArray,
+    delta: FloatArray,
+    lengths: FloatArray,
+    *,
+    shared: _Shared,
+    short_legs: tuple[NDArray[np.intp], _Phases],
+    kept: NDArray[np.intp],
+) -> FloatArray:
+    """The coefficients (P, 4, d) of the phases ``kept`` (P,) of legs ``delta`` (K, d) that
+    all fly the ``shared`` profile but the ``short_legs`` (their indices and own phases).
+
+    The shared profile is mixed for :data:`MIX_BLOCK` legs at a time, the short legs' own
+    phases written over theirs, and the phases kept taken straight into the result: each
+    block's array stays small. Mixed for all legs at once (two arrays of ``56 K d`` bytes),
+    a chain of 1,000 legs took 0.3 ms or 0.9 ms by how the C library's allocator had last
+    returned memory: the kernel zeroing fresh pages for both, call after call.
+    """
+    k, dim = delta.shape
+    n = shared.profile.durations.size
+    short, ph = short_legs
+    slots = _SLOTS[n]
     # p, v, a/2, j/6 at each slot's start, (k_short, n, 4), along each leg's direction.
     scalar = np.stack(
         (ph.p[:, slots], ph.v[:, slots], ph.a[:, slots] / 2.0, ph.j[:, slots] / 6.0), axis=-1
     )
-    short_delta = delta.take(short, axis=0)
-    directions = short_delta / lengths.take(short)[:, None]
-    coeffs = cruising.coeffs.reshape(k, n, 4, dim)
-    coeffs[short] = scalar[..., None] * directions[:, None, None, :]
-    coeffs[short, :, 0] += starts.take(short, axis=0)[:, None, :]
-    leg_durations = durations.sum(axis=1)
-    _refuse_long(lengths, limits, leg_durations)
-    phases = cruising.durations[1:]
-    kept = np.flatnonzero(phases > MIN_PHASE_S)
-    return Legs(phases.take(kept), cruising.coeffs.take(kept, axis=0), leg_durations)
+    own = (
+        scalar[..., None]
+        * (delta.take(short, axis=0) / lengths.take(short)[:, None])[:, None, None, :]
+    )
+    own[:, :, 0] += starts.take(short, axis=0)[:, None, :]
+    out = np.empty((kept.size, 4, dim))
+    if k <= MIX_BLOCK:  # (one block: no bounds to look up)
+        blocks: Sequence[tuple[int, int, slice, slice]] = ((0, k, slice(None), slice(None)),)
+    else:
+        edges = np.arange(0, k + MIX_BLOCK, MIX_BLOCK)
+        at_short = np.searchsorted(short, edges).tolist()
+        at_kept = np.searchsorted(kept, edges * n).tolist()
+        blocks = [
+            (lo, min(k, lo + MIX_BLOCK), slice(at_short[b], at_short[b + 1]),
+             slice(at_kept[b], at_kept[b + 1]))
+            for b, lo in enumerate(range(0, k, MIX_BLOCK))
+        ]  # fmt: skip
+    for lo, hi, mine, rows in blocks:
+        basis = np.concatenate(
+            (delta[lo:hi] / lengths[lo:hi, None], starts[lo:hi], ends[lo:hi]), axis=1
+        )
+        coeffs = np.dot(basis, shared.mixer).reshape(hi - lo, n, 4, dim)
+        coeffs[short[mine] - lo] = own[mine]
+        # ("clip": the rows are in range by construction; "raise" copies through a buffer.)
+        local = kept[rows] - lo * n
+        coeffs.reshape(-1, 4, dim).take(local, axis=0, out=out[rows], mode="clip")
+    return out
+
+
+#: Legs whose pieces :func:`_mixed` mixes at a time: 128 legs of seven phases in three axes
+#: are 86 kB, below the C library's threshold for memory of its own (128 kB).
+MIX_BLOCK = 128
 
 
 #: The phases of the seven-phase profile in the slots of a shared profile of n phases
