@@ -52,6 +52,14 @@ def test_looser_limits_never_give_a_slower_flight(
     assert _duration(char, loose) <= 1.01 * tighter  # type: ignore[arg-type]
 
 
+def test_a_plan_that_strays_at_its_probes_pace_is_flown_at_the_highest_faithful_one() -> None:
+    # (1, 4, 5): the probe at the full pace (sqrt 2) is faithful, the plan there strays
+    # (the timing accelerates at 4 m/s² where the jerk is held to 5 m/s³) and steps down,
+    # in steps that double, to where it writes faithfully: it went past 0 (the timing of
+    # (1, 2, 5), 15.2 s) to -0.42 (16.1 s); now the last step is halved back.
+    assert _duration("人", (1.0, 4.0, 5.0)) <= 1.01 * _duration("人", (1.0, 2.0, 5.0))
+
+
 @pytest.mark.parametrize("char", ["中", "永"])
 def test_the_issues_limit_sets_give_non_increasing_durations(char: str) -> None:
     durations = [_duration(char, bounds) for bounds in ISSUE_SETS]
