@@ -354,9 +354,9 @@ def _partly_cruising(
 ) -> Legs | None:
     """Legs from rest to rest under one norm limit, some too short to cruise.
 
-    Every leg is timed through the shared profile (:func:`_cruising`), then the phases of
-    those too short to cruise are replaced by their own (the closed form, in the same
-    phase slots), and the phases of no length dropped. The pieces are mixed
+    Every leg is timed through the shared profile (:meth:`_Shared.durations`), then the
+    phases of those too short to cruise are replaced by their own (the closed form, in the
+    same phase slots), and the phases of no length dropped. The pieces are mixed
     :data:`MIX_BLOCK` legs at a time straight into the result (:func:`_mixed`). None if the
     limits are per leg or per axis.
     """
