@@ -52,6 +52,31 @@ def test_looser_limits_never_give_a_slower_flight(
     assert _duration(char, loose) <= 1.01 * tighter  # type: ignore[arg-type]
 
 
+#: Limits whose jerk is low for their acceleration (not of the pace's shape): the plan at
+#: the probe's pace strays and steps down (bench/timing_strays.py draws the same).
+straying = st.tuples(
+    st.sampled_from([0.5, 1.0, 2.0]),
+    st.sampled_from([1.0, 2.0, 4.0]),
+    st.sampled_from([5.0, 8.0, 12.0]),
+)
+
+
+@settings(max_examples=6, deadline=None)
+@given(char=st.sampled_from(SMALL), tight=straying, raised=st.integers(0, 2),
+       factor=st.sampled_from([2.0, 3.0, 4.0]))  # fmt: skip
+def test_looser_limits_never_give_a_slower_flight_where_plans_stray(
+    char: str, tight: tuple[float, float, float], raised: int, factor: float
+) -> None:
+    """The property above where the flown plan strays from its probe: one limit of a set
+    whose jerk is low for its acceleration raised 2-4x."""
+    loose = tuple(t * factor if k == raised else t for k, t in enumerate(tight))
+    try:
+        tighter = _duration(char, tight)
+    except InfeasibleError:
+        return
+    assert _duration(char, loose) <= 1.01 * tighter  # type: ignore[arg-type]
+
+
 def test_a_plan_that_strays_at_its_probes_pace_is_flown_at_the_highest_faithful_one() -> None:
     # (1, 4, 5): the probe at the full pace (sqrt 2) is faithful, the plan there strays
     # (the timing accelerates at 4 m/s² where the jerk is held to 5 m/s³) and steps down,
