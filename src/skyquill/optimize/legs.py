@@ -271,10 +271,7 @@ def _cruising(
     if shortest / vmax - profile.ramp_s <= MIN_PHASE_S:
         return None
     durations = shared.durations(lengths)
-    # Each leg's unit direction, start and end, (K, 3 d), mixed into every phase's
-    # coefficients, (K, 4 n d), by one matrix product.
-    basis = np.concatenate((delta / lengths[:, None], starts, ends), axis=1)
-    coeffs = np.dot(basis, shared.mixer)  # (the matmul operator's dispatch costs more)
+    coeffs = shared.mixed(starts, ends, delta, lengths)
     n = profile.durations.size
     return _Cruising(
         durations, coeffs.reshape(lengths.size * n, 4, dim), n, profile.at_cruise, limits,
@@ -331,6 +328,17 @@ class _Shared:
         np.subtract(lengths / self.vmax, profile.ramp_s, out=durations[1 + profile.at_cruise :: n])
         return durations
 
+    def mixed(
+        self, starts: FloatArray, ends: FloatArray, delta: FloatArray, lengths: FloatArray
+    ) -> FloatArray:
+        """The profile's coefficients for legs ``delta`` (K, d) of ``lengths`` (K,) from
+        ``starts`` to ``ends``, m, each as if it cruised, (K, 4 n d): each leg's unit
+        direction, start and end, (K, 3 d), mixed into every phase's coefficients by one
+        matrix product."""
+        basis = np.concatenate((delta / lengths[:, None], starts, ends), axis=1)
+        coeffs: FloatArray = np.dot(basis, self.mixer)  # (the matmul operator's costs more)
+        return coeffs
+
 
 #: The longest chain whose phase durations are copied from an array kept per shared profile
 #: (:meth:`_Shared.durations`): at most 1,793 numbers, 14 kB, for each of the 256 kept.
@@ -365,9 +373,9 @@ def _partly_cruising(
     shared = _shared(limits.vmax, float(limits.amax), float(limits.jmax), delta.shape[1])
     if shared is None:
         return None
-    phases = shared.durations(lengths)
+    phases = shared.durations(lengths)[1:]  # (the leading 0 is for a running sum)
     k, n = lengths.size, shared.profile.durations.size
-    durations = phases[1:].reshape(k, n)
+    durations = phases.reshape(k, n)
     short = np.flatnonzero(durations[:, shared.profile.at_cruise] <= MIN_PHASE_S)
     bounds = np.array([[limits.vmax, limits.amax, limits.jmax]])
     ph = _rest_to_rest(lengths.take(short), np.repeat(bounds, short.size, axis=0))
@@ -376,9 +384,9 @@ def _partly_cruising(
     durations[short] = ph.t[:, _SLOTS[n]]
     leg_durations = durations.sum(axis=1)
     _refuse_long(lengths, limits, leg_durations)
-    kept = np.flatnonzero(phases[1:] > MIN_PHASE_S)
+    kept = np.flatnonzero(phases > MIN_PHASE_S)
     coeffs = _mixed(starts, ends, delta, lengths, shared=shared, short_legs=(short, ph), kept=kept)
-    return Legs(phases[1:].take(kept), coeffs, leg_durations)
+    return Legs(phases.take(kept), coeffs, leg_durations)
 
 
 def _mixed(
@@ -426,10 +434,9 @@ def _mixed(
             for b, lo in enumerate(range(0, k, MIX_BLOCK))
         ]  # fmt: skip
     for lo, hi, mine, rows in blocks:
-        basis = np.concatenate(
-            (delta[lo:hi] / lengths[lo:hi, None], starts[lo:hi], ends[lo:hi]), axis=1
-        )
-        coeffs = np.dot(basis, shared.mixer).reshape(hi - lo, n, 4, dim)
+        legs = slice(lo, hi)
+        mixed = shared.mixed(starts[legs], ends[legs], delta[legs], lengths[legs])
+        coeffs = mixed.reshape(hi - lo, n, 4, dim)
         coeffs[short[mine] - lo] = own[mine]
         # ("clip": the rows are in range by construction; "raise" copies through a buffer.)
         local = kept[rows] - lo * n
