@@ -63,8 +63,8 @@ class SpeedPlan:
         Total wall time spent in the LP solver, seconds.
     objectives : tuple of float
         ``sum(b)`` (in the planning parameter) of every LP, in order:
-        jerk-free; with a jerk limit then jerk-free with the rest-end caps,
-        the pseudo-jerk iterates and the certification LP; then per
+        jerk-free (with a jerk limit, with the rest-end caps); with a jerk
+        limit then the pseudo-jerk iterates and the certification LP; then per
         refinement round its iterates and certification LP (one LP per round
         without jerk limit).
     jerk_changes : tuple of float
