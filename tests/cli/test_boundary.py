@@ -94,6 +94,47 @@ def test_ctrl_c_while_the_program_starts_is_one_line_and_130(tmp_path: Path) -> 
     assert "Traceback" not in text and "interrupted by Ctrl+C" in _one_line(text)
 
 
+#: A child that imports the program as the console script does, through a module whose
+#: start is hit by Ctrl+C and swallows it, as piqp's loader does: the signal is sent from
+#: inside the import of the program, then a "compiled module's start" runs.
+SWALLOWED_AT_START = """
+import os, signal, sys, time
+signal.signal(signal.SIGINT, signal.default_int_handler)
+
+class Swallowing:
+    def find_spec(self, name, path=None, target=None):
+        if name == "skyquill.cli.main":
+            try:
+                os.kill(os.getpid(), signal.SIGINT)
+                time.sleep(0.5)
+            except KeyboardInterrupt:
+                sys.stderr.write("swallowed\\n")
+        return None
+
+sys.meta_path.insert(0, Swallowing())
+from skyquill.cli.entry import run
+run()
+"""
+
+
+@pytest.mark.timeout(120)
+def test_ctrl_c_inside_a_compiled_module_s_start_is_raised_after_the_imports() -> None:
+    """Ctrl+C in piqp's or ruckig's initialisation failed it (``ImportError:
+    initialization failed``, a traceback), crashed the interpreter (-11), or was swallowed
+    by piqp's loader and the command ran to its end (3 of 200 runs): held while the program
+    is imported, it is raised after, in the program's own code."""
+    child = subprocess.run(
+        [sys.executable, "-c", SWALLOWED_AT_START, "--version"],
+        capture_output=True,
+        timeout=110,
+        check=False,
+    )
+    text = child.stderr.decode()
+    assert child.returncode == 130, text
+    assert "swallowed" not in text
+    assert "Traceback" not in text and "interrupted by Ctrl+C" in _one_line(text)
+
+
 def test_warnings_before_an_error_are_not_printed(monkeypatch: pytest.MonkeyPatch) -> None:
     """Issue 25: scipy and shapely warnings came on stderr before the error line."""
 

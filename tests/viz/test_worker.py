@@ -137,6 +137,49 @@ def test_the_console_script_draws_in_the_worker(tmp_path: Path, command: tuple[s
     assert "matplotlib here: False" in done.stdout  # imported by the worker alone
 
 
+#: Ctrl+C held (as the console script holds it while the program loads) and sent just
+#: after the worker's process is forked, before it is given its work: the moment
+#: multiprocessing's resource tracker, started with the first process, had unblocked it.
+CTRL_C_AS_THE_WORKER_STARTS = """
+import os, signal, sys
+from multiprocessing import util
+signal.signal(signal.SIGINT, signal.default_int_handler)
+spawn = util.spawnv_passfds
+
+def spawn_then_ctrl_c(path, args, passfds):
+    pid = spawn(path, args, passfds)
+    if any("spawn_main" in str(arg) for arg in args):  # the worker, not the tracker
+        os.kill(os.getpid(), signal.SIGINT)
+    return pid
+
+util.spawnv_passfds = spawn_then_ctrl_c
+from skyquill.cli.entry import _ctrl_c_held
+from skyquill.viz.worker import PictureWorker
+try:
+    with _ctrl_c_held():
+        PictureWorker()
+        sys.stdout.write("started\\n")
+except KeyboardInterrupt:
+    sys.exit(130)
+"""
+
+
+@pytest.mark.timeout(120)
+def test_ctrl_c_while_the_worker_starts_comes_after_its_start() -> None:
+    """The Ctrl+C was raised between the worker's fork and its work: the worker, given
+    nothing, printed ``EOFError: Ran out of input`` under the command's one line."""
+    done = subprocess.run(
+        [sys.executable, "-c", CTRL_C_AS_THE_WORKER_STARTS],
+        capture_output=True,
+        text=True,
+        timeout=110,
+        check=False,
+    )
+    assert done.returncode == 130, done.stderr
+    assert done.stdout == "started\n"
+    assert done.stderr == ""
+
+
 def test_the_samples_unpickle_without_matplotlib_or_the_core() -> None:
     """What the worker imports to read the samples: numpy, not the planner (0.5 s more)."""
     probe = (

@@ -96,6 +96,7 @@ class PictureWorker:
     def __init__(self) -> None:
         clock = time.perf_counter()
         import multiprocessing  # a tenth of a second: counted in start_s
+        from multiprocessing import resource_tracker
 
         self._queued_s = _run_queue_s()
         context = multiprocessing.get_context("spawn")
@@ -105,12 +106,19 @@ class PictureWorker:
         )
         # Ctrl+C reaches the worker too (one process group): blocked while it starts, the
         # signal stays blocked in it from its first instruction (the mask survives exec),
-        # and is delivered here once unblocked, not lost.
-        blocked = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+        # and is delivered here once the caller's mask is back, not lost. multiprocessing
+        # starts its resource tracker with the first process and *unblocks* SIGINT after
+        # it, whatever the mask was: a Ctrl+C then came in the middle of the worker's
+        # start (the worker, given nothing, printed a traceback). So the tracker first
+        # (a Ctrl+C held until then is raised there, before the worker exists), then the
+        # mask again for the worker's start.
+        caller = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
         try:
+            resource_tracker.ensure_running()
+            signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
             self._process.start()
         finally:
-            signal.pthread_sigmask(signal.SIG_SETMASK, blocked)
+            signal.pthread_sigmask(signal.SIG_SETMASK, caller)
         theirs.close()
         self.start_s = time.perf_counter() - clock
         self.contention_s: float | None = None
