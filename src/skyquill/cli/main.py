@@ -175,11 +175,28 @@ def user_errors() -> Iterator[None]:
     except RecursionError:
         fail("got input nested too deeply to read, expected a flatter file")
     except Exception as exc:
+        if _raised_from_ctrl_c(exc):
+            # Ctrl+C inside a compiled module's start (matplotlib's, imported to draw a
+            # picture here) fails its import: "ImportError: initialization failed", raised
+            # from the KeyboardInterrupt. The person pressed Ctrl+C: say that.
+            raise KeyboardInterrupt from None
         fail(
             f"internal error ({type(exc).__name__}: {exc}); this is a bug in skyquill, please "
             "report it with the command line that caused it",
             status=1,
         )
+
+
+def _raised_from_ctrl_c(exc: BaseException) -> bool:
+    """Whether ``exc`` was raised from, or while handling, a ``KeyboardInterrupt``."""
+    seen: set[int] = set()
+    cause = exc.__cause__ or exc.__context__
+    while cause is not None and id(cause) not in seen:
+        if isinstance(cause, KeyboardInterrupt):
+            return True
+        seen.add(id(cause))
+        cause = cause.__cause__ or cause.__context__
+    return False
 
 
 @contextmanager
