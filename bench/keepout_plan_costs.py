@@ -162,7 +162,6 @@ def from_the_estimate(estimates: dict[int, tuple[np.ndarray, np.ndarray]]) -> An
 
     def wrap(fn: Any) -> Any:
         def inner(lp: Any, bounds: Any, *, c1: Any, jmax: Any, stop: Any, log: Any) -> Any:
-            lp.solve(bounds.rows(None), bounds.cols())
             _end_caps(bounds.ub, c1, jmax)
             start = lp.solve(bounds.rows(None), bounds.cols())
             u, b = estimates[start.size]
