@@ -3,6 +3,8 @@ pieces, rest at every waypoint."""
 
 from __future__ import annotations
 
+from unittest import mock
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -10,6 +12,7 @@ from hypothesis import strategies as st
 from ruckig import InputParameter, Ruckig, Trajectory
 from ruckig_reference import merged_phases, ruckig_move
 
+import skyquill.optimize.legs as legs_module
 from skyquill.errors import InputError
 from skyquill.limits import vehicle_limits
 from skyquill.optimize.legs import (
@@ -423,14 +426,23 @@ def _chain_points(kinds: list[str], seed: int, limits: tuple[float, float, float
 @given(
     st.lists(_CHAIN, min_size=1, max_size=4),
     st.tuples(st.floats(0.1, 10.0), st.floats(0.1, 10.0), st.floats(0.5, 100.0)),
+    st.booleans(),
 )
 def test_chains_under_one_limit_are_their_legs_timed_one_by_one(
-    chains: list[tuple[list[str], int]], limits: tuple[float, float, float]
+    chains: list[tuple[list[str], int]], limits: tuple[float, float, float], shared: bool
 ) -> None:
     # Chains of any lengths in turn under one LegLimits (the legs that cruise share one
     # profile, its phase durations kept for the longest chain so far) against the same
     # chains with a LegLimits per leg (every leg its own closed-form profile), and every
-    # leg's duration against a fresh Ruckig call.
+    # leg's duration against a fresh Ruckig call. With `shared`, a chain of any size with
+    # legs too short to cruise takes the shared profile with their own phases written over
+    # it (by default only from PARTLY_CRUISING_FROM legs).
+    fewest = 1 if shared else legs_module.PARTLY_CRUISING_FROM
+    with mock.patch.object(legs_module, "PARTLY_CRUISING_FROM", fewest):
+        _check_chains(chains, limits)
+
+
+def _check_chains(chains: list[tuple[list[str], int]], limits: tuple[float, float, float]) -> None:
     lim = LegLimits(*limits)
     for kinds, seed in chains:
         pts = _chain_points(kinds, seed, limits)
@@ -469,11 +481,12 @@ def test_chains_under_one_limit_are_their_legs_timed_one_by_one(
 def test_a_chain_longer_than_a_mixing_block_is_its_legs_timed_one_by_one() -> None:
     # Legs too short to cruise at the first and last legs of each block of MIX_BLOCK legs
     # (the pieces are mixed a block at a time, straight into the result) and at the chain's
-    # ends, the rest long: the same flight as with a LegLimits per leg.
-    from skyquill.optimize.legs import MIX_BLOCK
+    # ends, the rest long: the same flight as with a LegLimits per leg. (A chain that long:
+    # shorter ones are timed leg by leg.)
+    from skyquill.optimize.legs import MIX_BLOCK, PARTLY_CRUISING_FROM
 
     limits = (2.0, 3.0, 10.0)
-    kinds = ["long"] * (2 * MIX_BLOCK + 3)
+    kinds = ["long"] * (PARTLY_CRUISING_FROM + 3)
     for k in (0, MIX_BLOCK - 1, MIX_BLOCK, 2 * MIX_BLOCK - 1, 2 * MIX_BLOCK, len(kinds) - 1):
         kinds[k] = "short"
     pts = _chain_points(kinds, 5, limits)
