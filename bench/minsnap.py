@@ -13,7 +13,11 @@ minsnap-trajectories at 10 waypoints; Ruckig legs at most 3x a direct call."
   rest-to-rest profile, ``optimize/double_s.py``; at 1,000 the chain has 6 legs too short
   to reach the speed limit) against the direct call: ``Ruckig(1).calculate`` on reused
   objects, one leg at a time, which returns no pieces -- the least any leg timing costs
-  through Ruckig's Python API.
+  through Ruckig's Python API. Also chains with every fifth leg too short to reach the
+  speed limit (``short legs``: a zigzag's turns, a show's small moves), whose legs are
+  timed on their own.
+
+``--legs-only`` times the legs alone and merges them into the JSON (a few seconds).
 
 BLAS is pinned to one thread, the collector is off while timing, and the clock is the
 process's CPU time; the machine has 2 noisy cores, so the ratios (same run, interleaved)
@@ -25,6 +29,7 @@ Run: ``.venv/bin/python bench/minsnap.py [--quick]`` -> ``bench/results/minsnap.
 from __future__ import annotations
 
 import argparse
+import itertools
 import json
 import time
 from collections.abc import Callable
@@ -39,6 +44,7 @@ from ruckig import InputParameter, Ruckig, Trajectory
 from threadpoolctl import threadpool_limits
 
 from common import gc_off, jsonable, machine_info
+from skyquill.optimize.double_s import cruise
 from skyquill.optimize.legs import LegLimits, stop_and_go
 from skyquill.optimize.minsnap import min_snap
 from skyquill.optimize.timing import allocate_segment_times
@@ -143,11 +149,30 @@ def _direct(lengths: np.ndarray, lim: LegLimits, *, read: bool = False) -> Calla
     return run_and_read if read else run
 
 
+#: Every this many legs one is scaled down to this fraction in the chains with short legs
+#: (to at most 1.7 m, most of them below the 1.93 m a leg needs to reach 2 m/s under
+#: 3 m/s^2 and 10 m/s^3; ``short_legs`` in the JSON counts those that do not).
+SHORT_EVERY, SHORT_SCALE = 5, 0.05
+
+
+def _chain(k: int, *, short: bool) -> np.ndarray:
+    """K random legs in a 20 m cube; with ``short``, every :data:`SHORT_EVERY`-th scaled."""
+    pts = np.random.default_rng(k).uniform(0.0, 20.0, size=(k + 1, 3))
+    if not short:
+        return pts
+    steps = np.diff(pts, axis=0)
+    steps[::SHORT_EVERY] *= SHORT_SCALE
+    return np.vstack([pts[:1], pts[0] + np.cumsum(steps, axis=0)])
+
+
 def leg_cases(quick: bool) -> list[dict[str, Any]]:
     out = []
     lim = LegLimits(2.0, 3.0, 10.0)
-    for k, rounds in LEG_COUNTS.items():
-        pts = np.random.default_rng(k).uniform(0.0, 20.0, size=(k + 1, 3))
+    profile = cruise(lim.vmax, float(lim.amax), float(lim.jmax))
+    assert profile is not None
+    ramp_s = profile.ramp_s  # a leg no longer than vmax ramp_s does not cruise
+    for (k, rounds), short in itertools.product(LEG_COUNTS.items(), (False, True)):
+        pts = _chain(k, short=short)
         lengths = np.linalg.norm(np.diff(pts, axis=0), axis=1).tolist()
         ours_t, direct_t, read_t = _interleaved(
             [
@@ -160,6 +185,7 @@ def leg_cases(quick: bool) -> list[dict[str, Any]]:
         out.append(
             {
                 "legs": k,
+                "short_legs": int(np.sum(np.asarray(lengths) <= lim.vmax * ramp_s)),
                 "runs": int(ours_t.size),
                 "ours_us_per_leg": float(np.median(ours_t)) / k * 1e6,
                 "direct_us_per_leg": float(np.median(direct_t)) / k * 1e6,
@@ -173,11 +199,18 @@ def leg_cases(quick: bool) -> list[dict[str, Any]]:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="fewer rounds, no 1,000-waypoint peer")
+    parser.add_argument(
+        "--legs-only", action="store_true", help="time the legs alone, merged into the JSON"
+    )
     args = parser.parse_args()
     console = Console()
     start = time.perf_counter()
     with threadpool_limits(1), console.status("timing min-snap and legs"):
-        minsnap = minsnap_cases(args.quick)
+        if args.legs_only:
+            earlier = json.loads(RESULTS.read_text())
+            minsnap = earlier["minsnap"]
+        else:
+            minsnap = minsnap_cases(args.quick)
         legs = leg_cases(args.quick)
     at10 = next(c for c in minsnap if c["waypoints"] == 10)
     at10k = next(c for c in minsnap if c["waypoints"] == 10_000)
@@ -193,17 +226,23 @@ def main() -> None:
         <= GOALS["minsnap_us_per_piece_at_10000"],
         "legs_ratio": summary["legs_ratio_worst"] <= GOALS["legs_ratio"],
     }
-    result = {
-        "schema": 1,
-        "generated_utc": datetime.now(UTC).isoformat(timespec="seconds"),
-        "quick": args.quick,
-        "total_wall_s": time.perf_counter() - start,
-        "machine": machine_info(("scipy", "ruckig", "minsnap-trajectories")),
-        "blas_threads_pinned_to": 1,
-        "minsnap": minsnap,
-        "legs": legs,
-        "summary": summary,
-    }
+    now = datetime.now(UTC).isoformat(timespec="seconds")
+    machine = machine_info(("scipy", "ruckig", "minsnap-trajectories"))
+    if args.legs_only:
+        result = earlier | {"legs": legs, "summary": summary, "legs_generated_utc": now,
+                            "legs_machine": machine}  # fmt: skip
+    else:
+        result = {
+            "schema": 1,
+            "generated_utc": now,
+            "quick": args.quick,
+            "total_wall_s": time.perf_counter() - start,
+            "machine": machine,
+            "blas_threads_pinned_to": 1,
+            "minsnap": minsnap,
+            "legs": legs,
+            "summary": summary,
+        }
     RESULTS.parent.mkdir(exist_ok=True)
     RESULTS.write_text(json.dumps(jsonable(result), indent=2) + "\n")
     table = Table(title="min-snap (banded) vs minsnap-trajectories; legs vs a direct Ruckig call")
@@ -218,7 +257,7 @@ def main() -> None:
         )
     for c in legs:
         table.add_row(
-            f"{c['legs']} legs",
+            f"{c['legs']} legs ({c['short_legs']} short)",
             f"{c['ours_us_per_leg']:.2f} us/leg",
             f"{c['direct_us_per_leg']:.2f} us/leg (direct)",
             f"{c['ratio_ours_over_direct']:.2f}x the direct call",
