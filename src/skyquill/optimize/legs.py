@@ -280,7 +280,7 @@ def _cruising(
     pieces are that profile's, mixed from each leg's direction, start and end, in a handful
     of numpy calls whatever the number of legs (no phase to drop, each quantity one call).
     None if the limits are per leg or per axis, or a leg (the ``shortest``, m) is too short
-    to cruise (then :func:`_partly_cruising` times them). The caller checks the legs'
+    to cruise (then :func:`_not_all_cruising` times them). The caller checks the legs'
     durations (:meth:`_Cruising.check`).
     """
     if not isinstance(limits, LegLimits) or limits.per_axis:
