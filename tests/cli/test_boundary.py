@@ -61,7 +61,8 @@ def _ctrl_c_in_a_compiled_module_s_start() -> None:
         # then) into a silent status 130.
         (Command, "parse_args", _ctrl_c),
         # A compiled module imported inside the command (matplotlib, for a picture drawn
-        # in the command's process): an internal error, "a bug in skyquill", exit status 1.
+        # in the command's process), whose failed start said "internal error ... a bug in
+        # skyquill" with exit status 1.
         (fit_cmd, "read_points_csv", _ctrl_c_in_a_compiled_module_s_start),
     ],
     ids=["inside a command", "while the options are read", "in a compiled module's start"],
