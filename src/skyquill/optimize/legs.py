@@ -446,17 +446,14 @@ def _mixed(
     )
     own[:, :, 0] += starts.take(short, axis=0)[:, None, :]
     out = np.empty((kept.size, 4, dim))
-    if k <= MIX_BLOCK:  # (one block: no bounds to look up)
-        blocks: Sequence[tuple[int, int, slice, slice]] = ((0, k, slice(None), slice(None)),)
-    else:
-        edges = np.arange(0, k + MIX_BLOCK, MIX_BLOCK)
-        at_short = np.searchsorted(short, edges).tolist()
-        at_kept = np.searchsorted(kept, edges * n).tolist()
-        blocks = [
-            (lo, min(k, lo + MIX_BLOCK), slice(at_short[b], at_short[b + 1]),
-             slice(at_kept[b], at_kept[b + 1]))
-            for b, lo in enumerate(range(0, k, MIX_BLOCK))
-        ]  # fmt: skip
+    edges = np.arange(0, k + MIX_BLOCK, MIX_BLOCK)
+    at_short = np.searchsorted(short, edges).tolist()
+    at_kept = np.searchsorted(kept, edges * n).tolist()
+    blocks = [
+        (lo, min(k, lo + MIX_BLOCK), slice(at_short[b], at_short[b + 1]),
+         slice(at_kept[b], at_kept[b + 1]))
+        for b, lo in enumerate(range(0, k, MIX_BLOCK))
+    ]  # fmt: skip
     for lo, hi, mine, rows in blocks:
         legs = slice(lo, hi)
         mixed = shared.mixed(starts[legs], ends[legs], delta[legs], lengths[legs])
